@@ -1,0 +1,50 @@
+// kincal: closed-form inverse kinematics by Paden-Kahan subproblems.
+//
+// For 6R robots whose axes 2 and 3 are parallel and whose axes 4, 5, 6 meet in one point (KUKA,
+// FANUC, ABB class), with any offsets. The wrist centre fixes q1 (subproblem 4: its component along
+// the parallel axes), q3 (subproblem 3: its distance from axis 2) and q2 (subproblem 1); the wrist
+// orientation gives q4, q5 (subproblem 2) and q6 (subproblem 1). Up to 2 x 2 x 2 = 8 solutions.
+#pragma once
+
+#include "kincal/model.hpp"
+
+namespace kincal {
+
+// Paden-Kahan subproblems on unit axes k through the origin (callers subtract the axis point).
+/// SP1: theta with rot(k, theta) u = v (u, v projected on the plane normal to k).
+double pk_sub1(const Vec3& k, const Vec3& u, const Vec3& v);
+/// SP2: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v. Returns the count (0, 1 or 2).
+int pk_sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, double t1[2], double t2[2]);
+/// SP3: theta with |rot(k, theta) u - v| = d. Returns the count (0, 1 or 2).
+int pk_sub3(const Vec3& k, const Vec3& u, const Vec3& v, double d, double t[2]);
+/// SP4: theta with h . rot(k, theta) u = d. Returns the count (0, 1 or 2).
+int pk_sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, double t[2]);
+
+enum class IkStatus { Ok, OutOfReach, Unsupported };
+
+struct IkSolution {
+  Eigen::Matrix<double, 6, 1> q_deg;  ///< joint angles in degrees (within limits when possible)
+  bool within_limits = false;
+  bool wrist_singular = false;        ///< axes 4 and 6 aligned: q4 + q6 is fixed, q4 is arbitrary
+  bool shoulder_singular = false;     ///< wrist centre on axis 1: q1 is arbitrary
+  bool approximate = false;           ///< out of reach: the nearest stretched configuration
+};
+
+struct IkSolutions {
+  IkStatus status = IkStatus::OutOfReach;
+  int count = 0;
+  std::array<IkSolution, 8> sol;
+};
+
+/// All closed-form solutions of the nominal model for the tool pose T (base frame, mm).
+/// Each angle is shifted by multiples of 360 deg to the value nearest ref_deg (or 0) that lies
+/// within the joint limits, when one does. Never NaN.
+/// With nearest_if_unreachable, a pose just out of reach (as a calibrated robot may reach) gives the
+/// configurations nearest to it (subproblems at tangency), flagged approximate: a start for Newton.
+IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg = nullptr,
+                   bool nearest_if_unreachable = false);
+
+/// The solution within limits nearest (max-norm in joint space) to ref_deg; -1 when none.
+int ik_nearest(const Model& m, const IkSolutions& s, const double* ref_deg);
+
+}  // namespace kincal

@@ -1,0 +1,29 @@
+// kincal: forward kinematics and Jacobians on the compiled evaluator of a Model.
+// Joint angles are radians here (the hot path); the program layer converts degrees.
+// Nothing here allocates: every buffer has a fixed maximum size.
+#pragma once
+
+#include "kincal/model.hpp"
+
+namespace kincal {
+
+/// Tool pose in the base frame (rigid model: no compliance).
+Eigen::Isometry3d fk(const Model& m, const VecQ& q);
+
+/// Geometric Jacobian 6xN at the tool point: rows 0-2 linear velocity (mm/rad), rows 3-5 angular
+/// velocity, both in the base frame (the same convention as KDL::ChainJntToJacSolver).
+void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac);
+
+/// Gravity torque on every joint (N mm) and, when dtau is not null, its derivative dtau/dq.
+void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau = nullptr);
+
+/// The joint angles after deflection under gravity: q + K tau(q).
+VecQ deflected(const Model& m, const VecQ& q);
+
+/// Tool pose with joint compliance (equals fk() for a model without compliance).
+Eigen::Isometry3d fk_compliant(const Model& m, const VecQ& q);
+
+/// Tool pose and the 6xN Jacobian of the compliant model with respect to the commanded q.
+void fk_jacobian_compliant(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac);
+
+}  // namespace kincal

@@ -1,0 +1,174 @@
+// kincal: the immutable serial-robot model.
+//
+// A serial revolute chain in product-of-exponentials (screw theory) form: every joint is a line in
+// the base frame at the zero configuration (a point and a direction), the tool is a frame at the zero
+// configuration. That is 4 independent parameters per joint (a line) plus 6 for the tool: 30 for a
+// 6R robot, the minimal complete set. Non-geometric: one joint compliance per gravity-loaded joint
+// (deflection = compliance * gravity torque), from the link masses and the payload.
+//
+// The Model never changes after construction. It owns an equivalent KDL::Chain (the reference for
+// every test) and a compiled evaluator (local frames along each joint axis) used by the hot paths.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace KDL {
+class Chain;
+}
+
+namespace kincal {
+
+constexpr int kMaxJoints = 12;
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using VecQ = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
+using MatQ = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>;
+using Jac = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxJoints>;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+/// A frame given as position (mm) and KUKA ABC angles (deg): R = Rz(a) Ry(b) Rx(c).
+struct Pose6 {
+  Vec3 xyz = Vec3::Zero();
+  Vec3 abc = Vec3::Zero();
+};
+
+/// Rotation of KUKA ABC angles in degrees.
+Mat3 abc_to_rotation(const Vec3& abc_deg);
+/// ABC angles in degrees of a rotation (b in [-90, 90]).
+Vec3 rotation_to_abc(const Mat3& r);
+Eigen::Isometry3d pose_to_iso(const Pose6& p);
+Pose6 iso_to_pose(const Eigen::Isometry3d& t);
+
+/// Error raised for bad input: the message names the source (file:line) and the cause.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct JointSpec {
+  std::string name;
+  Vec3 point = Vec3::Zero();     ///< a point of the axis, base frame, zero configuration (mm)
+  Vec3 axis = Vec3::UnitZ();     ///< axis direction (normalised by the Model)
+  double lower_deg = -180, upper_deg = 180;
+  double max_velocity_deg_s = 0, max_acceleration_deg_s2 = 0, max_jerk_deg_s3 = 0;  ///< 0: unknown
+  double mass_kg = 0;            ///< mass of the link this joint moves (the link after the joint)
+  Vec3 com = Vec3::Zero();       ///< its centre of mass, base frame, zero configuration (mm)
+  double compliance_deg_per_knm = 0;  ///< joint deflection per gravity torque (deg per kN m)
+};
+
+/// Everything that defines one robot geometry; plain data, checked when a Model is built from it.
+struct ModelSpec {
+  std::string name = "robot";
+  std::vector<JointSpec> joints;
+  Pose6 tool;                      ///< tool (TCP) frame in the base frame at zero configuration
+  double payload_kg = 0;
+  Vec3 payload_com = Vec3::Zero(); ///< payload centre of mass in the tool frame (mm)
+  Vec3 gravity = Vec3(0, 0, -9.81);///< gravity in the base frame (m/s^2)
+  Pose6 base_in_instrument;        ///< robot base frame seen from the measuring instrument
+  std::vector<double> home_deg;    ///< preferred configuration for the first pose of a program
+};
+
+/// Which closed-form inverse kinematics applies to a model.
+struct IkStructure {
+  bool spherical_wrist_parallel_23 = false;  ///< axes 4,5,6 meet, axes 2,3 parallel (KUKA class)
+  std::string reason;                        ///< why not, when not
+  Vec3 wrist_center = Vec3::Zero();
+};
+
+class Model {
+ public:
+  explicit Model(ModelSpec spec);
+  ~Model();
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+
+  const ModelSpec& spec() const { return spec_; }
+  int dof() const { return n_; }
+  const KDL::Chain& kdl_chain() const { return *chain_; }
+  const IkStructure& ik_structure() const { return ik_; }
+  /// true for a joint that carries a compliance parameter (its axis is not fixed along gravity)
+  bool gravity_loaded(int j) const { return loaded_[j]; }
+  int compliance_count() const;
+  bool has_compliance() const { return has_compliance_; }
+  const Vec3& axis(int j) const { return w_[j]; }
+  const Vec3& point(int j) const { return p_[j]; }
+  const Eigen::Isometry3d& tool() const { return tool_; }
+  const Eigen::Isometry3d& base_in_instrument() const { return base_in_instrument_; }
+  bool within_limits_deg(const VecQ& q_deg, double tol_deg = 1e-9) const;
+
+  // --- compiled evaluator data (read by kinematics.cpp) ---
+  struct Link {
+    Mat3 r;     ///< rotation of the constant transform after the joint
+    Vec3 t;     ///< translation of it
+    double m;   ///< mass carried by the joint's link (payload included on the last)
+    Vec3 mc;    ///< first moment m * com in the joint's local frame (kg mm)
+  };
+  const Mat3& c0_r() const { return c0_r_; }
+  const Vec3& c0_t() const { return c0_t_; }
+  const Link& link(int j) const { return links_[j]; }
+  const Vec3& gravity() const { return g_; }
+  /// compliance in rad per N mm (internal unit)
+  double compliance(int j) const { return k_[j]; }
+
+ private:
+  ModelSpec spec_;
+  int n_ = 0;
+  std::unique_ptr<KDL::Chain> chain_;
+  IkStructure ik_;
+  std::array<bool, kMaxJoints> loaded_{};
+  bool has_compliance_ = false;
+  std::array<Vec3, kMaxJoints> w_, p_;
+  std::array<double, kMaxJoints> k_{};
+  Eigen::Isometry3d tool_, base_in_instrument_;
+  Mat3 c0_r_;
+  Vec3 c0_t_;
+  std::array<Link, kMaxJoints> links_;
+  Vec3 g_;
+};
+
+using ModelPtr = std::shared_ptr<const Model>;
+
+/// A robot as users name it: the nominal geometry (for the closed-form IK start) and the
+/// calibrated one (for FK and compensation). For a nominal robot both are the same object.
+struct Robot {
+  ModelPtr nominal;
+  ModelPtr calibrated;
+  bool identified() const { return nominal != calibrated; }
+};
+
+/// The built-in KUKA KR 500 R2830-class robot with a tape-laying head (sources in model.cpp).
+ModelSpec kr500_spec();
+/// Names of the built-in robots.
+std::vector<std::string> builtin_names();
+/// A built-in robot by name; throws InputError naming the unknown robot.
+ModelSpec builtin_spec(const std::string& name);
+
+/// Model JSON (contract: "format": "kincal-model", "version"). Exact round trip.
+std::string robot_to_json(const Robot& robot);
+Robot robot_from_json(const std::string& text, const std::string& source);
+/// A built-in name or a model JSON file path (URDF files are read by the Python layer).
+Robot load_robot(const std::string& name_or_path);
+std::string spec_to_json(const ModelSpec& spec);
+
+}  // namespace kincal
+
+namespace kincal {
+
+/// Realistic manufacturing errors for simulations and tests: every axis tilted by about sigma_deg
+/// and moved by about sigma_mm normal to itself, the tool moved and turned by the same amounts;
+/// with_compliance sets a joint compliance on every gravity-loaded joint (deg per kN m, about
+/// `compliance` each). Deterministic for a seed.
+ModelSpec perturbed_spec(const ModelSpec& spec, unsigned seed, double sigma_mm = 1.0, double sigma_deg = 0.05,
+                         double compliance = 0.0);
+
+}  // namespace kincal

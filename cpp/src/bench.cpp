@@ -1,0 +1,201 @@
+#include "kincal/bench.hpp"
+
+#include "kincal/compensation.hpp"
+#include "kincal/ik.hpp"
+#include "kincal/io.hpp"
+#include "kincal/kinematics.hpp"
+#include "kincal/model.hpp"
+
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_nr.hpp>
+#include <kdl/chainiksolvervel_pinv.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <random>
+#include <thread>
+
+namespace kincal {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Q6 = Eigen::Matrix<double, 6, 1>;
+
+volatile double g_sink = 0;
+
+// Median over batches of the time per call, in ns.
+template <class F>
+double time_ns(int n, F&& f, int batches = 15) {
+  std::vector<double> per;
+  for (int b = 0; b < batches; ++b) {
+    const auto t0 = Clock::now();
+    for (int i = 0; i < n; ++i) f(i);
+    const auto t1 = Clock::now();
+    per.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / n);
+  }
+  std::sort(per.begin(), per.end());
+  return per[per.size() / 2];
+}
+
+KDL::JntArray to_kdl(const VecQ& q) {
+  KDL::JntArray a(static_cast<unsigned>(q.size()));
+  for (int i = 0; i < q.size(); ++i) a(i) = q[i];
+  return a;
+}
+
+KDL::Frame to_kdl(const Eigen::Isometry3d& t) {
+  const Mat3& r = t.linear();
+  const Vec3& p = t.translation();
+  return KDL::Frame(KDL::Rotation(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)),
+                    KDL::Vector(p[0], p[1], p[2]));
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed, int threads) {
+  std::vector<std::pair<std::string, double>> out;
+  const Model nom(kr500_spec());
+  const Model cal(perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.0));
+  const Model calc(perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.003));
+  std::mt19937_64 rng(seed);
+  // random configurations inside the limits, more than 1 degree from the wrist singularity
+  std::vector<VecQ> qs;
+  std::vector<Pose6> poses;
+  std::vector<Q6> qref;
+  while (static_cast<int>(qs.size()) < n) {
+    VecQ q(6);
+    for (int j = 0; j < 6; ++j) {
+      const auto& js = nom.spec().joints[j];
+      q[j] = std::uniform_real_distribution<double>(js.lower_deg, js.upper_deg)(rng);
+    }
+    if (std::abs(q[4]) < 1.0 || std::abs(q[2] - 3.07) < 1.0) continue;  // wrist, elbow singularities
+    qref.push_back(q);
+    const VecQ qr = q * kDeg;
+    qs.push_back(qr);
+    poses.push_back(iso_to_pose(fk(nom, qr)));
+  }
+  out.emplace_back("poses", n);
+
+  // FK
+  out.emplace_back("fk_ns", time_ns(n, [&](int i) { g_sink = g_sink + fk(nom, qs[i]).translation()[0]; }));
+  KDL::ChainFkSolverPos_recursive kfk(nom.kdl_chain());
+  std::vector<KDL::JntArray> kq;
+  for (const auto& q : qs) kq.push_back(to_kdl(q));
+  KDL::Frame kf;
+  out.emplace_back("kdl_fk_ns", time_ns(n, [&](int i) {
+                     kfk.JntToCart(kq[i], kf);
+                     g_sink = g_sink + kf.p.x();
+                   }));
+  // Jacobian
+  Eigen::Isometry3d t;
+  Jac jac;
+  out.emplace_back("jacobian_ns", time_ns(n, [&](int i) {
+                     fk_jacobian(nom, qs[i], t, jac);
+                     g_sink = g_sink + jac(0, 0);
+                   }));
+  KDL::ChainJntToJacSolver kjac(nom.kdl_chain());
+  KDL::Jacobian kj(6);
+  out.emplace_back("kdl_jacobian_ns", time_ns(n, [&](int i) {
+                     kjac.JntToJac(kq[i], kj);
+                     g_sink = g_sink + kj(0, 0);
+                   }));
+  // IK, all solutions
+  std::vector<Eigen::Isometry3d> targets;
+  for (const auto& p : poses) targets.push_back(pose_to_iso(p));
+  out.emplace_back("ik_all_ns", time_ns(n, [&](int i) {
+                     const IkSolutions s = ik_all(nom, targets[i], qref[i].data());
+                     g_sink = g_sink + s.count;
+                   }));
+  // Compensation: nominal IK start, Newton on the calibrated model
+  std::vector<Q6> start(n);
+  for (int i = 0; i < n; ++i) {
+    const IkSolutions s = ik_all(nom, targets[i], qref[i].data());
+    const int k = ik_nearest(nom, s, qref[i].data());
+    start[i] = k >= 0 ? s.sol[k].q_deg : qref[i];
+  }
+  CompensationOptions an, fd;
+  fd.finite_difference = true;
+  int failed = 0;
+  // the program path: nominal IK nearest the reference, corrected start, Newton (io.hpp)
+  auto nomp = std::make_shared<Model>(kr500_spec());
+  const Robot rob{nomp, std::make_shared<Model>(cal.spec())};
+  const Robot robc{nomp, std::make_shared<Model>(calc.spec())};
+  struct R {
+    Q6 q_deg;
+    bool ok;
+  };
+  std::string err;
+  auto comp_with_ik = [&](const Robot& rb, const CompensationOptions& o, int i) {
+    ProgramOptions po;
+    po.comp = o;
+    R r;
+    int it;
+    double res;
+    r.ok = solve_pose(rb, po, poses[i], qref[i], r.q_deg, it, res, err);
+    return r;
+  };
+  out.emplace_back("compensate_ns", time_ns(n, [&](int i) {
+                     const auto r = comp_with_ik(rob, an, i);
+                     failed += !r.ok;
+                     g_sink = g_sink + r.q_deg[0];
+                   }));
+  out.emplace_back("compensate_newton_only_ns", time_ns(n, [&](int i) {
+                     const auto r = compensate(cal, poses[i], start[i], an);
+                     g_sink = g_sink + r.q_deg[0];
+                   }));
+  out.emplace_back("compensate_compliance_ns", time_ns(n, [&](int i) {
+                     const auto r = comp_with_ik(robc, an, i);
+                     g_sink = g_sink + r.q_deg[0];
+                   }));
+  out.emplace_back("compensate_fd_ns", time_ns(n, [&](int i) {
+                     const auto r = comp_with_ik(rob, fd, i);
+                     g_sink = g_sink + r.q_deg[0];
+                   }, 5));
+  // KDL's Newton-Raphson on the same calibrated chain, from the same start, |twist| < 3.2e-8 per
+  // component (our stop |F|^2 < 1e-15)
+  KDL::ChainFkSolverPos_recursive cfk(cal.kdl_chain());
+  KDL::ChainIkSolverVel_pinv cvel(cal.kdl_chain());
+  KDL::ChainIkSolverPos_NR cnr(cal.kdl_chain(), cfk, cvel, 100, std::sqrt(1e-15));
+  std::vector<KDL::JntArray> kstart;
+  for (const auto& s : start) kstart.push_back(to_kdl(VecQ(s * kDeg)));
+  KDL::JntArray kout(6);
+  const int nk = std::min(n, 500);
+  int kdl_failed = 0;
+  out.emplace_back("kdl_nr_ns", time_ns(nk, [&](int i) {
+                     const Eigen::Isometry3d& tg = targets[i];
+                     kdl_failed += cnr.CartToJnt(kstart[i], to_kdl(tg), kout) < 0;
+                     g_sink = g_sink + kout(0);
+                   }, 3));
+  // all cores
+  const int nt = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+  const int reps = 20;
+  const auto t0 = Clock::now();
+  std::vector<std::thread> pool;
+  for (int w = 0; w < nt; ++w) {
+    pool.emplace_back([&, w] {
+      double sink = 0;
+      for (int r = 0; r < reps; ++r)
+        for (int i = w; i < n; i += nt) sink += comp_with_ik(rob, an, i).q_deg[0];
+      g_sink = g_sink + sink;
+    });
+  }
+  for (auto& th : pool) th.join();
+  const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
+  out.emplace_back("batch_poses_per_s", n * reps / secs);
+  out.emplace_back("batch_threads", nt);
+  out.emplace_back("compensate_failures", failed / 15.0);
+  out.emplace_back("kdl_nr_failures", kdl_failed / 3.0);
+  auto get = [&](const char* k) {
+    for (auto& p : out)
+      if (p.first == k) return p.second;
+    return 0.0;
+  };
+  out.emplace_back("fk_speedup_vs_kdl", get("kdl_fk_ns") / get("fk_ns"));
+  out.emplace_back("jacobian_speedup_vs_kdl", get("kdl_jacobian_ns") / get("jacobian_ns"));
+  out.emplace_back("compensate_speedup_vs_kdl_nr", get("kdl_nr_ns") / get("compensate_ns"));
+  return out;
+}
+
+}  // namespace kincal

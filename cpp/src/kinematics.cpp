@@ -1,0 +1,132 @@
+#include "kincal/kinematics.hpp"
+
+#include <cmath>
+
+namespace kincal {
+
+namespace {
+
+// T <- T * Rz(q): mixes the first two columns of the rotation.
+inline void rotate_z(Mat3& r, double q) {
+  const double c = std::cos(q), s = std::sin(q);
+  const Vec3 x = r.col(0), y = r.col(1);
+  r.col(0) = c * x + s * y;
+  r.col(1) = c * y - s * x;
+}
+
+// Walks the chain; calls visit(j, R, t) with the frame right after joint j's rotation.
+template <class Visit>
+inline void walk(const Model& m, const VecQ& q, Mat3& r, Vec3& t, Visit&& visit) {
+  r = m.c0_r();
+  t = m.c0_t();
+  const int n = m.dof();
+  for (int j = 0; j < n; ++j) {
+    rotate_z(r, q[j]);
+    visit(j, r, t);
+    const Model::Link& l = m.link(j);
+    t += r * l.t;
+    r = r * l.r;
+  }
+}
+
+}  // namespace
+
+Eigen::Isometry3d fk(const Model& m, const VecQ& q) {
+  Mat3 r;
+  Vec3 t;
+  walk(m, q, r, t, [](int, const Mat3&, const Vec3&) {});
+  Eigen::Isometry3d out;
+  out.linear() = r;
+  out.translation() = t;
+  out.makeAffine();
+  return out;
+}
+
+void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac) {
+  const int n = m.dof();
+  std::array<Vec3, kMaxJoints> z, o;
+  Mat3 r;
+  Vec3 t;
+  walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
+    z[j] = rj.col(2);
+    o[j] = tj;
+  });
+  jac.resize(6, n);
+  for (int j = 0; j < n; ++j) {
+    jac.block<3, 1>(0, j) = z[j].cross(t - o[j]);
+    jac.block<3, 1>(3, j) = z[j];
+  }
+  tool.linear() = r;
+  tool.translation() = t;
+  tool.makeAffine();
+}
+
+void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
+  const int n = m.dof();
+  std::array<Vec3, kMaxJoints> z, o, mc;
+  std::array<double, kMaxJoints> mass;
+  Mat3 r;
+  Vec3 t;
+  walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
+    z[j] = rj.col(2);
+    o[j] = tj;
+    const Model::Link& l = m.link(j);
+    mass[j] = l.m;
+    mc[j] = rj * l.mc + l.m * tj;  // first moment about the base origin
+  });
+  // r_j = sum_{k>=j} m_k (c_k - o_j): the moment arm of everything joint j carries.
+  std::array<Vec3, kMaxJoints> arm;
+  Vec3 s = Vec3::Zero();
+  double msum = 0;
+  for (int j = n - 1; j >= 0; --j) {
+    s += mc[j];
+    msum += mass[j];
+    arm[j] = s - msum * o[j];
+  }
+  const Vec3& g = m.gravity();
+  tau.resize(n);
+  // torque about axis z_j of the weight: z_j . (arm_j x g)  [kg mm m/s^2 = N mm]
+  for (int j = 0; j < n; ++j) tau[j] = z[j].dot(arm[j].cross(g));
+  if (dtau) {
+    dtau->resize(n, n);
+    for (int j = 0; j < n; ++j) {
+      const Vec3 zj_arm = z[j].cross(arm[j]);
+      for (int i = 0; i < n; ++i) {
+        // i <= j: the whole sub-chain rotates about z_i; i > j: only the part beyond joint i moves.
+        (*dtau)(j, i) = (i <= j) ? g.dot(z[i].cross(zj_arm)) : g.dot(z[j].cross(z[i].cross(arm[i])));
+      }
+    }
+  }
+}
+
+VecQ deflected(const Model& m, const VecQ& q) {
+  if (!m.has_compliance()) return q;
+  VecQ tau;
+  gravity_torque(m, q, tau);
+  VecQ out = q;
+  for (int j = 0; j < m.dof(); ++j) out[j] += m.compliance(j) * tau[j];
+  return out;
+}
+
+Eigen::Isometry3d fk_compliant(const Model& m, const VecQ& q) { return fk(m, deflected(m, q)); }
+
+void fk_jacobian_compliant(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac) {
+  if (!m.has_compliance()) {
+    fk_jacobian(m, q, tool, jac);
+    return;
+  }
+  const int n = m.dof();
+  VecQ tau;
+  MatQ dtau;
+  gravity_torque(m, q, tau, &dtau);
+  VecQ qd = q;
+  for (int j = 0; j < n; ++j) qd[j] += m.compliance(j) * tau[j];
+  Jac j0;
+  fk_jacobian(m, qd, tool, j0);
+  // d q_eff / d q = I + K dtau/dq
+  MatQ dq = MatQ::Identity(n, n);
+  for (int j = 0; j < n; ++j) dq.row(j) += m.compliance(j) * dtau.row(j);
+  jac.noalias() = j0 * dq;
+}
+
+}  // namespace kincal

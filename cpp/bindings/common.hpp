@@ -1,0 +1,13 @@
+// Shared declarations of the _core bindings: one define_<area> per area, gathered in module.cpp.
+#pragma once
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+namespace py = pybind11;
+
+void define_model(py::module_& m);
+void define_kinematics(py::module_& m);
+void define_programs(py::module_& m);

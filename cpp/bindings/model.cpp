@@ -1,0 +1,36 @@
+#include "common.hpp"
+
+#include "kincal/model.hpp"
+
+using namespace kincal;
+
+void define_model(py::module_& m) {
+  py::class_<Robot>(m, "Robot", "A robot: nominal geometry and calibrated geometry (immutable)")
+      .def_static("load", &load_robot, py::arg("name_or_path"), "A built-in name or a model JSON file")
+      .def_static("from_json", &robot_from_json, py::arg("text"), py::arg("source") = "<json>")
+      .def("to_json", [](const Robot& r) { return robot_to_json(r); })
+      .def_property_readonly("dof", [](const Robot& r) { return r.nominal->dof(); })
+      .def_property_readonly("identified", &Robot::identified)
+      .def_property_readonly("name", [](const Robot& r) { return r.nominal->spec().name; })
+      .def_property_readonly("compliance_count", [](const Robot& r) { return r.nominal->compliance_count(); })
+      .def_property_readonly("geometric_parameter_count", [](const Robot& r) { return 4 * r.nominal->dof() + 6; })
+      .def_property_readonly("closed_form_ik",
+                             [](const Robot& r) { return r.nominal->ik_structure().spherical_wrist_parallel_23; })
+      .def_property_readonly("ik_reason", [](const Robot& r) { return r.nominal->ik_structure().reason; })
+      .def_property_readonly("home_deg", [](const Robot& r) { return r.nominal->spec().home_deg; })
+      .def_property_readonly("limits_deg",
+                             [](const Robot& r) {
+                               std::vector<std::pair<double, double>> l;
+                               for (const auto& j : r.nominal->spec().joints) l.emplace_back(j.lower_deg, j.upper_deg);
+                               return l;
+                             })
+      .def(
+          "with_calibrated",
+          [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance) {
+            return Robot{r.nominal, std::make_shared<Model>(perturbed_spec(r.nominal->spec(), seed, sigma_mm,
+                                                                            sigma_deg, compliance))};
+          },
+          py::arg("seed"), py::arg("sigma_mm") = 1.0, py::arg("sigma_deg") = 0.05, py::arg("compliance") = 0.0,
+          "A robot whose calibrated model has simulated manufacturing errors (for simulations and demos)");
+  m.def("builtin_names", &builtin_names);
+}

@@ -1,0 +1,11 @@
+#include "common.hpp"
+
+#include "kincal/model.hpp"
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "kincal C++ core (private: use the kincal package)";
+  py::register_exception<kincal::InputError>(m, "InputError", PyExc_ValueError);
+  define_model(m);
+  define_kinematics(m);
+  define_programs(m);
+}

@@ -1,0 +1,113 @@
+#include "common.hpp"
+
+#include "kincal/bench.hpp"
+#include "kincal/io.hpp"
+
+using namespace kincal;
+
+namespace {
+
+using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+ProgramOptions options(bool compensate, bool instrument, bool fd, double delta, double epsilon, int max_iter,
+                       bool corrected_start) {
+  ProgramOptions o;
+  o.compensate = compensate;
+  o.instrument_frame = instrument;
+  o.corrected_start = corrected_start;
+  o.comp.finite_difference = fd;
+  o.comp.delta = delta;
+  o.comp.epsilon = epsilon;
+  o.comp.max_iterations = max_iter;
+  return o;
+}
+
+py::dict result_dict(const ProgramResult& r) {
+  Rows q(static_cast<Eigen::Index>(r.q_deg.size()), 6);
+  for (size_t i = 0; i < r.q_deg.size(); ++i) q.row(static_cast<Eigen::Index>(i)) = r.q_deg[i].transpose();
+  py::dict d;
+  d["q_deg"] = q;
+  d["iterations"] = r.iterations;
+  d["residual"] = r.residual;
+  return d;
+}
+
+}  // namespace
+
+#define KINCAL_COMP_ARGS                                                                                  \
+  py::arg("compensate") = true, py::arg("instrument") = false, py::arg("finite_difference") = false,     \
+      py::arg("delta") = 1e-8, py::arg("epsilon") = 1e-15, py::arg("max_iterations") = 20,               \
+      py::arg("corrected_start") = true
+
+void define_programs(py::module_& m) {
+  m.def(
+      "compensate_poses",
+      [](const Robot& r, const Rows& poses, bool comp, bool instr, bool fd, double delta, double eps, int it,
+         bool cs) {
+        if (poses.cols() != 6) throw InputError("poses need 6 columns x,y,z,a,b,c");
+        std::vector<Pose6> p;
+        std::vector<std::string> where;
+        for (Eigen::Index i = 0; i < poses.rows(); ++i) {
+          if (!poses.row(i).allFinite()) throw InputError("pose " + std::to_string(i) + ": NaN or infinite value");
+          p.push_back(Pose6{poses.row(i).head<3>().transpose(), poses.row(i).tail<3>().transpose()});
+          where.push_back("pose " + std::to_string(i));
+        }
+        py::gil_scoped_release release;
+        const ProgramResult res = compensate_poses(r, p, where, options(comp, instr, fd, delta, eps, it, cs));
+        py::gil_scoped_acquire acquire;
+        return result_dict(res);
+      },
+      py::arg("robot"), py::arg("poses"), KINCAL_COMP_ARGS,
+      "IK + Newton compensation of every pose (N x 6), branch kept continuous");
+  m.def(
+      "compensate_program",
+      [](const Robot& r, const std::string& in, const std::string& out, bool comp, bool instr, bool fd, double delta,
+         double eps, int it, bool cs) {
+        return result_dict(compensate_program_file(r, in, out, options(comp, instr, fd, delta, eps, it, cs)));
+      },
+      py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS,
+      "Compensates a pose program file (CSV or G-code) into a joint program file, atomically");
+  m.def(
+      "read_pose_program",
+      [](const std::string& path) {
+        const PoseProgram p = read_pose_program(path);
+        Rows out(static_cast<Eigen::Index>(p.poses.size()), 6);
+        for (size_t i = 0; i < p.poses.size(); ++i)
+          out.row(static_cast<Eigen::Index>(i)) << p.poses[i].xyz.transpose(), p.poses[i].abc.transpose();
+        return std::make_pair(out, p.pose_line);
+      },
+      py::arg("path"));
+  m.def(
+      "read_joint_program",
+      [](const std::string& path, int dof) {
+        const JointProgram p = read_joint_program(path, dof);
+        Rows out(static_cast<Eigen::Index>(p.q.size()), dof);
+        for (size_t i = 0; i < p.q.size(); ++i)
+          for (int j = 0; j < dof; ++j) out(static_cast<Eigen::Index>(i), j) = p.q[i][static_cast<size_t>(j)];
+        return std::make_pair(out, p.line);
+      },
+      py::arg("path"), py::arg("dof"), "Joint program (CSV q1..qN or G-code A1=..) in degrees");
+  m.def("write_file_atomic", &write_file_atomic, py::arg("path"), py::arg("text"));
+  m.def(
+      "stream_lines",
+      [](const Robot& r, const std::vector<std::string>& lines, bool instr) {
+        StreamCompensator sc(r, options(true, instr, false, 1e-8, 1e-15, 20, true));
+        std::vector<std::string> out;
+        char buf[8192];
+        for (const auto& l : lines) out.emplace_back(buf, sc.process(l.data(), l.size(), buf, sizeof buf));
+        return out;
+      },
+      py::arg("robot"), py::arg("lines"), py::arg("instrument") = false,
+      "The streaming corrector on a list of lines (as kincal-compensate --stream)");
+  m.def(
+      "run_benchmarks",
+      [](int n, unsigned seed, int threads) {
+        py::gil_scoped_release release;
+        auto r = run_benchmarks(n, seed, threads);
+        py::gil_scoped_acquire acquire;
+        py::dict d;
+        for (auto& kv : r) d[py::str(kv.first)] = kv.second;
+        return d;
+      },
+      py::arg("n") = 2000, py::arg("seed") = 1, py::arg("threads") = 0);
+}

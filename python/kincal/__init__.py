@@ -1,0 +1,75 @@
+"""kincal: calibration, compensation and derivative analysis of industrial robots.
+
+The hot paths run in the C++ core (``kincal._core``); this package is the typed front over it.
+
+    >>> import kincal
+    >>> robot = kincal.load_robot("kr500")
+    >>> poses = kincal.fk(robot, [[0, -90, 90, 0, 90, 0]])      # x,y,z,a,b,c (mm, deg)
+    >>> q = kincal.compensate(robot, poses)["q_deg"]
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional, Sequence, Union
+
+import numpy as np
+
+from . import _core
+from ._core import Robot
+from .urdf import urdf_model_json
+
+__all__ = ["Robot", "load_robot", "fk", "ik", "compensate", "jacobian", "line_program", "__version__"]
+__version__ = "0.1.0"
+
+ArrayLike = Union[np.ndarray, Sequence[Sequence[float]]]
+
+
+def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: Optional[str] = None) -> Robot:
+    """A robot by built-in name (``kr500``), URDF file (chain ``base`` to ``tip``) or model JSON."""
+    s = str(name_or_path)
+    if s.lower().endswith(".urdf"):
+        return Robot.from_json(urdf_model_json(s, base, tip), s)
+    return Robot.load(s)
+
+
+def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "base") -> np.ndarray:
+    """Tool poses (N x 6: x,y,z mm, a,b,c deg) for joint angles in degrees (N x dof)."""
+    if frame not in ("base", "instrument"):
+        raise ValueError(f"frame must be 'base' or 'instrument', not '{frame}'")
+    q = np.atleast_2d(np.asarray(q_deg, dtype=float))
+    return _core.fk(robot, q, calibrated, frame == "instrument")
+
+
+def jacobian(robot: Robot, q_deg: Sequence[float], calibrated: bool = True) -> np.ndarray:
+    """6 x dof geometric Jacobian at the tool point (linear mm/rad, angular rad/rad), base frame."""
+    return _core.jacobian(robot, np.asarray(q_deg, dtype=float), calibrated)
+
+
+def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] = None) -> list:
+    """Every closed-form solution of the nominal model for one pose x,y,z,a,b,c (up to 8).
+
+    Each is a dict with ``q_deg``, ``within_limits``, ``wrist_singular``, ``shoulder_singular``;
+    an empty list means the pose is out of reach."""
+    return _core.ik_all(robot, np.asarray(pose, dtype=float), None if ref_deg is None else list(ref_deg))
+
+
+def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finite_difference: bool = False,
+               delta: float = 1e-8, epsilon: float = 1e-15, max_iterations: int = 20,
+               corrected_start: bool = True, frame: str = "base") -> dict:
+    """Machine coordinates for desired tool poses (N x 6) on the robot's calibrated model.
+
+    Returns ``q_deg`` (N x 6), ``iterations`` and ``residual`` (|F| of eq. 9) per pose."""
+    p = np.atleast_2d(np.asarray(poses, dtype=float))
+    return _core.compensate_poses(robot, p, compensate, frame == "instrument", finite_difference, delta, epsilon,
+                                  max_iterations, corrected_start)
+
+
+def line_program(start: Sequence[float] = (2000.0, -740.0, 500.0), direction: Sequence[float] = (0.0, 1.0, 0.0),
+                 count: int = 297, step_mm: float = 5.0, abc: Sequence[float] = (180.0, 0.0, 180.0)) -> np.ndarray:
+    """The Samak paper's use case: a straight tool path of ``count`` poses ``step_mm`` apart at
+    constant orientation (297 x 5 mm, about 1500 mm, tool pointing down)."""
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    xyz = np.asarray(start, dtype=float)[None, :] + np.arange(count)[:, None] * step_mm * d[None, :]
+    return np.hstack([xyz, np.tile(np.asarray(abc, dtype=float), (count, 1))])

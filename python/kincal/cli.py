@@ -1,0 +1,212 @@
+"""The `kincal` command: thin, one function per subcommand (see ../README.md for the contract)."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from . import _core, compensate, fk, ik, line_program, load_robot
+
+
+def _fmt_rows(header: Sequence[str], rows) -> str:
+    out = [",".join(header)]
+    for r in rows:
+        out.append(",".join(v if isinstance(v, str) else (str(v) if isinstance(v, (int, np.integer)) else f"{v:.10f}")
+                            for v in r))
+    return "\n".join(out) + "\n"
+
+
+def _csv_columns(path: str, names: Sequence[str]) -> dict:
+    """Extra columns (e.g. pose, target) of a CSV, row by row, when present (blank lines skipped)."""
+    with open(path, newline="") as f:
+        rows = [r for r in csv.reader(f) if any(c.strip() for c in r)]
+    if not rows:
+        return {}
+    header = [h.strip() for h in rows[0]]
+    return {n: [r[header.index(n)].strip() for r in rows[1:]] for n in names if n in header}
+
+
+def _robot(args) -> _core.Robot:
+    return load_robot(args.robot, getattr(args, "base", None), getattr(args, "tip", None))
+
+
+def cmd_fk(args) -> None:
+    robot = _robot(args)
+    if args.frame == "instrument" and not robot.identified:
+        raise ValueError(f"{args.robot}: --frame instrument needs an identified model (kincal identify)")
+    q, _ = _core.read_joint_program(args.joints, robot.dof)
+    poses = fk(robot, q, frame=args.frame)
+    extra = _csv_columns(args.joints, ["pose", "target"]) if args.joints.lower().endswith(".csv") else {}
+    header = list(extra) + ["x", "y", "z", "a", "b", "c"]
+    rows = [[extra[k][i] for k in extra] + list(p) for i, p in enumerate(poses)]
+    _core.write_file_atomic(args.out, _fmt_rows(header, rows))
+
+
+def cmd_ik(args) -> None:
+    robot = _robot(args)
+    if not robot.closed_form_ik:
+        raise ValueError(f"{args.robot}: no closed-form IK for this robot ({robot.ik_reason})")
+    poses, lines = _core.read_pose_program(args.poses)
+    ref = list(robot.home_deg) or [0.0] * robot.dof
+    rows = []
+    for i, (pose, line) in enumerate(zip(poses, lines)):
+        sols = ik(robot, pose, ref)
+        if not sols:
+            raise ValueError(f"{args.poses}:{line}: pose out of reach of the robot (no IK solution)")
+        if args.all:
+            rows += [[i, k, int(s["within_limits"])] + list(s["q_deg"]) for k, s in enumerate(sols)]
+        ok = [s for s in sols if s["within_limits"]]
+        if not ok:
+            raise ValueError(f"{args.poses}:{line}: no IK solution within the joint limits")
+        best = min(ok, key=lambda s: float(np.sum((np.asarray(s["q_deg"]) - ref) ** 2)))
+        ref = list(best["q_deg"])
+        if not args.all:
+            rows.append(ref)
+    qn = [f"q{j + 1}" for j in range(robot.dof)]
+    header = ["row", "solution", "within_limits"] + qn if args.all else qn
+    _core.write_file_atomic(args.out, _fmt_rows(header, rows))
+
+
+def _comp_kwargs(args) -> dict:
+    return dict(compensate=not args.nominal, instrument=args.frame == "instrument",
+                finite_difference=args.finite_difference, delta=args.delta, epsilon=args.epsilon,
+                max_iterations=args.max_iterations, corrected_start=not args.paper_start)
+
+
+def cmd_compensate(args) -> None:
+    robot = load_robot(args.model)
+    if args.frame == "instrument" and not robot.identified:
+        raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
+    res = _core.compensate_program(robot, args.program, args.out, **_comp_kwargs(args))
+    it = np.asarray(res["iterations"])
+    print(f"{args.out}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
+          f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
+
+
+def cmd_bench(args) -> None:
+    t0 = time.perf_counter()
+    r = _core.run_benchmarks(args.poses, args.seed, args.threads)
+    r["bench_seconds"] = time.perf_counter() - t0
+    print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
+
+
+def cmd_demo(args) -> None:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    steps = ["robot", "programs", "compensation", "summary"]
+    t0 = time.perf_counter()
+
+    def step(i: int, what: str) -> None:
+        print(f"[{i}/{len(steps)}] {what}", file=sys.stderr, flush=True)
+
+    step(1, "kr500 with a simulated calibration (1 mm, 0.05 deg errors, joint compliance)")
+    nominal = load_robot("kr500")
+    robot = nominal.with_calibrated(seed=7, sigma_mm=1.0, sigma_deg=0.05, compliance=0.003)
+    _core.write_file_atomic(str(out / "model.json"), robot.to_json())
+
+    step(2, "the paper's line program: 297 poses 5 mm apart, constant orientation")
+    poses = line_program()
+    _core.write_file_atomic(str(out / "line.csv"), _fmt_rows(["x", "y", "z", "a", "b", "c"], poses))
+    gcode = ["; kincal demo: 1480 mm straight tool path, 297 poses, tool pointing down", "G90"]
+    gcode += [f"N{10 * (i + 1)} G1 X{p[0]:.3f} Y{p[1]:.3f} Z{p[2]:.3f} A{p[3]:.3f} B{p[4]:.3f} C{p[5]:.3f}"
+              for i, p in enumerate(poses)]
+    gcode.append("M30")
+    _core.write_file_atomic(str(out / "line.gcode"), "\n".join(gcode) + "\n")
+
+    step(3, "nominal IK (uncompensated) and Newton compensation on the calibrated model")
+    unc = _core.compensate_program(robot, str(out / "line.gcode"), str(out / "uncompensated.gcode"), compensate=False)
+    com = _core.compensate_program(robot, str(out / "line.gcode"), str(out / "compensated.gcode"))
+    _core.compensate_program(robot, str(out / "line.csv"), str(out / "compensated.csv"))
+
+    step(4, "summary")
+    q_unc, q_com = np.asarray(unc["q_deg"]), np.asarray(com["q_deg"])
+    reached_unc = fk(robot, q_unc)  # where the real (calibrated) robot goes
+    reached_com = fk(robot, q_com)
+    err_unc = np.linalg.norm(reached_unc[:, :3] - poses[:, :3], axis=1)
+    err_com = np.linalg.norm(reached_com[:, :3] - poses[:, :3], axis=1)
+    it = np.asarray(com["iterations"])
+    summary = {
+        "robot": "kr500 (simulated calibrated model, seed 7)",
+        "poses": int(len(poses)),
+        "position_error_uncompensated_mm": {"mean": float(err_unc.mean()), "max": float(err_unc.max())},
+        "position_error_compensated_mm": {"mean": float(err_com.mean()), "max": float(err_com.max())},
+        "newton_iterations": {"min": int(it.min()), "max": int(it.max()), "mean": float(it.mean())},
+        "max_joint_correction_deg": [float(v) for v in np.abs(q_com - q_unc).max(axis=0)],
+        "files": sorted(p.name for p in out.iterdir()) + ["summary.json"],
+        "seconds": time.perf_counter() - t0,
+    }
+    _core.write_file_atomic(str(out / "summary.json"), json.dumps(summary, indent=2) + "\n")
+    print(f"position error on the calibrated robot: uncompensated mean {err_unc.mean():.3f} mm "
+          f"(max {err_unc.max():.3f}), compensated mean {err_com.mean():.2e} mm (max {err_com.max():.2e}); "
+          f"Newton iterations {it.min()}..{it.max()}", file=sys.stderr)
+    print(f"wrote {out}/: " + ", ".join(summary["files"]), file=sys.stderr)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="kincal", description="Calibration and compensation of industrial robots")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    def robot_opts(sp):
+        sp.add_argument("--robot", required=True, help="built-in name (kr500), URDF file or model JSON")
+        sp.add_argument("--base", help="URDF: base link of the chain (default: the root link)")
+        sp.add_argument("--tip", help="URDF: tip link of the chain (default: the only leaf)")
+
+    sp = sub.add_parser("fk", help="forward kinematics of a joint program")
+    robot_opts(sp)
+    sp.add_argument("--joints", required=True, help="CSV q1..qN (or a G-code joint program)")
+    sp.add_argument("--out", required=True, help="CSV x,y,z,a,b,c")
+    sp.add_argument("--frame", choices=["base", "instrument"], default="base")
+    sp.set_defaults(func=cmd_fk)
+
+    sp = sub.add_parser("ik", help="nominal closed-form inverse kinematics of a pose program")
+    robot_opts(sp)
+    sp.add_argument("--poses", required=True, help="CSV x,y,z,a,b,c (or G-code X Y Z A B C)")
+    sp.add_argument("--out", required=True, help="CSV q1..qN")
+    sp.add_argument("--all", action="store_true", help="every solution, with row, solution, within_limits")
+    sp.set_defaults(func=cmd_ik)
+
+    sp = sub.add_parser("compensate", help="Newton compensation of a pose program into a joint program")
+    sp.add_argument("--model", required=True, help="built-in name, URDF file or model JSON")
+    sp.add_argument("--program", required=True, help="pose program: CSV x,y,z,a,b,c or G-code X Y Z A B C")
+    sp.add_argument("--out", required=True, help="joint program: .csv (q1..q6) or G-code (A1=..)")
+    sp.add_argument("--frame", choices=["base", "instrument"], default="base")
+    sp.add_argument("--finite-difference", action="store_true", help="the paper's finite-difference Jacobian")
+    sp.add_argument("--paper-start", action="store_true", help="start Newton from the nominal IK (no correction)")
+    sp.add_argument("--nominal", action="store_true", help="nominal IK only: the uncompensated program")
+    sp.add_argument("--delta", type=float, default=1e-8, help="finite-difference step, degrees (eq. 7)")
+    sp.add_argument("--epsilon", type=float, default=1e-15, help="stop when |F|^2 < epsilon (eq. 9)")
+    sp.add_argument("--max-iterations", type=int, default=20)
+    sp.set_defaults(func=cmd_compensate)
+
+    sp = sub.add_parser("bench", help="benchmarks: our code and KDL's solvers in one run, JSON on stdout")
+    sp.add_argument("--poses", type=int, default=2000)
+    sp.add_argument("--seed", type=int, default=1)
+    sp.add_argument("--threads", type=int, default=0, help="batch threads (default: all cores)")
+    sp.set_defaults(func=cmd_bench)
+
+    sp = sub.add_parser("demo", help="the whole pipeline on the built-in example")
+    sp.add_argument("--out", default="kincal-demo", help="output folder")
+    sp.set_defaults(func=cmd_demo)
+    return p
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        args.func(args)
+    except (ValueError, OSError) as e:
+        print(f"kincal {args.command}: error: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,177 @@
+"""URDF to kincal model: the serial revolute chain from a base link to a tip link.
+
+Every revolute (or continuous) joint becomes a screw axis in the base frame at the zero
+configuration; fixed joints fold into the next joint or the tool; inertials are kept (mass and
+centre of mass) for gravity torques. URDF lengths are metres and radians; kincal's are mm and deg.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+
+def _floats(text: str | None, n: int, where: str) -> np.ndarray:
+    if text is None:
+        return np.zeros(n)
+    try:
+        v = np.array([float(t) for t in text.split()], dtype=float)
+    except ValueError:
+        raise ValueError(f"{where}: '{text}' is not {n} numbers") from None
+    if v.size != n or not np.all(np.isfinite(v)):
+        raise ValueError(f"{where}: '{text}' is not {n} finite numbers")
+    return v
+
+
+def _rpy(r: float, p: float, y: float) -> np.ndarray:
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def _origin(el: ET.Element | None, where: str) -> np.ndarray:
+    t = np.eye(4)
+    if el is not None:
+        t[:3, :3] = _rpy(*_floats(el.get("rpy"), 3, where + " rpy"))
+        t[:3, 3] = _floats(el.get("xyz"), 3, where + " xyz")
+    return t
+
+
+def _abc(r: np.ndarray) -> list[float]:
+    b = math.atan2(-r[2, 0], math.hypot(r[0, 0], r[1, 0]))
+    if math.hypot(r[0, 0], r[1, 0]) < 1e-12:
+        a, c = math.atan2(-r[0, 1], r[1, 1]), 0.0
+    else:
+        a, c = math.atan2(r[1, 0], r[0, 0]), math.atan2(r[2, 1], r[2, 2])
+    return [math.degrees(a), math.degrees(b), math.degrees(c)]
+
+
+def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None) -> dict:
+    """The kincal geometry (model JSON "nominal" section) of a URDF serial chain."""
+    path = str(path)
+    try:
+        root = ET.parse(path).getroot()
+    except FileNotFoundError:
+        raise ValueError(f"{path}: cannot open the URDF file") from None
+    except ET.ParseError as e:
+        line, col = e.position
+        raise ValueError(f"{path}:{line}:{col}: not valid XML") from None
+    if root.tag != "robot":
+        raise ValueError(f"{path}: the root element is <{root.tag}>, not <robot>")
+    links = {l.get("name"): l for l in root.findall("link")}
+    joints = root.findall("joint")
+    by_child = {}
+    children: dict[str, list] = {}
+    for j in joints:
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            raise ValueError(f"{path}: joint '{j.get('name')}' lacks <parent> or <child>")
+        by_child[child.get("link")] = j
+        children.setdefault(parent.get("link"), []).append(j)
+    roots = [n for n in links if n not in by_child]
+    if base is None:
+        if len(roots) != 1:
+            raise ValueError(f"{path}: {len(roots)} root links; name the base with --base")
+        base = roots[0]
+    if base not in links:
+        raise ValueError(f"{path}: no link '{base}'")
+    if tip is None:
+        # the only leaf below base
+        leaves, stack = [], [base]
+        while stack:
+            n = stack.pop()
+            kids = children.get(n, [])
+            if not kids:
+                leaves.append(n)
+            stack.extend(k.find("child").get("link") for k in kids)
+        if len(leaves) != 1:
+            raise ValueError(f"{path}: {len(leaves)} leaf links below '{base}' ({', '.join(leaves)}); name the tip with --tip")
+        tip = leaves[0]
+    if tip not in links:
+        raise ValueError(f"{path}: no link '{tip}'")
+    chain = []
+    n = tip
+    while n != base:
+        j = by_child.get(n)
+        if j is None:
+            raise ValueError(f"{path}: link '{tip}' is not below '{base}'")
+        chain.append(j)
+        n = j.find("parent").get("link")
+    chain.reverse()
+
+    t = np.eye(4)
+    out_joints: list[dict] = []
+
+    def inertial(link_name: str, frame: np.ndarray):
+        el = links[link_name].find("inertial")
+        if el is None:
+            return 0.0, frame[:3, 3] * 1000.0
+        mass_el = el.find("mass")
+        m = float(mass_el.get("value", "0")) if mass_el is not None else 0.0
+        c = frame @ _origin(el.find("origin"), f"{path}: link '{link_name}' inertial origin")
+        return m, c[:3, 3] * 1000.0
+
+    for j in chain:
+        name, typ = j.get("name"), j.get("type")
+        where = f"{path}: joint '{name}'"
+        t = t @ _origin(j.find("origin"), where + " origin")
+        child = j.find("child").get("link")
+        if typ == "fixed":
+            m, c = inertial(child, t)
+            if out_joints and m > 0:
+                # fold the mass into the previous moving link
+                prev = out_joints[-1]
+                tot = prev["mass_kg"] + m
+                prev["com_mm"] = list((np.array(prev["com_mm"]) * prev["mass_kg"] + c * m) / tot)
+                prev["mass_kg"] = tot
+            continue
+        if typ not in ("revolute", "continuous"):
+            raise ValueError(f"{where}: type '{typ}' is not supported (a serial revolute chain is needed)")
+        axis = _floats(j.find("axis").get("xyz") if j.find("axis") is not None else "1 0 0", 3, where + " axis")
+        lim = j.find("limit")
+        lo, hi, vel = -180.0, 180.0, 0.0
+        if lim is not None:
+            if typ == "revolute":
+                lo, hi = math.degrees(float(lim.get("lower", "0"))), math.degrees(float(lim.get("upper", "0")))
+            vel = math.degrees(float(lim.get("velocity", "0")))
+        if not lo < hi:
+            raise ValueError(f"{where}: lower limit {lo:g} deg is not below upper limit {hi:g} deg")
+        m, c = inertial(child, t)
+        out_joints.append(
+            {
+                "name": name,
+                "point_mm": list(t[:3, 3] * 1000.0),
+                "axis": list(t[:3, :3] @ axis),
+                "limits_deg": [lo, hi],
+                "max_velocity_deg_s": vel,
+                "max_acceleration_deg_s2": 0.0,
+                "max_jerk_deg_s3": 0.0,
+                "mass_kg": m,
+                "com_mm": list(c),
+                "compliance_deg_per_knm": 0.0,
+            }
+        )
+    if not out_joints:
+        raise ValueError(f"{path}: no revolute joint between '{base}' and '{tip}'")
+    return {
+        "name": root.get("name", Path(path).stem),
+        "joints": [{k: (list(map(float, v)) if isinstance(v, list) else v) for k, v in jt.items()} for jt in out_joints],
+        "tool": {"xyz_mm": [float(x) for x in t[:3, 3] * 1000.0], "abc_deg": _abc(t[:3, :3])},
+        "payload": {"mass_kg": 0.0, "com_mm": [0.0, 0.0, 0.0]},
+        "gravity_m_s2": [0.0, 0.0, -9.81],
+        "base_in_instrument": {"xyz_mm": [0.0, 0.0, 0.0], "abc_deg": [0.0, 0.0, 0.0]},
+        "home_deg": [0.0] * len(out_joints),
+    }
+
+
+def urdf_model_json(path: str | Path, base: str | None = None, tip: str | None = None) -> str:
+    return json.dumps({"format": "kincal-model", "version": 1, "nominal": urdf_spec(path, base, tip)})

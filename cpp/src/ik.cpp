@@ -1,5 +1,7 @@
 #include "kincal/ik.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 
@@ -40,6 +42,25 @@ inline bool safe_acos(double x, double& out, bool& tangent) {
     out = std::acos(x);
   }
   return true;
+}
+
+// Near the wrist singularity SP2 loses half the digits (q5 comes from a square root of a
+// difference): two Gauss-Newton steps with a pseudo-inverse restore the orientation to round-off.
+void polish_wrist(const Vec3& w4, const Vec3& w5, const Vec3& w6, const Mat3& target, double* q) {
+  for (int it = 0; it < 2; ++it) {
+    const Mat3 r4 = rot(w4, q[0]), r45 = r4 * rot(w5, q[1]);
+    const Mat3 r = r45 * rot(w6, q[2]);
+    const Eigen::AngleAxisd e(target * r.transpose());
+    const Vec3 err = e.axis() * e.angle();
+    Mat3 j;
+    j.col(0) = w4;
+    j.col(1) = r4 * w5;
+    j.col(2) = r45 * w6;
+    // damped least squares: J^T (J J^T + lambda I)^-1 err, rank-deficient at the singularity
+    const Mat3 jjt = j * j.transpose() + 1e-14 * Mat3::Identity();
+    const Vec3 dq = j.transpose() * jjt.ldlt().solve(err);
+    for (int k = 0; k < 3; ++k) q[k] += dq[k];
+  }
 }
 
 inline double wrap(double a) {  // to (-pi, pi]
@@ -174,7 +195,8 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
         const Vec3 v = w6.unitOrthogonal();
         const double q6 = pk_sub1(w6, v, r45.transpose() * r456 * v);
         IkSolution& s = out.sol[out.count];
-        const double q[6] = {q1, q2, q3, t4[i45], t5[i45], q6};
+        double q[6] = {q1, q2, q3, t4[i45], t5[i45], q6};
+        if (std::abs(w4.cross(rot(w5, q[4]) * w6).norm()) < 1e-6) polish_wrist(w4, w5, w6, r456, q + 3);
         for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) / kDeg;
         s.wrist_singular = std::abs(w4.cross(rot(w5, t5[i45]) * w6).norm()) < 1e-7;
         s.shoulder_singular = shoulder;

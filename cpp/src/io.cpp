@@ -225,6 +225,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
   Pose6 pose = pose_in;
   if (opt.instrument_frame) pose = iso_to_pose(cal.base_in_instrument().inverse() * pose_to_iso(pose_in));
   Q6 q0 = ref;
+  bool approximate_start = false;
   if (nom.ik_structure().spherical_wrist_parallel_23) {
     IkSolutions s = ik_all(nom, pose_to_iso(pose), ref.data());
     // a calibrated robot may reach a little beyond the nominal one: start from the nearest
@@ -239,6 +240,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
       return false;
     }
     q0 = s.sol[k].q_deg;
+    approximate_start = s.sol[k].approximate;
     if (opt.compensate && opt.corrected_start && robot.identified()) {
       // one fixed-point step: the nominal IK of the target corrected by the model difference at q0
       const VecQ a = q0 * kDeg;
@@ -257,6 +259,10 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
   // nominal robots without closed-form IK, and every calibrated robot: Newton on the model
   const Model& target_model = opt.compensate ? cal : nom;
   const CompensationResult r = compensate(target_model, pose, q0, opt.comp);
+  if (r.status != CompStatus::Converged && approximate_start) {
+    err = "pose out of reach of the robot (beyond the nominal reach, and the model does not reach it either)";
+    return false;
+  }
   if (r.status != CompStatus::Converged) {
     char buf[160];
     std::snprintf(buf, sizeof buf, " (after %d iterations, |F| = %.3g)", r.iterations, r.residual);

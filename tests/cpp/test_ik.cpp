@@ -1,1 +1,118 @@
+#include "kincal/ik.hpp"
+#include "kincal/kinematics.hpp"
+
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
+
+using namespace kincal;
+
+namespace {
+
+// Checks that every solution reproduces the pose and that the generating configuration is among them.
+void check_round_trip(const Model& m, const Eigen::Matrix<double, 6, 1>& q, double& worst_p, double& worst_r) {
+  const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
+  const IkSolutions s = ik_all(m, t, q.data());
+  ASSERT_EQ(s.status, IkStatus::Ok);
+  ASSERT_GE(s.count, 1);
+  ASSERT_LE(s.count, 8);
+  bool found = false;
+  for (int i = 0; i < s.count; ++i) {
+    ASSERT_TRUE(s.sol[i].q_deg.allFinite());
+    const Eigen::Isometry3d ti = fk(m, VecQ(s.sol[i].q_deg * kDeg));
+    worst_p = std::max(worst_p, (ti.translation() - t.translation()).norm());
+    worst_r = std::max(worst_r, test::rot_dist(ti.linear(), t.linear()));
+    double d = 0;
+    for (int j = 0; j < 6; ++j) d = std::max(d, std::abs(std::remainder(s.sol[i].q_deg[j] - q[j], 360.0)));
+    found = found || d < 1e-6;
+  }
+  EXPECT_TRUE(found) << "the generating configuration is not among the " << s.count << " solutions";
+}
+
+// A random robot of the class: axes 2 and 3 parallel, axes 4, 5, 6 through one point, any offsets.
+ModelSpec random_robot(std::mt19937_64& rng) {
+  std::normal_distribution<double> nd(0, 1);
+  auto rv = [&] { return Vec3(nd(rng), nd(rng), nd(rng)); };
+  ModelSpec s;
+  s.name = "random";
+  Vec3 w1 = rv().normalized(), w2 = rv().normalized();
+  const Vec3 wc = rv() * 600;
+  const Vec3 pts[6] = {rv() * 300, rv() * 300, rv() * 500, wc, wc, wc};
+  const Vec3 axes[6] = {w1, w2, (nd(rng) > 0 ? 1 : -1) * w2, rv().normalized(), rv().normalized(), rv().normalized()};
+  for (int j = 0; j < 6; ++j) {
+    JointSpec js;
+    js.point = pts[j];
+    js.axis = axes[j];
+    js.lower_deg = -360;
+    js.upper_deg = 360;
+    s.joints.push_back(js);
+  }
+  s.tool.xyz = wc + rv() * 200;
+  s.tool.abc = Vec3(nd(rng) * 60, nd(rng) * 30, nd(rng) * 60);
+  s.gravity = Vec3::Zero();
+  return s;
+}
+
+}  // namespace
+
+TEST(Ik, Kr500AllSolutionsRoundTrip) {
+  const Model m(kr500_spec());
+  std::mt19937_64 rng(21);
+  double wp = 0, wr = 0;
+  for (int i = 0, n = test::count(5000); i < n; ++i) check_round_trip(m, test::random_q(m, rng), wp, wr);
+  EXPECT_LT(wp, 1e-9);  // mm
+  EXPECT_LT(wr, 1e-9);  // rad
+}
+
+TEST(Ik, AnyOffsetsRoundTrip) {
+  std::mt19937_64 rng(22);
+  double wp = 0, wr = 0;
+  int robots = 0;
+  for (int r = 0; r < 200; ++r) {
+    const Model m(random_robot(rng));
+    ASSERT_TRUE(m.ik_structure().spherical_wrist_parallel_23) << m.ik_structure().reason;
+    ++robots;
+    for (int i = 0; i < 50; ++i) {
+      Eigen::Matrix<double, 6, 1> q;
+      for (int j = 0; j < 6; ++j) q[j] = std::uniform_real_distribution<double>(-180, 180)(rng);
+      check_round_trip(m, q, wp, wr);
+    }
+  }
+  EXPECT_EQ(robots, 200);
+  EXPECT_LT(wp, 1e-9);
+  EXPECT_LT(wr, 1e-9);
+}
+
+TEST(Ik, OutOfReachAndSingularPosesGiveClearAnswers) {
+  const Model m(kr500_spec());
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
+  far.translation() = Vec3(9000, 0, 1000);
+  const IkSolutions s = ik_all(m, far);
+  EXPECT_EQ(s.status, IkStatus::OutOfReach);
+  EXPECT_EQ(s.count, 0);
+  // the wrist singularity q5 = 0: solutions exist, are finite, reproduce the pose and are flagged
+  Eigen::Matrix<double, 6, 1> q;
+  q << 10, -80, 100, 30, 0, -20;
+  const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
+  const IkSolutions w = ik_all(m, t, q.data());
+  ASSERT_EQ(w.status, IkStatus::Ok);
+  int flagged = 0;
+  for (int i = 0; i < w.count; ++i) {
+    ASSERT_TRUE(w.sol[i].q_deg.allFinite());
+    flagged += w.sol[i].wrist_singular;
+    const Eigen::Isometry3d ti = fk(m, VecQ(w.sol[i].q_deg * kDeg));
+    EXPECT_LT((ti.translation() - t.translation()).norm(), 1e-9);
+    EXPECT_LT(test::rot_dist(ti.linear(), t.linear()), 1e-9);
+  }
+  EXPECT_GT(flagged, 0);
+}
+
+TEST(Ik, NearestSolutionFollowsTheReference) {
+  const Model m(kr500_spec());
+  Eigen::Matrix<double, 6, 1> q;
+  q << 20, -60, 80, 40, 50, -30;
+  const IkSolutions s = ik_all(m, fk(m, VecQ(q * kDeg)), q.data());
+  const int k = ik_nearest(m, s, q.data());
+  ASSERT_GE(k, 0);
+  EXPECT_LT((s.sol[k].q_deg - q).norm(), 1e-9);
+}

@@ -1,1 +1,109 @@
+#include "kincal/kinematics.hpp"
+
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+using namespace kincal;
+
+namespace {
+
+Eigen::Isometry3d kdl_fk(const Model& m, const VecQ& q) {
+  KDL::ChainFkSolverPos_recursive s(m.kdl_chain());
+  KDL::JntArray a(6);
+  for (int i = 0; i < 6; ++i) a(i) = q[i];
+  KDL::Frame f;
+  s.JntToCart(a, f);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) t.linear()(i, j) = f.M(i, j);
+    t.translation()[i] = f.p[i];
+  }
+  return t;
+}
+
+}  // namespace
+
+// Truth: KDL's recursive FK and Jacobian solvers on the same chain; nominal and perturbed kr500.
+TEST(Kinematics, FkAndJacobianMatchKdl) {
+  std::mt19937_64 rng(11);
+  const int n = test::count(2000);
+  double dp = 0, dr = 0, dj = 0;
+  for (unsigned seed = 0; seed < 4; ++seed) {
+    const Model m(seed == 0 ? kr500_spec() : perturbed_spec(kr500_spec(), seed, 2.0, 0.5));
+    KDL::ChainJntToJacSolver js(m.kdl_chain());
+    for (int i = 0; i < n; ++i) {
+      const VecQ q = test::random_q(m, rng) * kDeg;
+      const Eigen::Isometry3d a = fk(m, q), b = kdl_fk(m, q);
+      dp = std::max(dp, (a.translation() - b.translation()).norm());
+      dr = std::max(dr, test::rot_dist(a.linear(), b.linear()));
+      Eigen::Isometry3d t;
+      Jac j;
+      fk_jacobian(m, q, t, j);
+      KDL::JntArray ka(6);
+      for (int k = 0; k < 6; ++k) ka(k) = q[k];
+      KDL::Jacobian kj(6);
+      js.JntToJac(ka, kj);
+      dj = std::max(dj, (j - kj.data).cwiseAbs().maxCoeff());
+      ASSERT_LT((t.translation() - a.translation()).norm(), 1e-12);
+    }
+  }
+  EXPECT_LT(dp, 1e-9);   // mm
+  EXPECT_LT(dr, 1e-12);  // rad
+  EXPECT_LT(dj, 1e-9);
+}
+
+TEST(Kinematics, GravityTorqueOfAHorizontalArm) {
+  // one joint about y at the origin, 10 kg at 1000 mm along x: torque about +y = m g L (N mm)
+  ModelSpec s;
+  JointSpec j;
+  j.axis = Vec3::UnitY();
+  j.mass_kg = 10;
+  j.com = Vec3(1000, 0, 0);
+  s.joints = {j};
+  s.tool.xyz = Vec3(1000, 0, 0);
+  const Model m(s);
+  VecQ tau;
+  VecQ q = VecQ::Zero(1);
+  gravity_torque(m, q, tau);
+  // weight along -z at +x: (r x F) . y = (z F_x - x F_z) = 1000 * 98.1
+  EXPECT_NEAR(tau[0], 10 * 9.81 * 1000, 1e-9);
+  q[0] = kPi / 2;  // arm pointing down (-z): no torque
+  gravity_torque(m, q, tau);
+  EXPECT_NEAR(tau[0], 0, 1e-9);
+}
+
+// Every analytic derivative against central finite differences.
+TEST(Kinematics, DerivativesMatchFiniteDifferences) {
+  const Model m(perturbed_spec(kr500_spec(), 4, 1.0, 0.05, 0.003));
+  ASSERT_TRUE(m.has_compliance());
+  std::mt19937_64 rng(12);
+  const double h = 1e-6;
+  for (int i = 0; i < 200; ++i) {
+    const VecQ q = test::random_q(m, rng) * kDeg;
+    VecQ tau;
+    MatQ dtau;
+    gravity_torque(m, q, tau, &dtau);
+    Eigen::Isometry3d t;
+    Jac jc;
+    fk_jacobian_compliant(m, q, t, jc);
+    for (int k = 0; k < 6; ++k) {
+      VecQ qp = q, qm = q;
+      qp[k] += h;
+      qm[k] -= h;
+      VecQ tp, tm;
+      gravity_torque(m, qp, tp);
+      gravity_torque(m, qm, tm);
+      const VecQ fd = (tp - tm) / (2 * h);
+      EXPECT_LT((fd - dtau.col(k)).norm(), 1e-5 * (1 + dtau.norm())) << "dtau/dq" << k;
+      const Eigen::Isometry3d a = fk_compliant(m, qp), b = fk_compliant(m, qm);
+      const Vec3 dv = (a.translation() - b.translation()) / (2 * h);
+      const Eigen::AngleAxisd aa(a.linear() * b.linear().transpose());
+      const Vec3 dw = aa.axis() * aa.angle() / (2 * h);
+      EXPECT_LT((dv - jc.block<3, 1>(0, k)).norm(), 1e-4) << "linear column " << k;
+      EXPECT_LT((dw - jc.block<3, 1>(3, k)).norm(), 1e-7) << "angular column " << k;
+    }
+  }
+}

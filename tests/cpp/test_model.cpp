@@ -1,1 +1,73 @@
+#include "kincal/model.hpp"
+#include <random>
+#include <kdl/chain.hpp>
+
 #include <gtest/gtest.h>
+
+using namespace kincal;
+
+TEST(Model, Kr500HasThirtyGeometricAndFiveComplianceParameters) {
+  const Model m(kr500_spec());
+  EXPECT_EQ(m.dof(), 6);
+  EXPECT_EQ(4 * m.dof() + 6, 30);
+  EXPECT_EQ(m.compliance_count(), 5);  // axis 1 is vertical: no gravity torque on it
+  EXPECT_FALSE(m.gravity_loaded(0));
+  EXPECT_TRUE(m.ik_structure().spherical_wrist_parallel_23) << m.ik_structure().reason;
+  EXPECT_EQ(m.kdl_chain().getNrOfJoints(), 6u);
+}
+
+TEST(Model, JsonRoundTripIsExact) {
+  auto nom = std::make_shared<Model>(kr500_spec());
+  auto cal = std::make_shared<Model>(perturbed_spec(kr500_spec(), 3, 1.0, 0.05, 0.003));
+  const Robot r{nom, cal};
+  const std::string a = robot_to_json(r);
+  const Robot back = robot_from_json(a, "mem.json");
+  EXPECT_EQ(robot_to_json(back), a);
+  ASSERT_TRUE(back.identified());
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_EQ(back.calibrated->spec().joints[j].point, cal->spec().joints[j].point);  // bit-exact
+    EXPECT_EQ(back.calibrated->spec().joints[j].axis, cal->spec().joints[j].axis);
+    EXPECT_EQ(back.calibrated->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
+  }
+  EXPECT_EQ(back.calibrated->spec().tool.abc, cal->spec().tool.abc);
+}
+
+TEST(Model, ErrorsNameTheSourceAndCause) {
+  try {
+    load_robot("kr9000");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown robot 'kr9000'"), std::string::npos);
+  }
+  try {
+    robot_from_json("{\n  \"format\": \"kincal-model\",\n  \"version\": 1,\n  x\n}", "m.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("m.json:4:"), std::string::npos) << e.what();
+  }
+  try {
+    robot_from_json(R"({"format": "kincal-model", "version": 7, "nominal": {}})", "v.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("version 7"), std::string::npos) << e.what();
+  }
+  ModelSpec s = kr500_spec();
+  s.joints[0].compliance_deg_per_knm = 1;  // axis along gravity has no torque to comply with
+  EXPECT_THROW(Model{s}, InputError);
+  s = kr500_spec();
+  s.joints[2].axis = Vec3(0, 0, 0);
+  EXPECT_THROW(Model{s}, InputError);
+}
+
+TEST(Model, AbcConvention) {
+  // R = Rz(a) Ry(b) Rx(c): a rotation about z alone moves x towards y
+  const Mat3 r = abc_to_rotation(Vec3(90, 0, 0));
+  EXPECT_NEAR((r * Vec3::UnitX() - Vec3::UnitY()).norm(), 0, 1e-15);
+  std::mt19937 rng(5);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 abc(std::uniform_real_distribution<double>(-179, 179)(rng),
+                   std::uniform_real_distribution<double>(-89, 89)(rng),
+                   std::uniform_real_distribution<double>(-179, 179)(rng));
+    EXPECT_NEAR((rotation_to_abc(abc_to_rotation(abc)) - abc).norm(), 0, 1e-9);
+  }
+}

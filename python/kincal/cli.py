@@ -19,7 +19,7 @@ from . import _core, compensate, fk, ik, line_program, load_robot
 def _fmt_rows(header: Sequence[str], rows) -> str:
     out = [",".join(header)]
     for r in rows:
-        out.append(",".join(v if isinstance(v, str) else (str(v) if isinstance(v, (int, np.integer)) else f"{v:.10f}")
+        out.append(",".join(v if isinstance(v, str) else (str(v) if isinstance(v, (int, np.integer)) else repr(float(v)))
                             for v in r))
     return "\n".join(out) + "\n"
 

@@ -1,0 +1,144 @@
+"""The commands of the contract: fk, ik, compensate, kincal-compensate (file and --stream), demo,
+and bad input (one message naming file, line and cause; non-zero exit; no output file)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kincal
+
+from conftest import random_q, run
+
+
+def _write_poses_gcode(path: Path, poses: np.ndarray) -> None:
+    lines = ["; test program", "G90"]
+    lines += [f"N{10 * (i + 1)} G1 X{p[0]:.4f} Y{p[1]:.4f} Z{p[2]:.4f} A{p[3]:.4f} B{p[4]:.4f} C{p[5]:.4f} F2000"
+              for i, p in enumerate(poses)]
+    lines.append("M30")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def _write_csv(path: Path, header, rows) -> None:
+    path.write_text(",".join(header) + "\n" + "".join(",".join(f"{v:.10f}" for v in r) + "\n" for r in rows))
+
+
+def test_fk_then_ik_round_trip(tmp_path, kr500):
+    q = random_q(kr500, np.random.default_rng(3), 50, margin=5)
+    q[:, 4] = np.where(np.abs(q[:, 4]) < 2, 10, q[:, 4])
+    _write_csv(tmp_path / "q.csv", [f"q{j + 1}" for j in range(6)], q)
+    r = run("kincal", "fk", "--robot", "kr500", "--joints", str(tmp_path / "q.csv"), "--out", str(tmp_path / "p.csv"))
+    assert r.returncode == 0, r.stderr
+    poses = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
+    assert np.allclose(poses, kincal.fk(kr500, q), atol=1e-9)
+    r = run("kincal", "ik", "--robot", "kr500", "--poses", str(tmp_path / "p.csv"), "--out", str(tmp_path / "q2.csv"),
+            "--all")
+    assert r.returncode == 0, r.stderr
+    allq = np.loadtxt(tmp_path / "q2.csv", delimiter=",", skiprows=1)
+    assert set(allq[:, 0].astype(int)) == set(range(50))
+    back = kincal.fk(kr500, allq[:, 3:])
+    assert np.abs(back[:, :3] - poses[allq[:, 0].astype(int), :3]).max() < 1e-9
+
+
+def test_python_and_standalone_compensation_agree(tmp_path, calibrated):
+    model = tmp_path / "model.json"
+    model.write_text(calibrated.to_json())
+    poses = kincal.line_program(count=60)
+    _write_poses_gcode(tmp_path / "line.gcode", poses)
+    _write_csv(tmp_path / "line.csv", ["x", "y", "z", "a", "b", "c"], poses)
+    for ext in ("gcode", "csv"):
+        a, b = tmp_path / f"py.{ext}", tmp_path / f"cpp.{ext}"
+        r1 = run("kincal", "compensate", "--model", str(model), "--program", str(tmp_path / f"line.{ext}"), "--out", str(a))
+        r2 = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / f"line.{ext}"), "--out", str(b))
+        assert r1.returncode == 0 and r2.returncode == 0, r1.stderr + r2.stderr
+        assert a.read_text() == b.read_text()  # identical text: well within 1e-9 deg
+    q = kincal._core.read_joint_program(str(tmp_path / "py.gcode"), 6)[0]
+    reached = kincal.fk(calibrated, q)
+    assert np.abs(reached[:, :3] - poses[:, :3]).max() < 1e-6  # the calibrated robot lands on the path
+    assert np.abs(kincal.fk(calibrated, kincal.compensate(calibrated, poses, compensate=False)["q_deg"])[:, :3]
+                  - poses[:, :3]).max() > 0.5  # while the nominal program misses it by about a millimetre
+    # the branch stays continuous along the program
+    assert np.abs(np.diff(q, axis=0)).max() < 2.0
+
+
+def test_stream_one_line_in_one_line_out(tmp_path, calibrated):
+    model = tmp_path / "model.json"
+    model.write_text(calibrated.to_json())
+    poses = kincal.line_program(count=20)
+    _write_poses_gcode(tmp_path / "line.gcode", poses)
+    r = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / "line.gcode"), "--out",
+            str(tmp_path / "out.gcode"))
+    assert r.returncode == 0, r.stderr
+    text_in = (tmp_path / "line.gcode").read_text()
+    s = run("kincal-compensate", "--model", str(model), "--stream", stdin=text_in)
+    assert s.returncode == 0, s.stderr
+    assert s.stdout == (tmp_path / "out.gcode").read_text()
+    assert len(s.stdout.splitlines()) == len(text_in.splitlines())
+    csv_in = "x,y,z,a,b,c\n" + "".join(",".join(f"{v}" for v in p) + "\n" for p in poses)
+    s = run("kincal-compensate", "--model", str(model), "--stream", stdin=csv_in)
+    assert s.returncode == 0, s.stderr
+    out = s.stdout.splitlines()
+    assert out[0] == "q1,q2,q3,q4,q5,q6" and len(out) == 21
+    assert np.allclose(np.array([[float(v) for v in l.split(",")] for l in out[1:]]),
+                       kincal.compensate(calibrated, poses)["q_deg"], atol=1e-9)
+
+
+BAD = [
+    ("nan.csv", "x,y,z,a,b,c\n2000,0,500,180,0,180\n2000,nan,500,180,0,180\n", "nan.csv:3: column 'y'"),
+    ("text.csv", "x,y,z,a,b,c\n2000,0,500,180,zero,180\n", "text.csv:2: column 'b': 'zero' is not a number"),
+    ("short.csv", "x,y,z,a,b,c\n2000,0,500\n", "short.csv:2: 3 fields"),
+    ("far.csv", "x,y,z,a,b,c\n2000,0,500,180,0,180\n9000,0,500,180,0,180\n", "far.csv:3: pose out of reach"),
+    ("broken.gcode", "G1 X2000 Y0 Z500 A180 B0 C180\nG1 X20.0.1\n", "broken.gcode:2: broken number in word X"),
+    ("modal.gcode", "G90\nG1 X2000 Y0\n", "modal.gcode:2: pose word(s) Z A B C not set yet"),
+]
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+@pytest.mark.parametrize("name,text,message", BAD)
+def test_bad_programs(tmp_path, tool, name, text, message):
+    src = tmp_path / name
+    src.write_text(text)
+    out = tmp_path / ("out" + src.suffix)
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", "kr500", "--program", str(src), "--out", str(out))
+    assert r.returncode != 0
+    assert message in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not out.exists()
+    assert not list(tmp_path.glob("out*"))  # no temporary file left either
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_unknown_robot_and_missing_file(tmp_path, tool):
+    args = ["compensate"] if tool == "kincal" else []
+    (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n2000,0,500,180,0,180\n")
+    r = run(tool, *args, "--model", "kr9000", "--program", str(tmp_path / "p.csv"), "--out", str(tmp_path / "o.csv"))
+    assert r.returncode != 0 and "unknown robot 'kr9000'" in r.stderr
+    r = run(tool, *args, "--model", "kr500", "--program", str(tmp_path / "none.csv"), "--out", str(tmp_path / "o.csv"))
+    assert r.returncode != 0 and "none.csv: cannot open" in r.stderr
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_stream_stops_on_a_bad_line(calibrated, tmp_path):
+    model = tmp_path / "model.json"
+    model.write_text(calibrated.to_json())
+    s = run("kincal-compensate", "--model", str(model), "--stream",
+            stdin="G1 X2000 Y0 Z500 A180 B0 C180\nG1 X9000\nG1 X2000\n")
+    assert s.returncode != 0
+    assert len(s.stdout.splitlines()) == 1  # the good line, and nothing after the bad one
+    assert "stdin:2: pose out of reach" in s.stderr
+
+
+def test_demo(tmp_path):
+    r = run("kincal", "demo", "--out", str(tmp_path / "demo"))
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "demo" / "summary.json").read_text())
+    assert s["poses"] == 297
+    assert s["position_error_uncompensated_mm"]["mean"] > 0.5
+    assert s["position_error_compensated_mm"]["max"] < 1e-6
+    for f in ("uncompensated.gcode", "compensated.gcode", "compensated.csv", "model.json", "line.gcode"):
+        assert (tmp_path / "demo" / f).stat().st_size > 0

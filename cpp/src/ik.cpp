@@ -133,7 +133,14 @@ int pk_sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, double t[2]) 
 }
 
 IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg,
-                   bool nearest_if_unreachable) {
+                   bool nearest_if_unreachable, bool nearest_branch) {
+  const bool greedy = nearest_branch && ref_deg != nullptr;
+  // index of the candidate nearest the reference angle (deg), comparing modulo 360
+  auto nearer = [&](const double* cand, int n, int joint) {
+    if (!greedy || n < 2) return 0;
+    const double r = ref_deg[joint] * kDeg;
+    return std::abs(wrap(cand[1] - r)) < std::abs(wrap(cand[0] - r)) ? 1 : 0;
+  };
   IkSolutions out;
   t_clamp = nearest_if_unreachable;
   t_clamped = false;
@@ -174,13 +181,15 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     for (int i = 0; i < n1; ++i) q1s[i] = -t1[i];
     nq1 = n1;
   }
-  for (int i1 = 0; i1 < nq1; ++i1) {
+  const int b1 = nearer(q1s, nq1, 0);
+  for (int i1 = greedy ? b1 : 0; i1 < (greedy ? std::min(b1 + 1, nq1) : nq1); ++i1) {
     const double q1 = q1s[i1];
     const Mat3 r1 = rot(w1, q1);
     const Vec3 pp = r1.transpose() * (p - p1) + p1;  // e^{-xi1 q1} p
     double t3[2];
     const int n3 = pk_sub3(w3, pw - p3, p2 - p3, (pp - p2).norm(), t3);
-    for (int i3 = 0; i3 < n3; ++i3) {
+    const int b3 = nearer(t3, n3, 2);
+    for (int i3 = greedy ? b3 : 0; i3 < (greedy ? std::min(b3 + 1, n3) : n3); ++i3) {
       const double q3 = t3[i3];
       const Mat3 r3 = rot(w3, q3);
       const Vec3 x = r3 * (pw - p3) + p3;
@@ -189,7 +198,14 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       const Mat3 r456 = r123.transpose() * gr;
       double t4[2], t5[2];
       const int n45 = pk_sub2(w4, w5, w6, r456 * w6, t4, t5);
-      for (int i45 = 0; i45 < n45; ++i45) {
+      int b45 = 0;
+      if (greedy && n45 == 2) {
+        auto dist = [&](int i) {
+          return std::abs(wrap(t4[i] - ref_deg[3] * kDeg)) + std::abs(wrap(t5[i] - ref_deg[4] * kDeg));
+        };
+        b45 = dist(1) < dist(0) ? 1 : 0;
+      }
+      for (int i45 = greedy ? b45 : 0; i45 < (greedy ? std::min(b45 + 1, n45) : n45); ++i45) {
         const Mat3 r45 = rot(w4, t4[i45]) * rot(w5, t5[i45]);
         // any vector normal to w6
         const Vec3 v = w6.unitOrthogonal();

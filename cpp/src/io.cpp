@@ -227,9 +227,12 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
   Q6 q0 = ref;
   bool approximate_start = false;
   if (nom.ik_structure().spherical_wrist_parallel_23) {
-    IkSolutions s = ik_all(nom, pose_to_iso(pose), ref.data());
+    const Eigen::Isometry3d target = pose_to_iso(pose);
+    // the branch nearest the reference first; all branches when it is out of limits
+    IkSolutions s = ik_all(nom, target, ref.data(), false, true);
+    if (s.status != IkStatus::Ok || !s.sol[0].within_limits) s = ik_all(nom, target, ref.data());
     // a calibrated robot may reach a little beyond the nominal one: start from the nearest
-    if (s.status != IkStatus::Ok && opt.compensate) s = ik_all(nom, pose_to_iso(pose), ref.data(), true);
+    if (s.status != IkStatus::Ok && opt.compensate) s = ik_all(nom, target, ref.data(), true);
     if (s.status != IkStatus::Ok) {
       err = "pose out of reach of the robot (no inverse-kinematics solution)";
       return false;
@@ -245,7 +248,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
       // one fixed-point step: the nominal IK of the target corrected by the model difference at q0
       const VecQ a = q0 * kDeg;
       const Eigen::Isometry3d e = fk(nom, a).inverse() * fk_compliant(cal, a);
-      const IkSolutions s2 = ik_all(nom, pose_to_iso(pose) * e.inverse(), q0.data());
+      const IkSolutions s2 = ik_all(nom, target * e.inverse(), q0.data(), false, true);
       const int k2 = ik_nearest(nom, s2, q0.data());
       if (k2 >= 0) q0 = s2.sol[k2].q_deg;
     }

@@ -41,8 +41,10 @@ struct IkSolutions {
 /// within the joint limits, when one does. Never NaN.
 /// With nearest_if_unreachable, a pose just out of reach (as a calibrated robot may reach) gives the
 /// configurations nearest to it (subproblems at tangency), flagged approximate: a start for Newton.
+/// With nearest_branch (and ref_deg), only the branch nearest the reference is computed, choosing
+/// shoulder, elbow and wrist in turn: about a quarter of the work, for programs and compensation.
 IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg = nullptr,
-                   bool nearest_if_unreachable = false);
+                   bool nearest_if_unreachable = false, bool nearest_branch = false);
 
 /// The solution within limits nearest (max-norm in joint space) to ref_deg; -1 when none.
 int ik_nearest(const Model& m, const IkSolutions& s, const double* ref_deg);

@@ -126,8 +126,8 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
     Q6 q_deg;
     bool ok;
   };
-  std::string err;
   auto comp_with_ik = [&](const Robot& rb, const CompensationOptions& o, int i) {
+    thread_local std::string err;  // written only on failure; one per batch thread
     ProgramOptions po;
     po.comp = o;
     R r;

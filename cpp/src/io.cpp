@@ -563,13 +563,13 @@ StreamCompensator::StreamCompensator(Robot robot, ProgramOptions opt) : robot_(s
   prev_ = home_of(*robot_.nominal);
 }
 
-Q6 StreamCompensator::solve(const Pose6& p, const char* kind) {
+Q6 StreamCompensator::solve(const Pose6& p) {
   Q6 q;
   int it;
   double r;
   std::string err;
   if (!solve_pose(robot_, opt_, p, prev_, q, it, r, err))
-    throw InputError(std::string("stdin:") + std::to_string(line_no_) + ": " + kind + err);
+    throw InputError(std::string("stdin:") + std::to_string(line_no_) + ": " + err);
   prev_ = q;
   return q;
 }
@@ -631,7 +631,7 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
     }
     if (got != 6) fail_at("stdin", line_no_, "a CSV pose line needs x,y,z,a,b,c");
     for (int k = 0; k < 3; ++k) p.xyz[k] = vals[k], p.abc[k] = vals[3 + k];
-    return format_joints(out, cap, solve(p, ""), true);
+    return format_joints(out, cap, solve(p), true);
   }
   // G-code
   WordSpan spans[16];
@@ -648,7 +648,7 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
   for (int k = 0; k < 6; ++k)
     if (!modal_set_[k])
       fail_at("stdin", line_no_, std::string("pose word ") + kPoseLetters[k] + " not set yet on the first motion line");
-  const Q6 q = solve(modal_, "");
+  const Q6 q = solve(modal_);
   char cut[4096];
   size_t insert_at;
   const size_t cn = cut_spans(s, n, spans, cnt, cut, sizeof cut, insert_at, "stdin", line_no_);

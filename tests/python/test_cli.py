@@ -4,7 +4,6 @@ and bad input (one message naming file, line and cause; non-zero exit; no output
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np

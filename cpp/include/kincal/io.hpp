@@ -114,7 +114,7 @@ class StreamCompensator {
   // G-code modal state
   Pose6 modal_;
   bool modal_set_[6] = {false, false, false, false, false, false};
-  Eigen::Matrix<double, 6, 1> solve(const Pose6& p, const char* where_kind);
+  Eigen::Matrix<double, 6, 1> solve(const Pose6& p);
 };
 
 }  // namespace kincal

@@ -181,13 +181,16 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     for (int i = 0; i < n1; ++i) q1s[i] = -t1[i];
     nq1 = n1;
   }
+  const bool clamped1 = t_clamped;  // q1 itself came from a tangency
   const int b1 = nearer(q1s, nq1, 0);
   for (int i1 = greedy ? b1 : 0; i1 < (greedy ? std::min(b1 + 1, nq1) : nq1); ++i1) {
     const double q1 = q1s[i1];
     const Mat3 r1 = rot(w1, q1);
     const Vec3 pp = r1.transpose() * (p - p1) + p1;  // e^{-xi1 q1} p
     double t3[2];
+    t_clamped = clamped1;
     const int n3 = pk_sub3(w3, pw - p3, p2 - p3, (pp - p2).norm(), t3);
+    const bool clamped3 = t_clamped;  // flags of this shoulder and elbow branch only
     const int b3 = nearer(t3, n3, 2);
     for (int i3 = greedy ? b3 : 0; i3 < (greedy ? std::min(b3 + 1, n3) : n3); ++i3) {
       const double q3 = t3[i3];
@@ -197,6 +200,7 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       const Mat3 r123 = r1 * rot(w2, q2) * r3;
       const Mat3 r456 = r123.transpose() * gr;
       double t4[2], t5[2];
+      t_clamped = clamped3;
       const int n45 = pk_sub2(w4, w5, w6, r456 * w6, t4, t5);
       int b45 = 0;
       if (greedy && n45 == 2) {

@@ -66,6 +66,7 @@ void define_kinematics(py::module_& m) {
       "gravity_torque",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
         const Model& md = pick(r, calibrated);
+        check_q(md, q_deg.transpose());
         VecQ tau;
         MatQ d;
         gravity_torque(md, VecQ(q_deg * kDeg), tau, &d);
@@ -77,6 +78,7 @@ void define_kinematics(py::module_& m) {
       "kdl_fk",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
         const Model& md = pick(r, calibrated);
+        check_q(md, q_deg.transpose());
         KDL::ChainFkSolverPos_recursive s(md.kdl_chain());
         KDL::JntArray q(md.dof());
         for (int i = 0; i < md.dof(); ++i) q(i) = q_deg[i] * kDeg;

@@ -80,6 +80,9 @@ def test_api_errors_are_value_errors(kr500):
         kincal.fk(kr500, [[0, 0, 0]])
     with pytest.raises(ValueError, match="NaN"):
         kincal.fk(kr500, [[0, 0, float("nan"), 0, 0, 0]])
+    for f in (_core.gravity_torque, _core.kdl_fk, _core.jacobian):  # no out-of-bounds read on a short vector
+        with pytest.raises(ValueError, match="4 columns, the robot has 6 joints"):
+            f(kr500, np.zeros(4))
     with pytest.raises(ValueError, match="pose 1: pose out of reach"):
         kincal.compensate(kr500, [[2000, 0, 500, 180, 0, 180], [9000, 0, 500, 180, 0, 180]])
 

@@ -1,0 +1,752 @@
+// kincal: measurement files, the campaign simulator and Ceres identification.
+// The only translation unit that includes Ceres (builds stay quick).
+#include "kincal/identify.hpp"
+
+#include "kincal/io.hpp"
+#include "kincal/kinematics.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <set>
+
+namespace kincal {
+
+namespace {
+
+Mat3 skew(const Vec3& v) {
+  Mat3 s;
+  s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return s;
+}
+
+Mat3 so3_exp(const Vec3& phi) {
+  const double th = phi.norm();
+  if (th < 1e-300) return Mat3::Identity();
+  return Eigen::AngleAxisd(th, phi / th).toRotationMatrix();
+}
+
+Vec3 so3_log(const Mat3& r) {
+  const Eigen::AngleAxisd aa(r);
+  return aa.angle() * aa.axis();
+}
+
+/// Right Jacobian of SO(3): Exp(phi + d) = Exp(phi) Exp(Jr(phi) d) to first order.
+Mat3 so3_right_jacobian(const Vec3& phi) {
+  const double th = phi.norm();
+  const Mat3 s = skew(phi);
+  double a, b;
+  if (th < 1e-4) {
+    a = 0.5 - th * th / 24.0;
+    b = 1.0 / 6.0 - th * th / 120.0;
+  } else {
+    a = (1.0 - std::cos(th)) / (th * th);
+    b = (th - std::sin(th)) / (th * th * th);
+  }
+  return Mat3::Identity() - a * s + b * s * s;
+}
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Measurement files
+// ---------------------------------------------------------------------------------------------
+namespace {
+MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
+  const std::string& source = t.source;
+  MeasurementSet m;
+  m.source = source;
+  const int cpose = t.require("pose");
+  std::vector<int> cq;
+  for (int j = 0; j < dof; ++j) cq.push_back(t.require("q" + std::to_string(j + 1)));
+  if (t.find("q" + std::to_string(dof + 1)) >= 0)
+    throw InputError(source + ":1: column q" + std::to_string(dof + 1) + " but the robot has " +
+                     std::to_string(dof) + " joints");
+  const int cx = t.require("x"), cy = t.require("y"), cz = t.require("z");
+  const int ctarget = t.find("target"), cpay = t.find("payload_kg");
+  int max_target = 0;
+  for (size_t r = 0; r < t.cells.size(); ++r) {
+    Measurement row;
+    const double pid = t.number(r, cpose);
+    if (pid != std::floor(pid)) throw InputError(t.where(r) + ": column 'pose': not an integer");
+    row.pose = static_cast<int>(pid);
+    row.q_deg.resize(dof);
+    for (int j = 0; j < dof; ++j) row.q_deg[j] = t.number(r, cq[j]);
+    row.xyz = Vec3(t.number(r, cx), t.number(r, cy), t.number(r, cz));
+    if (ctarget >= 0) {
+      const double tv = t.number(r, ctarget);
+      if (tv < 0 || tv != std::floor(tv) || tv > 99)
+        throw InputError(t.where(r) + ": column 'target': expected an integer 0..99");
+      row.target = static_cast<int>(tv);
+      max_target = std::max(max_target, row.target);
+    }
+    if (cpay >= 0) {
+      row.payload_kg = t.number(r, cpay);
+      if (row.payload_kg < 0) throw InputError(t.where(r) + ": column 'payload_kg': negative mass");
+    }
+    row.line = t.line[r];
+    m.rows.push_back(row);
+  }
+  if (m.rows.empty()) throw InputError(source + ": no measurements");
+  m.n_targets = max_target + 1;
+  return m;
+}
+
+}  // namespace
+
+MeasurementSet parse_measurements(const std::string& text, const std::string& source, int dof) {
+  return measurements_from_table(parse_csv(text, source), dof);
+}
+
+MeasurementSet read_measurements(const std::string& path, int dof) {
+  return measurements_from_table(read_csv(path), dof);
+}
+
+std::string format_measurements(const MeasurementSet& m, int dof) {
+  std::string s = "pose";
+  for (int j = 0; j < dof; ++j) s += ",q" + std::to_string(j + 1);
+  s += ",x,y,z,target";
+  bool pay = false;
+  for (const auto& r : m.rows) pay = pay || !std::isnan(r.payload_kg);
+  if (pay) s += ",payload_kg";
+  s += "\n";
+  for (const auto& r : m.rows) {
+    s += std::to_string(r.pose);
+    for (int j = 0; j < dof; ++j) s += "," + fmt(r.q_deg[j]);
+    for (int k = 0; k < 3; ++k) s += "," + fmt(r.xyz[k]);
+    s += "," + std::to_string(r.target);
+    if (pay) s += "," + fmt(r.payload_kg);
+    s += "\n";
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Simulation: every effect of the truth in one place
+// ---------------------------------------------------------------------------------------------
+Vec3 simulate_point(const Model& truth, const VecQ& q_deg, const Vec3& target) {
+  const VecQ q = q_deg * kDeg;
+  // joint compliance under gravity (truth masses and payload); later effects plug in here
+  const Eigen::Isometry3d tool = fk_compliant(truth, q);
+  return truth.base_in_instrument() * (tool * target);
+}
+
+MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
+  if (opt.poses < 1) throw InputError("simulate: the number of poses must be positive");
+  if (opt.targets.empty()) throw InputError("simulate: at least one target");
+  MeasurementSet m;
+  m.source = "simulated";
+  m.n_targets = static_cast<int>(opt.targets.size());
+  std::mt19937_64 rng(opt.seed);
+  std::uniform_real_distribution<double> ud(-0.5, 0.5), u01(0.0, 1.0);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  const int n = truth.dof();
+  for (int p = 0; p < opt.poses; ++p) {
+    VecQ q(n);
+    for (int j = 0; j < n; ++j) {
+      const JointSpec& js = truth.spec().joints[j];
+      const double mid = 0.5 * (js.lower_deg + js.upper_deg), span = js.upper_deg - js.lower_deg;
+      q[j] = mid + ud(rng) * span * opt.limit_margin;
+    }
+    for (int t = 0; t < m.n_targets; ++t) {
+      Measurement row;
+      row.pose = p;
+      row.q_deg = q;
+      row.target = t;
+      row.xyz = simulate_point(truth, q, opt.targets[t]);
+      row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
+      if (opt.outlier_fraction > 0 && u01(rng) < opt.outlier_fraction)
+        row.xyz += Vec3(nd(rng), nd(rng), nd(rng)).normalized() * opt.outlier_mm;
+      m.rows.push_back(row);
+    }
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parameter layout and the measurement model
+// ---------------------------------------------------------------------------------------------
+ParamLayout::ParamLayout(const Model& nominal, int nt) : dof(nominal.dof()), n_targets(nt) {
+  for (int j = 0; j < dof; ++j)
+    if (nominal.gravity_loaded(j)) loaded.push_back(j);
+  joints = 0;
+  compliance = 4 * dof;
+  tool = compliance + static_cast<int>(loaded.size());
+  base = tool + 6;
+  targets = base + 6;
+  size = targets + 3 * n_targets;
+  for (int j = 0; j < dof; ++j) {
+    const std::string p = "joint" + std::to_string(j + 1);
+    for (const char* s : {".tilt_u", ".tilt_v"}) names.push_back(p + s), units.push_back("rad");
+    for (const char* s : {".move_u", ".move_v"}) names.push_back(p + s), units.push_back("mm");
+  }
+  for (int j : loaded) names.push_back("joint" + std::to_string(j + 1) + ".compliance"), units.push_back("deg/kNm");
+  for (const std::string f : {"tool", "base"}) {
+    for (const char* s : {".x", ".y", ".z"}) names.push_back(f + s), units.push_back("mm");
+    for (const char* s : {".rx", ".ry", ".rz"}) names.push_back(f + s), units.push_back("rad");
+  }
+  for (int t = 0; t < n_targets; ++t)
+    for (const char* s : {".x", ".y", ".z"}) names.push_back("target" + std::to_string(t) + s), units.push_back("mm");
+}
+
+PointModel::PointModel(const Model& nominal, int n_targets) : nominal_(nominal), layout_(nominal, n_targets) {
+  const int n = nominal.dof();
+  for (int j = 0; j < n; ++j) {
+    const Vec3 w = nominal.axis(j);
+    u_.push_back(w.unitOrthogonal());
+    v_.push_back(w.cross(u_.back()));
+  }
+  w_.resize(n);
+  p_.resize(n);
+  std::vector<double> x(layout_.size, 0.0);
+  for (size_t i = 0; i < layout_.loaded.size(); ++i)
+    x[layout_.compliance + i] = nominal.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
+  set_params(x);
+}
+
+void PointModel::set_params(const std::vector<double>& x) {
+  x_ = x;
+  spec_ = nominal_.spec();
+  const int n = layout_.dof;
+  for (int j = 0; j < n; ++j) {
+    const double* a = &x[4 * j];
+    w_[j] = (nominal_.axis(j) + a[0] * u_[j] + a[1] * v_[j]).normalized();
+    p_[j] = nominal_.point(j) + a[2] * u_[j] + a[3] * v_[j];
+    spec_.joints[j].axis = w_[j];
+    spec_.joints[j].point = p_[j];
+    spec_.joints[j].compliance_deg_per_knm = 0;
+  }
+  for (size_t i = 0; i < layout_.loaded.size(); ++i)
+    spec_.joints[layout_.loaded[i]].compliance_deg_per_knm = x[layout_.compliance + i];
+  const Vec3 phim(x[layout_.tool + 3], x[layout_.tool + 4], x[layout_.tool + 5]);
+  rm_ = nominal_.tool().linear() * so3_exp(phim);
+  jrm_ = so3_right_jacobian(phim);
+  tm_ = nominal_.tool().translation() + Vec3(x[layout_.tool], x[layout_.tool + 1], x[layout_.tool + 2]);
+  const Vec3 phib(x[layout_.base + 3], x[layout_.base + 4], x[layout_.base + 5]);
+  rb_ = nominal_.base_in_instrument().linear() * so3_exp(phib);
+  jrb_ = so3_right_jacobian(phib);
+  tb_ = nominal_.base_in_instrument().translation() + Vec3(x[layout_.base], x[layout_.base + 1], x[layout_.base + 2]);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = rm_;
+  t.translation() = tm_;
+  spec_.tool = iso_to_pose(t);
+  t.linear() = rb_;
+  t.translation() = tb_;
+  spec_.base_in_instrument = iso_to_pose(t);
+  current_ = std::make_shared<const Model>(spec_);
+  for (auto& pm : payload_models_) {
+    ModelSpec s = spec_;
+    s.payload_kg = pm.first;
+    pm.second = std::make_shared<const Model>(s);
+  }
+}
+
+void PointModel::prepare_payloads(const MeasurementSet& data) {
+  std::set<double> pays;
+  for (const auto& r : data.rows)
+    if (!std::isnan(r.payload_kg) && r.payload_kg != spec_.payload_kg) pays.insert(r.payload_kg);
+  payload_models_.clear();
+  for (double p : pays) payload_models_.emplace_back(p, nullptr);
+  set_params(x_);
+}
+
+const Model& PointModel::model_for(double payload) const {
+  if (std::isnan(payload) || payload == spec_.payload_kg) return *current_;
+  for (const auto& pm : payload_models_)
+    if (pm.first == payload) return *pm.second;
+  throw std::logic_error("PointModel: payload not prepared");
+}
+
+ModelSpec PointModel::spec() const { return spec_; }
+
+// The deflection K tau(q) depends on the geometry through the gravity torque: moving a joint line
+// moves the links (their centres of mass) and the axes the torque is taken about; moving the tool
+// frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter).
+void PointModel::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr,
+                              std::array<Vec3, kMaxJoints + 1>& gt) const {
+  gr[0].setIdentity();
+  gt[0].setZero();
+  for (int j = 0; j < layout_.dof; ++j) {
+    const Mat3 e = Eigen::AngleAxisd(q[j], w_[j]).toRotationMatrix();
+    const Vec3 et = p_[j] - e * p_[j];
+    gr[j + 1] = gr[j] * e;
+    gt[j + 1] = gr[j] * et + gt[j];
+  }
+}
+
+void PointModel::add_torque_terms(const Model& model, const Measurement& m, const std::array<Vec3, kMaxJoints>& jp,
+                                  double* jac) const {
+  const int n = layout_.dof, P = layout_.size;
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  const ModelSpec& sp = model.spec();
+  // the torque is taken at the commanded angles (the frames gr, gt passed in are the deflected ones)
+  std::array<Mat3, kMaxJoints + 1> gr;
+  std::array<Vec3, kMaxJoints + 1> gt;
+  chain_frames(m.q_deg * kDeg, gr, gt);
+  const Vec3& g = model.gravity();
+  const double mp = std::isnan(m.payload_kg) ? sp.payload_kg : m.payload_kg;
+  // current centres of mass; S[i] = sum_{k>=i} m_k c_k, M[i] = sum_{k>=i} m_k (payload on the last link)
+  const Vec3 cp = gr[n] * (rm_ * sp.payload_com + tm_) + gt[n];
+  std::array<Vec3, kMaxJoints + 1> S;
+  std::array<double, kMaxJoints + 1> M;
+  S[n] = mp * cp;
+  M[n] = mp;
+  for (int k = n - 1; k >= 0; --k) {
+    const double mk = sp.joints[k].mass_kg;
+    S[k] = S[k + 1] + mk * (gr[k + 1] * sp.joints[k].com + gt[k + 1]);
+    M[k] = M[k + 1] + mk;
+  }
+  std::array<Vec3, kMaxJoints> wc, oc, arm;
+  for (int j = 0; j < n; ++j) {
+    wc[j] = gr[j] * w_[j];
+    oc[j] = gr[j] * p_[j] + gt[j];
+    arm[j] = S[j] - M[j] * oc[j];
+  }
+  auto ad = [&](int k, const Vec3& om, const Vec3& v, Vec3& omo, Vec3& vo) {
+    omo = gr[k] * om;
+    vo = gr[k] * v + gt[k].cross(omo);
+  };
+  // effect on the point of a torque change dtau (N mm) on every loaded joint
+  auto apply = [&](int col, const std::array<double, kMaxJoints>& dtau) {
+    Vec3 dx = Vec3::Zero();
+    for (int j : layout_.loaded) dx += jp[j] * (model.compliance(j) * dtau[j]);
+    J.col(col) += rb_ * dx;
+  };
+  for (int i = 0; i < n; ++i) {
+    const Vec3 wraw = nominal_.axis(i) + x_[4 * i] * u_[i] + x_[4 * i + 1] * v_[i];
+    const double nn = wraw.norm();
+    for (int c = 0; c < 4; ++c) {
+      const Vec3& d = (c % 2 == 0) ? u_[i] : v_[i];
+      Vec3 om, v;
+      if (c < 2) {
+        om = w_[i].cross((d - w_[i] * w_[i].dot(d)) / nn);
+        v = p_[i].cross(om);
+      } else {
+        om.setZero();
+        v = d;
+      }
+      Vec3 go, gv, ao, av;  // Gamma: the line itself; Delta: the links beyond it
+      ad(i, om, v, go, gv);
+      ad(i + 1, om, v, ao, av);
+      const Vec3 dom = go - ao, dv = gv - av;
+      std::array<double, kMaxJoints> dtau{};
+      for (int j : layout_.loaded) {
+        if (j > i) {
+          dtau[j] = dom.cross(wc[j]).dot(arm[j].cross(g)) + wc[j].dot(dom.cross(arm[j]).cross(g));
+        } else if (j == i) {
+          const Vec3 darm = M[j] * dv + dom.cross(S[j]) - M[j] * (gv + go.cross(oc[j]));
+          dtau[j] = go.cross(wc[j]).dot(arm[j].cross(g)) + wc[j].dot(darm.cross(g));
+        } else {
+          const Vec3 darm = M[i] * dv + dom.cross(S[i]);
+          dtau[j] = wc[j].dot(darm.cross(g));
+        }
+      }
+      apply(4 * i + c, dtau);
+    }
+  }
+  if (mp != 0) {
+    for (int c = 0; c < 6; ++c) {
+      Vec3 om = Vec3::Zero(), v = Vec3::Zero();
+      if (c < 3) {
+        v[c] = 1;
+      } else {
+        om = rm_ * jrm_.col(c - 3);
+        v = tm_.cross(om);
+      }
+      Vec3 lo, lv;
+      ad(n, om, v, lo, lv);
+      const Vec3 dcp = mp * (lv + lo.cross(cp));
+      std::array<double, kMaxJoints> dtau{};
+      for (int j : layout_.loaded) dtau[j] = wc[j].dot(dcp.cross(g));
+      apply(layout_.tool + c, dtau);
+    }
+  }
+}
+
+Vec3 PointModel::predict(const Measurement& m, double* jac) const {
+  const Model& model = model_for(m.payload_kg);
+  const int n = layout_.dof;
+  const VecQ q = m.q_deg * kDeg;
+  VecQ tau = VecQ::Zero(n), qe = q;
+  if (!layout_.loaded.empty()) {
+    gravity_torque(model, q, tau);
+    for (int j = 0; j < n; ++j) qe[j] += model.compliance(j) * tau[j];
+  }
+  // G_j = exp(xi_1 qe_1) ... exp(xi_j qe_j), G_0 = identity
+  std::array<Mat3, kMaxJoints + 1> gr;
+  std::array<Vec3, kMaxJoints + 1> gt;
+  chain_frames(qe, gr, gt);
+  const Vec3 tkv(x_[layout_.targets + 3 * m.target], x_[layout_.targets + 3 * m.target + 1],
+                 x_[layout_.targets + 3 * m.target + 2]);
+  const Vec3 x0 = rm_ * tkv + tm_;
+  const Mat3& rn = gr[n];
+  const Vec3 x = rn * x0 + gt[n];
+  const Vec3 y = rb_ * x + tb_;
+  if (!jac) return y;
+  const int P = layout_.size;
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  J.setZero();
+  // x in the frames G_j: xl_j = G_j^-1 x
+  std::array<Vec3, kMaxJoints + 1> xl;
+  for (int j = 0; j <= n; ++j) xl[j] = gr[j].transpose() * (x - gt[j]);
+  for (int j = 0; j < n; ++j) {
+    const Vec3 wraw = nominal_.axis(j) + x_[4 * j] * u_[j] + x_[4 * j + 1] * v_[j];
+    const double nn = wraw.norm();
+    for (int k = 0; k < 2; ++k) {
+      const Vec3& d = k == 0 ? u_[j] : v_[j];
+      const Vec3 dw = (d - w_[j] * w_[j].dot(d)) / nn;
+      const Vec3 om = w_[j].cross(dw);  // the line turns about p_j
+      const Vec3 dx = gr[j] * om.cross(xl[j] - p_[j]) - gr[j + 1] * om.cross(xl[j + 1] - p_[j]);
+      J.col(4 * j + k) = rb_ * dx;
+      const Vec3 dxt = gr[j] * d - gr[j + 1] * d;  // the line moves along d
+      J.col(4 * j + 2 + k) = rb_ * dxt;
+    }
+  }
+  // velocity of the point per unit rotation of each joint (current configuration, base frame)
+  std::array<Vec3, kMaxJoints> jp;
+  for (int j = 0; j < n; ++j) jp[j] = gr[j] * w_[j].cross(xl[j] - p_[j]);
+  for (size_t i = 0; i < layout_.loaded.size(); ++i) {
+    const int j = layout_.loaded[i];
+    const double dq = tau[j] * kDeg / 1e6;  // per deg/kNm
+    J.col(layout_.compliance + static_cast<int>(i)) = rb_ * jp[j] * dq;
+  }
+  const Mat3 rbn = rb_ * rn;
+  J.block<3, 3>(0, layout_.tool) = rbn;
+  J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * skew(tkv) * jrm_;
+  J.block<3, 3>(0, layout_.base) = Mat3::Identity();
+  J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
+  J.block<3, 3>(0, layout_.targets + 3 * m.target) = rbn * rm_;
+  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, m, jp, J.data());
+  return y;
+}
+
+std::vector<double> PointModel::start(const MeasurementSet& data) const {
+  std::vector<double> x(layout_.size, 0.0);
+  for (size_t i = 0; i < layout_.loaded.size(); ++i)
+    x[layout_.compliance + i] = nominal_.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
+  // nominal prediction of the tool point in the base frame, matched to the measurements (Horn)
+  const size_t m = data.rows.size();
+  Eigen::Matrix3Xd a(3, m), b(3, m);
+  for (size_t i = 0; i < m; ++i) {
+    a.col(i) = fk_compliant(nominal_, data.rows[i].q_deg * kDeg).translation();
+    b.col(i) = data.rows[i].xyz;
+  }
+  const Vec3 ca = a.rowwise().mean(), cb = b.rowwise().mean();
+  const Mat3 h = (a.colwise() - ca) * (b.colwise() - cb).transpose();
+  Eigen::JacobiSVD<Mat3> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 d = Mat3::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  const Mat3 r = svd.matrixV() * d * svd.matrixU().transpose();
+  const Vec3 t = cb - r * ca;
+  const Vec3 dt = t - nominal_.base_in_instrument().translation();
+  const Vec3 phi = so3_log(nominal_.base_in_instrument().linear().transpose() * r);
+  for (int k = 0; k < 3; ++k) x[layout_.base + k] = dt[k], x[layout_.base + 3 + k] = phi[k];
+  return x;
+}
+
+std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data) {
+  std::vector<double> e;
+  e.reserve(data.rows.size());
+  std::map<double, std::shared_ptr<const Model>> variants;
+  for (const auto& r : data.rows) {
+    const Model* m = &model;
+    if (!std::isnan(r.payload_kg) && r.payload_kg != model.spec().payload_kg) {
+      auto& v = variants[r.payload_kg];
+      if (!v) {
+        ModelSpec s = model.spec();
+        s.payload_kg = r.payload_kg;
+        v = std::make_shared<const Model>(s);
+      }
+      m = v.get();
+    }
+    const Vec3 t = r.target < static_cast<int>(targets.size()) ? targets[r.target] : Vec3::Zero();
+    e.push_back((simulate_point(*m, r.q_deg, t) - r.xyz).norm());
+  }
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Identification
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+/// Fills residuals and Jacobians of every row once per evaluation point (the cost functions read).
+class AllRows : public ceres::EvaluationCallback {
+ public:
+  AllRows(PointModel& pm, const MeasurementSet& d, double* x)
+      : pm_(pm), d_(d), x_(x), P_(pm.layout().size), r_(3 * d.rows.size()), j_(3 * d.rows.size() * P_) {}
+  void PrepareForEvaluation(bool jacobians, bool new_point) override {
+    if (new_point || !valid_) {
+      pm_.set_params(std::vector<double>(x_, x_ + P_));
+      valid_ = false;
+    }
+    if (valid_ && (!jacobians || have_j_)) return;
+    for (size_t i = 0; i < d_.rows.size(); ++i) {
+      const Vec3 y = pm_.predict(d_.rows[i], jacobians ? &j_[3 * i * P_] : nullptr);
+      const Vec3 res = y - d_.rows[i].xyz;
+      for (int k = 0; k < 3; ++k) r_[3 * i + k] = res[k];
+    }
+    valid_ = true;
+    have_j_ = jacobians;
+  }
+  const double* residual(size_t i) const { return &r_[3 * i]; }
+  const double* jacobian(size_t i) const { return &j_[3 * i * P_]; }
+  int size() const { return P_; }
+  size_t rows() const { return d_.rows.size(); }
+
+ private:
+  PointModel& pm_;
+  const MeasurementSet& d_;
+  double* x_;
+  int P_;
+  std::vector<double> r_, j_;
+  bool valid_ = false, have_j_ = false;
+};
+
+class RowCost : public ceres::CostFunction {
+ public:
+  RowCost(const AllRows& all, size_t i) : all_(all), i_(i) {
+    set_num_residuals(3);
+    mutable_parameter_block_sizes()->push_back(all.size());
+  }
+  bool Evaluate(double const* const*, double* residuals, double** jacobians) const override {
+    std::copy_n(all_.residual(i_), 3, residuals);
+    if (jacobians && jacobians[0]) std::copy_n(all_.jacobian(i_), 3 * all_.size(), jacobians[0]);
+    return true;
+  }
+
+ private:
+  const AllRows& all_;
+  size_t i_;
+};
+
+class Progress : public ceres::IterationCallback {
+ public:
+  explicit Progress(const std::function<void(int, double)>& f) : f_(f) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (f_) f_(s.iteration, s.cost);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<void(int, double)>& f_;
+};
+
+std::unique_ptr<ceres::LossFunction> make_loss(const IdentifyOptions& opt) {
+  if (opt.loss == "huber") return std::make_unique<ceres::HuberLoss>(opt.loss_scale_mm);
+  if (opt.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(opt.loss_scale_mm);
+  if (opt.loss != "none" && !opt.loss.empty())
+    throw InputError("identify: unknown loss '" + opt.loss + "' (none, huber, cauchy)");
+  return nullptr;
+}
+
+ceres::Problem::Options problem_options(AllRows& all) {
+  ceres::Problem::Options popt;
+  popt.evaluation_callback = &all;
+  popt.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  popt.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  return popt;
+}
+
+/// Levenberg-Marquardt on x with the listed parameters held.
+void solve(ceres::Problem& problem, const AllRows& all, ceres::LossFunction* loss, std::vector<double>& x,
+           const std::vector<int>& fixed_idx, const IdentifyOptions& opt, ceres::Solver::Summary& summary,
+           bool report) {
+  const int P = static_cast<int>(x.size());
+  for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, x.data());
+  if (!fixed_idx.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(P, fixed_idx));
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = opt.max_iterations;
+  so.function_tolerance = 1e-12;
+  so.gradient_tolerance = 1e-14;
+  so.parameter_tolerance = 1e-12;
+  so.num_threads = 1;
+  Progress prog(opt.progress);
+  if (report && opt.progress) so.callbacks.push_back(&prog);
+  ceres::Solve(so, &problem, &summary);
+}
+
+/// Full identification Jacobian (3 rows per measurement) at x.
+Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std::vector<double>& x) {
+  pm.set_params(x);
+  const int P = pm.layout().size;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(3 * d.rows.size(), P);
+  for (size_t i = 0; i < d.rows.size(); ++i) pm.predict(d.rows[i], J.data() + 3 * i * P);
+  return J;
+}
+
+}  // namespace
+
+IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt) {
+  for (const auto& r : data.rows)
+    if (r.q_deg.size() != nominal.dof())
+      throw InputError(data.source + ":" + std::to_string(r.line) + ": " + std::to_string(r.q_deg.size()) +
+                       " joint angles but the robot has " + std::to_string(nominal.dof()));
+  IdentifyResult res(ParamLayout(nominal, data.n_targets));
+  const ParamLayout& L = res.layout;
+  const int P = L.size;
+  PointModel pm(nominal, data.n_targets);
+  pm.prepare_payloads(data);
+  res.start = pm.start(data);
+  std::vector<double> x = res.start;
+  res.fixed.assign(P, false);
+  res.fixed_reason.assign(P, "");
+  std::vector<int> targets_used(data.n_targets, 0);
+  for (const auto& r : data.rows) targets_used[r.target] = 1;
+  for (int t = 0; t < data.n_targets; ++t)
+    if (!targets_used[t])
+      for (int k = 0; k < 3; ++k) res.fixed[L.targets + 3 * t + k] = true, res.fixed_reason[L.targets + 3 * t + k] = "target never measured";
+  if (!opt.compliance)
+    for (int i = L.compliance; i < L.tool; ++i) res.fixed[i] = true, res.fixed_reason[i] = "not asked for (--effects)";
+  for (const auto& name : opt.fix) {
+    auto it = std::find(L.names.begin(), L.names.end(), name);
+    if (it == L.names.end()) throw InputError("identify: no parameter named '" + name + "'");
+    res.fixed[it - L.names.begin()] = true;
+    res.fixed_reason[it - L.names.begin()] = "held by request";
+  }
+
+  // --- stage 1: base frame and targets on the nominal geometry (the "before" of the summary, and a
+  // start where the targets are where they are, so that the analysis below sees the real geometry)
+  {
+    std::vector<int> held;
+    for (int i = 0; i < L.base; ++i) held.push_back(i);
+    for (int i = L.targets; i < P; ++i)
+      if (res.fixed[i]) held.push_back(i);
+    ceres::Solver::Summary s1;
+    AllRows all1(pm, data, x.data());
+    ceres::Problem p1(problem_options(all1));
+    std::unique_ptr<ceres::LossFunction> loss1 = make_loss(opt);
+    solve(p1, all1, loss1.get(), x, held, opt, s1, false);
+    res.nominal_x = x;
+    const Model nom(nominal.spec());
+    pm.set_params(x);
+    double ss = 0;
+    for (const auto& r : data.rows) {
+      const double e = (pm.predict(r, nullptr) - r.xyz).norm();
+      ss += e * e;
+      res.nominal_max_mm = std::max(res.nominal_max_mm, e);
+    }
+    res.nominal_rms_mm = std::sqrt(ss / data.rows.size());
+  }
+
+  // --- identifiability: greedy selection of independent scaled columns in a preferred order ---
+  {
+    const Eigen::MatrixXd J = full_jacobian(pm, data, x);
+    std::vector<int> order;
+    for (int i = L.targets; i < P; ++i) order.push_back(i);
+    for (int i = L.compliance; i < L.tool; ++i) order.push_back(i);
+    for (int j = 1; j < L.dof; ++j)
+      for (int k = 0; k < 4; ++k) order.push_back(4 * j + k);
+    for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
+    for (int k = 0; k < 4; ++k) order.push_back(k);
+    for (int i = L.tool; i < L.tool + 6; ++i) order.push_back(i);
+    Eigen::MatrixXd Q(J.rows(), 0);
+    for (int i : order) {
+      if (res.fixed[i]) continue;
+      const double nrm = J.col(i).norm();
+      if (nrm == 0) {
+        res.fixed[i] = true;
+        res.fixed_reason[i] = "no effect on the measured points";
+        continue;
+      }
+      Eigen::VectorXd c = J.col(i) / nrm;
+      for (int pass = 0; pass < 2; ++pass) c -= Q * (Q.transpose() * c);
+      const double left = c.norm();
+      if (left < opt.rank_tolerance) {
+        res.fixed[i] = true;
+        res.fixed_reason[i] = "not identifiable: a combination of the other parameters";
+        continue;
+      }
+      Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
+      Q.col(Q.cols() - 1) = c / left;
+    }
+  }
+  std::vector<int> free_idx, fixed_idx;
+  for (int i = 0; i < P; ++i) (res.fixed[i] ? fixed_idx : free_idx).push_back(i);
+  const int nres = 3 * static_cast<int>(data.rows.size());
+  if (nres <= static_cast<int>(free_idx.size()))
+    throw InputError(data.source + ": " + std::to_string(data.rows.size()) + " measured points give " +
+                     std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
+                     " free parameters: too few to identify the model");
+
+  // --- stage 2: everything identifiable ---
+  ceres::Solver::Summary summary;
+  std::unique_ptr<ceres::LossFunction> loss = make_loss(opt);
+  AllRows all(pm, data, x.data());
+  ceres::Problem problem(problem_options(all));
+  solve(problem, all, loss.get(), x, fixed_idx, opt, summary, true);
+  res.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  res.initial_cost = summary.initial_cost;
+  res.final_cost = summary.final_cost;
+  res.termination = summary.BriefReport();
+  res.x = x;
+  pm.set_params(x);
+  res.calibrated = pm.spec();
+  res.calibrated.name = nominal.spec().name + "-calibrated";
+  for (int t = 0; t < data.n_targets; ++t)
+    res.targets.emplace_back(x[L.targets + 3 * t], x[L.targets + 3 * t + 1], x[L.targets + 3 * t + 2]);
+  {
+    const Model cal(res.calibrated);
+    const std::vector<double> e = point_errors(cal, res.targets, data);
+    double ss = 0;
+    for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
+    res.rms_mm = std::sqrt(ss / e.size());
+  }
+
+  // --- condition, observability, covariance ---
+  res.stddev.assign(P, std::nan(""));
+  {
+    const Eigen::MatrixXd J = full_jacobian(pm, data, x);
+    Eigen::MatrixXd Jf(J.rows(), free_idx.size());
+    for (size_t k = 0; k < free_idx.size(); ++k) {
+      const double nrm = J.col(free_idx[k]).norm();
+      Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
+    }
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jf);
+    const auto& s = svd.singularValues();
+    res.condition_number = s(0) / s(s.size() - 1);
+    double logsum = 0;
+    for (int k = 0; k < s.size(); ++k) logsum += std::log(s(k));
+    res.observability_index = std::exp(logsum / s.size()) / std::sqrt(static_cast<double>(data.rows.size()));
+    pm.set_params(x);
+  }
+  {
+    ceres::Covariance::Options co;
+    co.algorithm_type = ceres::DENSE_SVD;
+    co.null_space_rank = -1;
+    co.min_reciprocal_condition_number = 1e-14;
+    ceres::Covariance cov(co);
+    std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
+    if (cov.Compute(blocks, &problem)) {
+      const int F = static_cast<int>(free_idx.size());
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(F, F);
+      cov.GetCovarianceBlockInTangentSpace(x.data(), x.data(), C.data());
+      const double dofres = std::max(1, nres - F);
+      const double s2 = 2.0 * summary.final_cost / dofres;
+      C *= s2;
+      // SubsetManifold's tangent space lists the free parameters in order
+      for (int a = 0; a < F; ++a) res.stddev[free_idx[a]] = std::sqrt(std::max(0.0, C(a, a)));
+      for (int a = 0; a < F; ++a)
+        for (int b = a + 1; b < F; ++b) {
+          const double r = C(a, b) / std::sqrt(C(a, a) * C(b, b));
+          if (std::abs(r) >= opt.correlation_threshold)
+            res.correlations.push_back({L.names[free_idx[a]], L.names[free_idx[b]], r});
+        }
+    }
+  }
+  return res;
+}
+
+}  // namespace kincal

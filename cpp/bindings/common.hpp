@@ -11,3 +11,4 @@ namespace py = pybind11;
 void define_model(py::module_& m);
 void define_kinematics(py::module_& m);
 void define_programs(py::module_& m);
+void define_identify(py::module_& m);

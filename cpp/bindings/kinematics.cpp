@@ -25,6 +25,9 @@ void check_q(const Model& m, const Rows& q) {
 
 void define_kinematics(py::module_& m) {
   m.def(
+      "abc_to_rotation", [](const Eigen::Vector3d& abc) { return Eigen::Matrix3d(abc_to_rotation(abc)); },
+      py::arg("abc_deg"), "Rotation matrix of KUKA ABC angles (deg): Rz(a) Ry(b) Rx(c)");
+  m.def(
       "fk",
       [](const Robot& r, const Rows& q_deg, bool calibrated, bool instrument) {
         const Model& md = pick(r, calibrated);

@@ -2,6 +2,9 @@
 
 #include "kincal/model.hpp"
 
+#include <array>
+#include <optional>
+
 using namespace kincal;
 
 void define_model(py::module_& m) {
@@ -26,11 +29,18 @@ void define_model(py::module_& m) {
                              })
       .def(
           "with_calibrated",
-          [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance) {
-            return Robot{r.nominal, std::make_shared<Model>(perturbed_spec(r.nominal->spec(), seed, sigma_mm,
-                                                                            sigma_deg, compliance))};
+          [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance,
+             std::optional<std::array<double, 6>> instrument) {
+            ModelSpec s = perturbed_spec(r.nominal->spec(), seed, sigma_mm, sigma_deg, compliance);
+            if (instrument) {
+              const auto& v = *instrument;
+              s.base_in_instrument.xyz = Vec3(v[0], v[1], v[2]);
+              s.base_in_instrument.abc = Vec3(v[3], v[4], v[5]);
+            }
+            return Robot{r.nominal, std::make_shared<Model>(s)};
           },
           py::arg("seed"), py::arg("sigma_mm") = 1.0, py::arg("sigma_deg") = 0.05, py::arg("compliance") = 0.0,
+          py::arg("base_in_instrument") = py::none(),
           "A robot whose calibrated model has simulated manufacturing errors (for simulations and demos)");
   m.def("builtin_names", &builtin_names);
 }

@@ -8,4 +8,5 @@ PYBIND11_MODULE(_core, m) {
   define_model(m);
   define_kinematics(m);
   define_programs(m);
+  define_identify(m);
 }

@@ -578,6 +578,12 @@ void solve(ceres::Problem& problem, const AllRows& all, ceres::LossFunction* los
   ceres::Solve(so, &problem, &summary);
 }
 
+int count_poses(const MeasurementSet& d) {
+  std::set<int> ids;
+  for (const auto& r : d.rows) ids.insert(r.pose);
+  return static_cast<int>(ids.size());
+}
+
 /// Full identification Jacobian (3 rows per measurement) at x.
 Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std::vector<double>& x) {
   pm.set_params(x);
@@ -630,8 +636,11 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     std::unique_ptr<ceres::LossFunction> loss1 = make_loss(opt);
     solve(p1, all1, loss1.get(), x, held, opt, s1, false);
     res.nominal_x = x;
-    const Model nom(nominal.spec());
     pm.set_params(x);
+    res.nominal_fitted = pm.spec();
+    res.nominal_fitted.name = nominal.spec().name;
+    for (int t = 0; t < data.n_targets; ++t)
+      res.nominal_targets.emplace_back(x[L.targets + 3 * t], x[L.targets + 3 * t + 1], x[L.targets + 3 * t + 2]);
     double ss = 0;
     for (const auto& r : data.rows) {
       const double e = (pm.predict(r, nullptr) - r.xyz).norm();
@@ -641,9 +650,10 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     res.nominal_rms_mm = std::sqrt(ss / data.rows.size());
   }
 
-  // --- identifiability: greedy selection of independent scaled columns in a preferred order ---
+  // --- identifiability: greedy selection of independent scaled columns in a preferred order, on
+  // the data and on a generic campaign (random poses, the same targets): what the generic campaign
+  // determines but the data do not means the data are too few or too alike ---
   {
-    const Eigen::MatrixXd J = full_jacobian(pm, data, x);
     std::vector<int> order;
     for (int i = L.targets; i < P; ++i) order.push_back(i);
     for (int i = L.compliance; i < L.tool; ++i) order.push_back(i);
@@ -652,26 +662,55 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
     for (int k = 0; k < 4; ++k) order.push_back(k);
     for (int i = L.tool; i < L.tool + 6; ++i) order.push_back(i);
-    Eigen::MatrixXd Q(J.rows(), 0);
-    for (int i : order) {
-      if (res.fixed[i]) continue;
-      const double nrm = J.col(i).norm();
-      if (nrm == 0) {
-        res.fixed[i] = true;
-        res.fixed_reason[i] = "no effect on the measured points";
-        continue;
+    auto select = [&](const Eigen::MatrixXd& J, std::vector<bool>& fixed, std::vector<std::string>& reason) {
+      Eigen::MatrixXd Q(J.rows(), 0);
+      for (int i : order) {
+        if (fixed[i]) continue;
+        const double nrm = J.col(i).norm();
+        if (nrm == 0) {
+          fixed[i] = true;
+          reason[i] = "no effect on the measured points";
+          continue;
+        }
+        Eigen::VectorXd c = J.col(i) / nrm;
+        for (int pass = 0; pass < 2; ++pass) c -= Q * (Q.transpose() * c);
+        const double left = c.norm();
+        if (left < opt.rank_tolerance) {
+          fixed[i] = true;
+          reason[i] = "not identifiable: a combination of the other parameters";
+          continue;
+        }
+        Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
+        Q.col(Q.cols() - 1) = c / left;
       }
-      Eigen::VectorXd c = J.col(i) / nrm;
-      for (int pass = 0; pass < 2; ++pass) c -= Q * (Q.transpose() * c);
-      const double left = c.norm();
-      if (left < opt.rank_tolerance) {
-        res.fixed[i] = true;
-        res.fixed_reason[i] = "not identifiable: a combination of the other parameters";
-        continue;
+    };
+    MeasurementSet generic;
+    generic.n_targets = data.n_targets;
+    std::mt19937_64 rng(12345);
+    std::uniform_real_distribution<double> ud(-0.45, 0.45);
+    for (int p = 0; p < 100; ++p) {
+      Measurement row;
+      row.pose = p;
+      row.q_deg.resize(L.dof);
+      for (int j = 0; j < L.dof; ++j) {
+        const JointSpec& js = nominal.spec().joints[j];
+        row.q_deg[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg);
       }
-      Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
-      Q.col(Q.cols() - 1) = c / left;
+      for (int t = 0; t < data.n_targets; ++t)
+        if (targets_used[t]) row.target = t, generic.rows.push_back(row);
     }
+    std::vector<bool> gfixed = res.fixed;
+    std::vector<std::string> greason = res.fixed_reason;
+    select(full_jacobian(pm, generic, x), gfixed, greason);
+    select(full_jacobian(pm, data, x), res.fixed, res.fixed_reason);
+    std::string missing;
+    int n_missing = 0;
+    for (int i = 0; i < P; ++i)
+      if (res.fixed[i] && !gfixed[i]) missing += (n_missing++ ? ", " : "") + L.names[i];
+    if (n_missing)
+      throw InputError(data.source + ": the " + std::to_string(data.rows.size()) + " measured points of " +
+                       std::to_string(count_poses(data)) + " poses cannot determine " + missing +
+                       ": too few or too similar poses to identify the model");
   }
   std::vector<int> free_idx, fixed_idx;
   for (int i = 0; i < P; ++i) (res.fixed[i] ? fixed_idx : free_idx).push_back(i);

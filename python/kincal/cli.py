@@ -13,6 +13,8 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core, compensate, fk, ik, line_program, load_robot
+from . import identify as ident
+from .urdf import spec_urdf
 
 
 def _fmt_rows(header: Sequence[str], rows) -> str:
@@ -44,9 +46,29 @@ def cmd_fk(args) -> None:
     q, _ = _core.read_joint_program(args.joints, robot.dof)
     poses = fk(robot, q, frame=args.frame)
     extra = _csv_columns(args.joints, ["pose", "target"]) if args.joints.lower().endswith(".csv") else {}
+    if "target" in extra:
+        targets = _identified_targets(args.robot)
+        for i, t in enumerate(extra["target"]):
+            k = int(float(t))
+            if not 0 <= k < len(targets):
+                raise ValueError(f"{args.joints}:{i + 2}: target {t} but the model knows {len(targets)} target(s)")
+            r = _core.abc_to_rotation(poses[i, 3:]) if targets[k].any() else None
+            if r is not None:
+                poses[i, :3] = poses[i, :3] + r @ targets[k]
     header = list(extra) + ["x", "y", "z", "a", "b", "c"]
     rows = [[extra[k][i] for k in extra] + list(p) for i, p in enumerate(poses)]
     _core.write_file_atomic(args.out, _fmt_rows(header, rows))
+
+
+def _identified_targets(robot_arg: str) -> np.ndarray:
+    """Target offsets (tool frame, mm) an identified model JSON carries; only the tool point otherwise."""
+    if str(robot_arg).lower().endswith(".json"):
+        with open(robot_arg) as f:
+            d = json.load(f)
+        t = d.get("identification", {}).get("targets_mm")
+        if t:
+            return np.asarray(t, dtype=float)
+    return np.zeros((1, 3))
 
 
 def cmd_ik(args) -> None:
@@ -88,6 +110,49 @@ def cmd_compensate(args) -> None:
     it = np.asarray(res["iterations"])
     print(f"{args.out}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
+
+
+def _progress(label: str):
+    """A one-line progress report on stderr for work that takes seconds (quiet when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(iteration: int, cost: float) -> None:
+        print(f"\r{label}: iteration {iteration}, cost {cost:.6g}   ", end="", file=sys.stderr, flush=True)
+    return report
+
+
+def cmd_simulate(args) -> None:
+    robot = _robot(args)
+    if args.truth:
+        truth = load_robot(args.truth)
+        if truth.dof != robot.dof:
+            raise ValueError(f"{args.truth}: {truth.dof} joints but {args.robot} has {robot.dof}")
+    else:
+        truth = ident.default_truth(robot, seed=args.seed)
+        if args.truth_out:
+            _core.write_file_atomic(args.truth_out, truth.to_json())
+    data = ident.simulate(truth, args.poses, seed=args.seed, noise_mm=args.noise, targets=args.targets,
+                          outlier_fraction=args.outliers, outlier_mm=args.outlier_mm)
+    _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
+    print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
+
+
+def cmd_identify(args) -> None:
+    robot = _robot(args)
+    effects = [] if args.effects in ("", "none") else [e.strip() for e in args.effects.split(",") if e.strip()]
+    data = ident.read_measurements(args.data, robot)
+    res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
+                         holdout=args.holdout, k_folds=args.folds, seed=args.seed,
+                         progress=_progress("identify"))
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    text = res.model_json()
+    if args.urdf:
+        cal = json.loads(text)["calibrated"]
+        _core.write_file_atomic(args.urdf, spec_urdf(cal, cal.get("name", "calibrated").replace(" ", "_")))
+    _core.write_file_atomic(args.out, text)
+    print(res.summary())
 
 
 def cmd_bench(args) -> None:
@@ -184,6 +249,34 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--epsilon", type=float, default=1e-15, help="stop when |F|^2 < epsilon (eq. 9)")
     sp.add_argument("--max-iterations", type=int, default=20)
     sp.set_defaults(func=cmd_compensate)
+
+    sp = sub.add_parser("simulate", help="a simulated measurement campaign on a true model")
+    robot_opts(sp)
+    sp.add_argument("--truth", help="model JSON of the true robot (default: realistic errors drawn with --seed: "
+                                    "1 mm, 0.05 deg, joint compliance about 0.003 deg/kNm)")
+    sp.add_argument("--truth-out", help="write the drawn true model here (when --truth is not given)")
+    sp.add_argument("--poses", type=int, required=True, help="number of robot configurations")
+    sp.add_argument("--out", required=True, help="measurement CSV")
+    sp.add_argument("--targets", type=int, default=3, help="reflectors on the tool (1..4)")
+    sp.add_argument("--noise", type=float, default=0.02, help="instrument noise per coordinate (mm)")
+    sp.add_argument("--outliers", type=float, default=0.0, help="share of points with a gross error")
+    sp.add_argument("--outlier-mm", type=float, default=5.0, help="size of a gross error (mm)")
+    sp.add_argument("--seed", type=int, default=1)
+    sp.set_defaults(func=cmd_simulate)
+
+    sp = sub.add_parser("identify", help="parameter identification from measurements")
+    robot_opts(sp)
+    sp.add_argument("--data", required=True, help="measurement CSV (pose, q1..qN, x, y, z[, target, payload_kg])")
+    sp.add_argument("--out", required=True, help="model JSON")
+    sp.add_argument("--effects", default="joint_compliance",
+                    help="non-geometric effects to identify, comma separated, or 'none' (default: joint_compliance)")
+    sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
+    sp.add_argument("--loss-scale", type=float, default=0.1, help="where the robust loss bends (mm)")
+    sp.add_argument("--holdout", type=float, default=0.25, help="share of poses held out for validation")
+    sp.add_argument("--folds", type=int, default=0, help="k-fold cross-validation instead of a split (k >= 2)")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
+    sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
+    sp.set_defaults(func=cmd_identify)
 
     sp = sub.add_parser("bench", help="benchmarks: our code and KDL's solvers in one run, JSON on stdout")
     sp.add_argument("--poses", type=int, default=2000)

@@ -175,3 +175,47 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
 
 def urdf_model_json(path: str | Path, base: str | None = None, tip: str | None = None) -> str:
     return json.dumps({"format": "kincal-model", "version": 1, "nominal": urdf_spec(path, base, tip)})
+
+
+def spec_urdf(spec: dict, name: str = "kincal_calibrated") -> str:
+    """A URDF of a kincal geometry (a model JSON "nominal" or "calibrated" section).
+
+    Every link frame keeps the base orientation at the zero configuration and sits on its joint's
+    axis at the model's point of that axis (near the nominal one, so no absurd origins); each joint
+    turns about its axis given in that frame. The chain's FK is then exactly the model's product of
+    exponentials. The tool is a fixed joint to `tool0`; masses and centres of mass are kept."""
+    def f(v) -> str:
+        return " ".join(repr(float(x)) for x in v)
+
+    out = ['<?xml version="1.0"?>', f'<robot name="{name}">', '  <link name="base_link"/>']
+    prev = np.zeros(3)
+    parent = "base_link"
+    for i, j in enumerate(spec["joints"]):
+        p = np.asarray(j["point_mm"], dtype=float)
+        w = np.asarray(j["axis"], dtype=float)
+        w = w / np.linalg.norm(w)
+        link = f"link{i + 1}"
+        lo, hi = (math.radians(v) for v in j["limits_deg"])
+        vel = math.radians(j.get("max_velocity_deg_s", 0.0))
+        out.append(f'  <joint name="{j["name"]}" type="revolute">')
+        out.append(f'    <parent link="{parent}"/>\n    <child link="{link}"/>')
+        out.append(f'    <origin xyz="{f((p - prev) / 1000.0)}" rpy="0 0 0"/>')
+        out.append(f'    <axis xyz="{f(w)}"/>')
+        out.append(f'    <limit lower="{lo!r}" upper="{hi!r}" effort="0" velocity="{vel!r}"/>')
+        out.append('  </joint>')
+        m = float(j.get("mass_kg", 0.0))
+        if m > 0:
+            c = (np.asarray(j["com_mm"], dtype=float) - p) / 1000.0
+            out.append(f'  <link name="{link}">\n    <inertial>\n      <origin xyz="{f(c)}" rpy="0 0 0"/>\n'
+                       f'      <mass value="{m!r}"/>\n'
+                       f'      <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>\n    </inertial>\n  </link>')
+        else:
+            out.append(f'  <link name="{link}"/>')
+        prev, parent = p, link
+    t = np.asarray(spec["tool"]["xyz_mm"], dtype=float)
+    a, b, c = (math.radians(v) for v in spec["tool"]["abc_deg"])
+    out.append('  <joint name="tool_joint" type="fixed">')
+    out.append(f'    <parent link="{parent}"/>\n    <child link="tool0"/>')
+    out.append(f'    <origin xyz="{f((t - prev) / 1000.0)}" rpy="{f([c, b, a])}"/>')  # URDF rpy = KUKA c, b, a
+    out.append('  </joint>\n  <link name="tool0"/>\n</robot>')
+    return "\n".join(out) + "\n"

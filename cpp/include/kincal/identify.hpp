@@ -125,6 +125,8 @@ struct IdentifyResult {
   std::vector<double> start, x, stddev;   ///< stddev NaN for fixed parameters
   std::vector<double> nominal_x;          ///< nominal geometry with the fitted base frame and targets
   double nominal_rms_mm = 0, nominal_max_mm = 0;  ///< on the fitted rows, nominal geometry
+  ModelSpec nominal_fitted;               ///< nominal geometry, fitted base frame
+  std::vector<Vec3> nominal_targets;      ///< targets fitted with the nominal geometry
   std::vector<bool> fixed;
   std::vector<std::string> fixed_reason;
   ModelSpec calibrated;

@@ -123,8 +123,8 @@ void define_identify(py::module_& m) {
   m.def(
       "identify",
       [](const Robot& robot, const py::dict& d, bool compliance, const std::string& loss, double loss_scale_mm,
-         int max_iterations, const std::vector<std::string>& fix, py::object progress) {
-        const Model& nominal = *robot.nominal;
+         int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated) {
+        const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
         const MeasurementSet data = from_dict(d, nominal.dof());
         IdentifyOptions o;
         o.compliance = compliance;
@@ -137,6 +137,7 @@ void define_identify(py::module_& m) {
         py::dict out;
         out["robot"] = Robot{robot.nominal, std::make_shared<const Model>(r.calibrated)};
         out["nominal_fitted"] = Robot{robot.nominal, std::make_shared<const Model>(r.nominal_fitted)};
+        out["termination"] = r.termination;
         out["targets"] = targets_to(r.targets);
         out["nominal_targets"] = targets_to(r.nominal_targets);
         out["names"] = r.layout.names;
@@ -165,7 +166,9 @@ void define_identify(py::module_& m) {
       },
       py::arg("robot"), py::arg("data"), py::arg("compliance") = true, py::arg("loss") = "huber",
       py::arg("loss_scale_mm") = 0.1, py::arg("max_iterations") = 100, py::arg("fix") = std::vector<std::string>{},
-      py::arg("progress") = py::none());
+      py::arg("progress") = py::none(), py::arg("from_calibrated") = false,
+      "Identify from measurements, starting from the nominal model (or from the calibrated one: then\n"
+      "the parameters are corrections to it, e.g. to refit only the base frame and targets)");
 
   py::class_<PointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
       .def(py::init([](const Robot& r, int n_targets) { return new PointModel(*r.nominal, n_targets); }),

@@ -616,6 +616,29 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
       for (int k = 0; k < 3; ++k) res.fixed[L.targets + 3 * t + k] = true, res.fixed_reason[L.targets + 3 * t + k] = "target never measured";
   if (!opt.compliance)
     for (int i = L.compliance; i < L.tool; ++i) res.fixed[i] = true, res.fixed_reason[i] = "not asked for (--effects)";
+  // a compliance is only identifiable where gravity loads its joint: below min_torque_share of the
+  // largest joint's torque over the measured poses it is held (its effect is lost in the geometry)
+  if (opt.compliance && !L.loaded.empty()) {
+    std::vector<double> tmax(L.dof, 0.0);
+    VecQ tau;
+    for (const auto& r : data.rows) {
+      gravity_torque(nominal, r.q_deg * kDeg, tau);
+      for (int j = 0; j < L.dof; ++j) tmax[j] = std::max(tmax[j], std::abs(tau[j]));
+    }
+    const double top = *std::max_element(tmax.begin(), tmax.end());
+    for (size_t i = 0; i < L.loaded.size(); ++i) {
+      const int j = L.loaded[i];
+      if (tmax[j] < opt.min_torque_share * top) {
+        const int k = L.compliance + static_cast<int>(i);
+        res.fixed[k] = true;
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "gravity torque too small to see it (at most %.3g N m, %.1f%% of joint %d's)",
+                      tmax[j] / 1000.0, 100.0 * tmax[j] / top,
+                      static_cast<int>(std::max_element(tmax.begin(), tmax.end()) - tmax.begin()) + 1);
+        res.fixed_reason[k] = buf;
+      }
+    }
+  }
   for (const auto& name : opt.fix) {
     auto it = std::find(L.names.begin(), L.names.end(), name);
     if (it == L.names.end()) throw InputError("identify: no parameter named '" + name + "'");
@@ -678,6 +701,13 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
         if (left < opt.rank_tolerance) {
           fixed[i] = true;
           reason[i] = "not identifiable: a combination of the other parameters";
+          continue;
+        }
+        if (left < opt.weak_tolerance) {
+          fixed[i] = true;
+          char buf[160];
+          std::snprintf(buf, sizeof buf, "barely identifiable: only %.1e of its effect is not a combination of the others", left);
+          reason[i] = buf;
           continue;
         }
         Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);

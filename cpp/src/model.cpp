@@ -242,10 +242,55 @@ ModelSpec kr500_spec() {
   return s;
 }
 
-std::vector<std::string> builtin_names() { return {"kr500"}; }
+// ---------------------------------------------------------------------------------------------
+// Built-in UR10 (Universal Robots, CB3 generation): the standard Denavit-Hartenberg parameters
+// Universal Robots publishes ("DH parameters for calculations of kinematics and dynamics": d1 =
+// 127.3 mm, a2 = -612 mm, a3 = -572.3 mm, d4 = 163.941 mm, d5 = 115.7 mm, d6 = 92.2 mm, alpha =
+// 90, 0, 0, 90, -90, 0 deg; link masses 7.1, 12.7, 4.27, 2.0, 2.0, 0.365 kg with the centres of mass
+// of the same page), joint ranges +-360 deg, speeds 120 deg/s (base, shoulder) and 180 deg/s
+// (elbow, wrists) from the UR10 data sheet. Zero configuration and joint senses are UR's, so the
+// angles a UR controller reports apply unchanged. The tool is the flange (tool0). Not a spherical
+// wrist: no closed-form IK; identification and compensation do not need one.
+// ---------------------------------------------------------------------------------------------
+ModelSpec ur10_spec() {
+  ModelSpec s;
+  s.name = "ur10";
+  const double d[6] = {127.3, 0, 0, 163.941, 115.7, 92.2};
+  const double a[6] = {0, -612.0, -572.3, 0, 0, 0};
+  const double alpha[6] = {kPi / 2, 0, 0, kPi / 2, -kPi / 2, 0};
+  const double mass[6] = {7.1, 12.7, 4.27, 2.0, 2.0, 0.365};
+  const Vec3 com[6] = {Vec3(21, 0, 27), Vec3(380, 0, 158), Vec3(240, 0, 68),
+                       Vec3(0, 7, 18), Vec3(0, 7, 18), Vec3(0, 0, -26)};
+  const double vel[6] = {120, 120, 180, 180, 180, 180};
+  const char* names[6] = {"shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"};
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 6; ++i) {
+    JointSpec j;
+    j.name = names[i];
+    j.point = t.translation();
+    j.axis = t.linear().col(2);
+    // DH frame i: Rz(theta) Tz(d) Tx(a) Rx(alpha) at theta = 0
+    t = t * Eigen::Translation3d(0, 0, d[i]) * Eigen::Translation3d(a[i], 0, 0) *
+        Eigen::AngleAxisd(alpha[i], Vec3::UnitX());
+    j.lower_deg = -360;
+    j.upper_deg = 360;
+    j.max_velocity_deg_s = vel[i];
+    j.max_acceleration_deg_s2 = 2 * vel[i];  // assumption, as for kr500
+    j.max_jerk_deg_s3 = 20 * vel[i];
+    j.mass_kg = mass[i];
+    j.com = t * com[i];
+    s.joints.push_back(j);
+  }
+  s.tool = iso_to_pose(t);
+  s.home_deg = {0, -90, 90, -90, -90, 0};
+  return s;
+}
+
+std::vector<std::string> builtin_names() { return {"kr500", "ur10"}; }
 
 ModelSpec builtin_spec(const std::string& name) {
   if (name == "kr500") return kr500_spec();
+  if (name == "ur10") return ur10_spec();
   std::string known;
   for (const auto& n : builtin_names()) known += (known.empty() ? "" : ", ") + n;
   throw InputError("unknown robot '" + name + "': not a built-in name (" + known +

@@ -202,3 +202,17 @@ def identify(robot: Robot, data: dict, *, effects: Sequence[str] = ("joint_compl
     val["fit_rows"] = int(fit_mask.sum())
     return Identification(robot=r["robot"], targets=np.asarray(r["targets"]), fit=r, effects=list(effects),
                           validation=val)
+
+
+def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
+    """Accuracy of an identified robot on another measurement series, where the instrument may stand
+    elsewhere and the probe may sit differently: only the base frame and the targets are refitted
+    (on the calibrated geometry, and on the nominal one for the "before")."""
+    names = list(_core.PointModel(robot, int(np.max(data["target"])) + 1).names)
+    frames_only = [n for n in names if not (n.startswith("base.") or n.startswith("target"))]
+    cal = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, True)
+    nom = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, False)
+    ea = _core.point_errors(cal["robot"], cal["targets"], data)
+    eb = _core.point_errors(nom["robot"], nom["targets"], data)
+    return {"rows": int(len(ea)), "before_rms_mm": _rms(eb), "after_rms_mm": _rms(ea),
+            "before_max_mm": float(np.max(eb)), "after_max_mm": float(np.max(ea))}

@@ -128,3 +128,23 @@ def test_identify_bad_input(tmp_path, content, message):
     assert r.returncode == 1
     assert message in r.stderr and str(f) in r.stderr
     assert not out.exists()
+
+
+@pytest.mark.realdata
+def test_ur10_real_data_calibrates_across_series():
+    """Real data: the UR10 laser-tracker series of ../shared/data/ipa-robot-accuracy (Landgraf et al.
+    2021). Fitted on series B (varied joint configurations), predicted on series C (random poses)
+    and D (ISO cubes) with only the tracker frame and probe offset refitted: the calibrated model
+    beats the nominal one on every series. Measured: B held out 1.07 -> 0.41 mm, C 0.99 -> 0.50 mm,
+    D 0.78 -> 0.50 mm RMS; we require at least a 30% reduction."""
+    from conftest import SHARED
+    from kincal import datasets
+    base = SHARED / "data" / "ipa-robot-accuracy"
+    if not base.exists():
+        pytest.skip("the shared UR10 data are not present")
+    robot = kincal.load_robot("ur10")
+    res = ident.identify(robot, datasets.read_ipa(base / "Series_B/measurements_joint_configurations.csv"))
+    assert res.validation["after_rms_mm"] < 0.7 * res.validation["before_rms_mm"]
+    for f in ("Series_C/measurements_random_poses.csv", "Series_D/measurements_iso_cubes.csv"):
+        v = ident.validate(res.robot, datasets.read_ipa(base / f))
+        assert v["after_rms_mm"] < 0.7 * v["before_rms_mm"], (f, v)

@@ -113,7 +113,9 @@ struct IdentifyOptions {
   std::string loss = "huber";      ///< "none", "huber", "cauchy"
   double loss_scale_mm = 0.1;      ///< where the robust loss bends
   int max_iterations = 100;
-  double rank_tolerance = 1e-6;    ///< a scaled column closer than this to the others is fixed
+  double rank_tolerance = 1e-4;    ///< a unit column closer than this to the others' span: redundant
+  double min_torque_share = 0.05;  ///< compliance of a joint with less gravity torque than this share is held
+  double weak_tolerance = 2e-3;    ///< closer than this: so weakly seen that it is held too
   double correlation_threshold = 0.95;
   std::vector<std::string> fix;    ///< parameter names to hold in any case
   std::function<void(int iteration, double cost)> progress;

@@ -148,6 +148,8 @@ struct Robot {
 
 /// The built-in KUKA KR 500 R2830-class robot with a tape-laying head (sources in model.cpp).
 ModelSpec kr500_spec();
+/// The built-in Universal Robots UR10 (UR's published DH parameters; sources in model.cpp).
+ModelSpec ur10_spec();
 /// Names of the built-in robots.
 std::vector<std::string> builtin_names();
 /// A built-in robot by name; throws InputError naming the unknown robot.

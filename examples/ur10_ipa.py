@@ -1,0 +1,48 @@
+"""Calibrate the real UR10 of ../shared/data/ipa-robot-accuracy on one series, validate on the others.
+
+    .venv/bin/python examples/ur10_ipa.py [DATA_DIR] [--fit B]
+
+Fit series (default B, varied joint configurations): a 25% split of its poses is held out; the
+other series are predicted with only the tracker frame and probe offset refitted (the geometry and
+compliances are those identified on the fit series). Prints a table (mm)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import kincal
+from kincal import datasets
+from kincal import identify as ident
+
+SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",
+          "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("data", nargs="?", default=str(Path(__file__).resolve().parents[1] / ".." / "shared" / "data" /
+                                                  "ipa-robot-accuracy"))
+    p.add_argument("--fit", default="B", choices=sorted(SERIES))
+    p.add_argument("--effects", default="joint_compliance")
+    args = p.parse_args()
+    robot = kincal.load_robot("ur10")
+    data = {k: datasets.read_ipa(Path(args.data) / v) for k, v in SERIES.items()}
+    effects = [e for e in args.effects.split(",") if e and e != "none"]
+    res = ident.identify(robot, data[args.fit], effects=effects)
+    print(res.summary())
+    print()
+    print(f"{'series':<34}{'points':>8}{'RMS before':>12}{'RMS after':>12}{'max before':>12}{'max after':>12}")
+    v = res.validation
+    print(f"{args.fit + ' held out (25% of poses)':<34}{v['held_rows']:>8}{v['before_rms_mm']:>12.3f}"
+          f"{v['after_rms_mm']:>12.3f}{v['before_max_mm']:>12.3f}{v['after_max_mm']:>12.3f}")
+    for k in sorted(SERIES):
+        if k == args.fit:
+            continue
+        r = ident.validate(res.robot, data[k])
+        print(f"{k + ' (frames refitted)':<34}{r['rows']:>8}{r['before_rms_mm']:>12.3f}{r['after_rms_mm']:>12.3f}"
+              f"{r['before_max_mm']:>12.3f}{r['after_max_mm']:>12.3f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,54 @@
+"""Readers for public measurement data sets (converted to kincal's measurement sets)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
+             "wrist_3_joint"]
+
+
+def read_ipa(path: str | Path) -> dict:
+    """A series of the UR10 laser-tracker data of Landgraf et al. (CASE 2021; ../shared/data/
+    ipa-robot-accuracy): ';' separated, ',' decimal mark, joints in rad, the T-Mac probe's position
+    in the tracker frame in mm. Returns a measurement set (one target: the probe) with the
+    temperature (deg C) of every row as ``temperature_c``."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except OSError as e:
+        raise ValueError(f"{path}: {e.strerror}") from None
+    if not lines:
+        raise ValueError(f"{path}: empty file")
+    header = [h.strip() for h in lines[0].split(";")]
+    need = UR_JOINTS + ["measurement_x", "measurement_y", "measurement_z", "measurement_temperature"]
+    for n in need:
+        if n not in header:
+            raise ValueError(f"{path}:1: missing column '{n}'")
+    col = [header.index(n) for n in need]
+    rows = []
+    for i, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        f = line.split(";")
+        try:
+            rows.append([float(f[c].replace(",", ".")) for c in col])
+        except (ValueError, IndexError):
+            raise ValueError(f"{path}:{i}: a field is missing or not a number") from None
+    a = np.asarray(rows, dtype=float)
+    if not np.all(np.isfinite(a)):
+        bad = int(np.argwhere(~np.isfinite(a))[0, 0])
+        raise ValueError(f"{path}: row {bad + 2}: not a finite number")
+    n = len(a)
+    return {
+        "pose": np.arange(n, dtype=np.int32),
+        "q_deg": np.degrees(a[:, :6]),
+        "xyz": a[:, 6:9].copy(),
+        "target": np.zeros(n, dtype=np.int32),
+        "payload_kg": np.full(n, np.nan),
+        "line": np.arange(2, n + 2, dtype=np.int32),
+        "source": str(path),
+        "temperature_c": a[:, 9].copy(),
+    }

@@ -123,7 +123,7 @@ void define_identify(py::module_& m) {
   m.def(
       "identify",
       [](const Robot& robot, const py::dict& d, bool compliance, const std::string& loss, double loss_scale_mm,
-         int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated) {
+         int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated, bool covariance) {
         const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
         const MeasurementSet data = from_dict(d, nominal.dof());
         IdentifyOptions o;
@@ -132,6 +132,7 @@ void define_identify(py::module_& m) {
         o.loss_scale_mm = loss_scale_mm;
         o.max_iterations = max_iterations;
         o.fix = fix;
+        o.covariance = covariance;
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
         const IdentifyResult r = identify(nominal, data, o);
         py::dict out;
@@ -144,6 +145,7 @@ void define_identify(py::module_& m) {
         out["units"] = r.layout.units;
         out["x"] = r.x;
         out["start"] = r.start;
+        out["nominal_x"] = r.nominal_x;
         out["stddev"] = r.stddev;
         std::vector<bool> fixed(r.fixed.begin(), r.fixed.end());
         out["fixed"] = fixed;
@@ -166,7 +168,7 @@ void define_identify(py::module_& m) {
       },
       py::arg("robot"), py::arg("data"), py::arg("compliance") = true, py::arg("loss") = "huber",
       py::arg("loss_scale_mm") = 0.1, py::arg("max_iterations") = 100, py::arg("fix") = std::vector<std::string>{},
-      py::arg("progress") = py::none(), py::arg("from_calibrated") = false,
+      py::arg("progress") = py::none(), py::arg("from_calibrated") = false, py::arg("covariance") = true,
       "Identify from measurements, starting from the nominal model (or from the calibrated one: then\n"
       "the parameters are corrections to it, e.g. to refit only the base frame and targets)");
 

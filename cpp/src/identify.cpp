@@ -7,6 +7,7 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <thread>
 
 namespace kincal {
 
@@ -285,34 +287,47 @@ void PointModel::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& g
   }
 }
 
-void PointModel::add_torque_terms(const Model& model, const Measurement& m, const std::array<Vec3, kMaxJoints>& jp,
+void PointModel::gravity_state(const Model& model, const Measurement& m, GravityState& gs) const {
+  const int n = layout_.dof;
+  const ModelSpec& sp = model.spec();
+  chain_frames(m.q_deg * kDeg, gs.gr, gs.gt);
+  const auto& gr = gs.gr;
+  const auto& gt = gs.gt;
+  const double mp = std::isnan(m.payload_kg) ? sp.payload_kg : m.payload_kg;
+  gs.mp = mp;
+  // current centres of mass; S[i] = sum_{k>=i} m_k c_k, M[i] = sum_{k>=i} m_k (payload on the last link)
+  gs.cp = gr[n] * (rm_ * sp.payload_com + tm_) + gt[n];
+  gs.S[n] = mp * gs.cp;
+  gs.M[n] = mp;
+  for (int k = n - 1; k >= 0; --k) {
+    const double mk = sp.joints[k].mass_kg;
+    gs.S[k] = gs.S[k + 1] + mk * (gr[k + 1] * sp.joints[k].com + gt[k + 1]);
+    gs.M[k] = gs.M[k + 1] + mk;
+  }
+  const Vec3& g = model.gravity();
+  for (int j = 0; j < n; ++j) {
+    gs.wc[j] = gr[j] * w_[j];
+    gs.oc[j] = gr[j] * p_[j] + gt[j];
+    gs.arm[j] = gs.S[j] - gs.M[j] * gs.oc[j];
+    gs.tau[j] = gs.wc[j].dot(gs.arm[j].cross(g));  // N mm, the same as gravity_torque()
+  }
+}
+
+void PointModel::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
                                   double* jac) const {
   const int n = layout_.dof, P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
-  const ModelSpec& sp = model.spec();
-  // the torque is taken at the commanded angles (the frames gr, gt passed in are the deflected ones)
-  std::array<Mat3, kMaxJoints + 1> gr;
-  std::array<Vec3, kMaxJoints + 1> gt;
-  chain_frames(m.q_deg * kDeg, gr, gt);
+  // the torque is taken at the commanded angles (frames of gs), the point moves at the deflected ones
+  const auto& gr = gs.gr;
+  const auto& gt = gs.gt;
+  const auto& S = gs.S;
+  const auto& M = gs.M;
+  const auto& wc = gs.wc;
+  const auto& oc = gs.oc;
+  const auto& arm = gs.arm;
+  const Vec3& cp = gs.cp;
+  const double mp = gs.mp;
   const Vec3& g = model.gravity();
-  const double mp = std::isnan(m.payload_kg) ? sp.payload_kg : m.payload_kg;
-  // current centres of mass; S[i] = sum_{k>=i} m_k c_k, M[i] = sum_{k>=i} m_k (payload on the last link)
-  const Vec3 cp = gr[n] * (rm_ * sp.payload_com + tm_) + gt[n];
-  std::array<Vec3, kMaxJoints + 1> S;
-  std::array<double, kMaxJoints + 1> M;
-  S[n] = mp * cp;
-  M[n] = mp;
-  for (int k = n - 1; k >= 0; --k) {
-    const double mk = sp.joints[k].mass_kg;
-    S[k] = S[k + 1] + mk * (gr[k + 1] * sp.joints[k].com + gt[k + 1]);
-    M[k] = M[k + 1] + mk;
-  }
-  std::array<Vec3, kMaxJoints> wc, oc, arm;
-  for (int j = 0; j < n; ++j) {
-    wc[j] = gr[j] * w_[j];
-    oc[j] = gr[j] * p_[j] + gt[j];
-    arm[j] = S[j] - M[j] * oc[j];
-  }
   auto ad = [&](int k, const Vec3& om, const Vec3& v, Vec3& omo, Vec3& vo) {
     omo = gr[k] * om;
     vo = gr[k] * v + gt[k].cross(omo);
@@ -378,15 +393,22 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
   const Model& model = model_for(m.payload_kg);
   const int n = layout_.dof;
   const VecQ q = m.q_deg * kDeg;
-  VecQ tau = VecQ::Zero(n), qe = q;
-  if (!layout_.loaded.empty()) {
-    gravity_torque(model, q, tau);
-    for (int j = 0; j < n; ++j) qe[j] += model.compliance(j) * tau[j];
+  VecQ qe = q;
+  GravityState gs;
+  const bool torque = !layout_.loaded.empty();
+  if (torque) {
+    gravity_state(model, m, gs);
+    for (int j = 0; j < n; ++j) qe[j] += model.compliance(j) * gs.tau[j];
   }
   // G_j = exp(xi_1 qe_1) ... exp(xi_j qe_j), G_0 = identity
   std::array<Mat3, kMaxJoints + 1> gr;
   std::array<Vec3, kMaxJoints + 1> gt;
-  chain_frames(qe, gr, gt);
+  if (torque && !model.has_compliance()) {
+    gr = gs.gr;
+    gt = gs.gt;
+  } else {
+    chain_frames(qe, gr, gt);
+  }
   const Vec3 tkv(x_[layout_.targets + 3 * m.target], x_[layout_.targets + 3 * m.target + 1],
                  x_[layout_.targets + 3 * m.target + 2]);
   const Vec3 x0 = rm_ * tkv + tm_;
@@ -397,6 +419,11 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
   const int P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
   J.setZero();
+  const Mat3 rbn = rb_ * rn;
+  J.block<3, 3>(0, layout_.base) = Mat3::Identity();
+  J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
+  J.block<3, 3>(0, layout_.targets + 3 * m.target) = rbn * rm_;
+  if (frames_only_) return y;
   // x in the frames G_j: xl_j = G_j^-1 x
   std::array<Vec3, kMaxJoints + 1> xl;
   for (int j = 0; j <= n; ++j) xl[j] = gr[j].transpose() * (x - gt[j]);
@@ -418,16 +445,12 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
   for (int j = 0; j < n; ++j) jp[j] = gr[j] * w_[j].cross(xl[j] - p_[j]);
   for (size_t i = 0; i < layout_.loaded.size(); ++i) {
     const int j = layout_.loaded[i];
-    const double dq = tau[j] * kDeg / 1e6;  // per deg/kNm
+    const double dq = gs.tau[j] * kDeg / 1e6;  // per deg/kNm
     J.col(layout_.compliance + static_cast<int>(i)) = rb_ * jp[j] * dq;
   }
-  const Mat3 rbn = rb_ * rn;
   J.block<3, 3>(0, layout_.tool) = rbn;
   J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * skew(tkv) * jrm_;
-  J.block<3, 3>(0, layout_.base) = Mat3::Identity();
-  J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
-  J.block<3, 3>(0, layout_.targets + 3 * m.target) = rbn * rm_;
-  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, m, jp, J.data());
+  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, J.data());
   return y;
 }
 
@@ -481,36 +504,71 @@ std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& ta
 // ---------------------------------------------------------------------------------------------
 namespace {
 
+/// Run f(i) for i in [0, n) on all cores (rows are independent; PointModel::predict is const).
+template <class F>
+void parallel_rows(size_t n, F&& f) {
+  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), n / 256 + 1);
+  if (threads <= 1) {
+    for (size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  std::vector<std::thread> pool;
+  const size_t chunk = (n + threads - 1) / threads;
+  for (size_t t = 1; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      for (size_t i = t * chunk; i < std::min(n, (t + 1) * chunk); ++i) f(i);
+    });
+  for (size_t i = 0; i < std::min(n, chunk); ++i) f(i);
+  for (auto& th : pool) th.join();
+}
+
 /// Fills residuals and Jacobians of every row once per evaluation point (the cost functions read).
 class AllRows : public ceres::EvaluationCallback {
  public:
-  AllRows(PointModel& pm, const MeasurementSet& d, double* x)
-      : pm_(pm), d_(d), x_(x), P_(pm.layout().size), r_(3 * d.rows.size()), j_(3 * d.rows.size() * P_) {}
+  /// x: the full parameter vector (held values stay, free ones are written back by finish());
+  /// Ceres sees only the free parameters (z), so no manifold is needed.
+  AllRows(PointModel& pm, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx)
+      : pm_(pm), d_(d), x_(x), free_(std::move(free_idx)), P_(pm.layout().size), F_(static_cast<int>(free_.size())),
+        r_(3 * d.rows.size()), j_(3 * d.rows.size() * F_) {
+    for (int i : free_) z_.push_back(x_[i]);
+  }
   void PrepareForEvaluation(bool jacobians, bool new_point) override {
     if (new_point || !valid_) {
-      pm_.set_params(std::vector<double>(x_, x_ + P_));
+      for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
+      pm_.set_params(x_);
       valid_ = false;
     }
     if (valid_ && (!jacobians || have_j_)) return;
-    for (size_t i = 0; i < d_.rows.size(); ++i) {
-      const Vec3 y = pm_.predict(d_.rows[i], jacobians ? &j_[3 * i * P_] : nullptr);
+    parallel_rows(d_.rows.size(), [&](size_t i) {
+      thread_local std::vector<double> full;
+      if (jacobians) full.resize(3 * P_);
+      const Vec3 y = pm_.predict(d_.rows[i], jacobians ? full.data() : nullptr);
       const Vec3 res = y - d_.rows[i].xyz;
       for (int k = 0; k < 3; ++k) r_[3 * i + k] = res[k];
-    }
+      if (jacobians)
+        for (int r = 0; r < 3; ++r)
+          for (int k = 0; k < F_; ++k) j_[(3 * i + r) * F_ + k] = full[r * P_ + free_[k]];
+    });
     valid_ = true;
     have_j_ = jacobians;
   }
+  void finish() {
+    for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
+    pm_.set_params(x_);
+  }
+  double* z() { return z_.data(); }
   const double* residual(size_t i) const { return &r_[3 * i]; }
-  const double* jacobian(size_t i) const { return &j_[3 * i * P_]; }
-  int size() const { return P_; }
+  const double* jacobian(size_t i) const { return &j_[3 * i * F_]; }
+  int size() const { return F_; }
   size_t rows() const { return d_.rows.size(); }
 
  private:
   PointModel& pm_;
   const MeasurementSet& d_;
-  double* x_;
-  int P_;
-  std::vector<double> r_, j_;
+  std::vector<double>& x_;
+  std::vector<int> free_;
+  int P_, F_;
+  std::vector<double> z_, r_, j_;
   bool valid_ = false, have_j_ = false;
 };
 
@@ -559,15 +617,12 @@ ceres::Problem::Options problem_options(AllRows& all) {
   return popt;
 }
 
-/// Levenberg-Marquardt on x with the listed parameters held.
-void solve(ceres::Problem& problem, const AllRows& all, ceres::LossFunction* loss, std::vector<double>& x,
-           const std::vector<int>& fixed_idx, const IdentifyOptions& opt, ceres::Solver::Summary& summary,
-           bool report) {
-  const int P = static_cast<int>(x.size());
-  for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, x.data());
-  if (!fixed_idx.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(P, fixed_idx));
+/// Levenberg-Marquardt on the free parameters of all (written back into its x by finish()).
+void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, const IdentifyOptions& opt,
+           ceres::Solver::Summary& summary, bool report) {
+  for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, all.z());
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = 1e-12;
   so.gradient_tolerance = 1e-14;
@@ -576,6 +631,7 @@ void solve(ceres::Problem& problem, const AllRows& all, ceres::LossFunction* los
   Progress prog(opt.progress);
   if (report && opt.progress) so.callbacks.push_back(&prog);
   ceres::Solve(so, &problem, &summary);
+  all.finish();
 }
 
 int count_poses(const MeasurementSet& d) {
@@ -589,7 +645,7 @@ Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std
   pm.set_params(x);
   const int P = pm.layout().size;
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(3 * d.rows.size(), P);
-  for (size_t i = 0; i < d.rows.size(); ++i) pm.predict(d.rows[i], J.data() + 3 * i * P);
+  parallel_rows(d.rows.size(), [&](size_t i) { pm.predict(d.rows[i], J.data() + 3 * i * P); });
   return J;
 }
 
@@ -649,15 +705,16 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // --- stage 1: base frame and targets on the nominal geometry (the "before" of the summary, and a
   // start where the targets are where they are, so that the analysis below sees the real geometry)
   {
-    std::vector<int> held;
-    for (int i = 0; i < L.base; ++i) held.push_back(i);
-    for (int i = L.targets; i < P; ++i)
-      if (res.fixed[i]) held.push_back(i);
+    std::vector<int> frames;
+    for (int i = L.base; i < P; ++i)
+      if (i < L.targets || !res.fixed[i]) frames.push_back(i);
     ceres::Solver::Summary s1;
-    AllRows all1(pm, data, x.data());
+    AllRows all1(pm, data, x, frames);
     ceres::Problem p1(problem_options(all1));
     std::unique_ptr<ceres::LossFunction> loss1 = make_loss(opt);
-    solve(p1, all1, loss1.get(), x, held, opt, s1, false);
+    pm.set_frames_only(true);  // only the base and target columns are needed here
+    solve(p1, all1, loss1.get(), opt, s1, false);
+    pm.set_frames_only(false);
     res.nominal_x = x;
     pm.set_params(x);
     res.nominal_fitted = pm.spec();
@@ -685,19 +742,32 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
     for (int k = 0; k < 4; ++k) order.push_back(k);
     for (int i = L.tool; i < L.tool + 6; ++i) order.push_back(i);
+    // greedy on the normal matrix of the unit-scaled columns: the squared distance of column i from
+    // the span of the chosen ones is N_ii - N_iS N_SS^-1 N_Si (an incremental Cholesky factor)
     auto select = [&](const Eigen::MatrixXd& J, std::vector<bool>& fixed, std::vector<std::string>& reason) {
-      Eigen::MatrixXd Q(J.rows(), 0);
+      Eigen::VectorXd nrm = J.colwise().norm().transpose();
+      Eigen::MatrixXd N = J.transpose() * J;
+      for (int a = 0; a < P; ++a)
+        for (int b = 0; b < P; ++b) N(a, b) /= (nrm[a] > 0 ? nrm[a] : 1.0) * (nrm[b] > 0 ? nrm[b] : 1.0);
+      std::vector<int> chosen;
+      Eigen::MatrixXd Lc(P, P);  // rows: chosen index k; Lc(k, i) = component of column i on chosen k
       for (int i : order) {
         if (fixed[i]) continue;
-        const double nrm = J.col(i).norm();
-        if (nrm == 0) {
+        if (nrm[i] == 0) {
           fixed[i] = true;
           reason[i] = "no effect on the measured points";
           continue;
         }
-        Eigen::VectorXd c = J.col(i) / nrm;
-        for (int pass = 0; pass < 2; ++pass) c -= Q * (Q.transpose() * c);
-        const double left = c.norm();
+        double left2 = N(i, i);
+        const int k = static_cast<int>(chosen.size());
+        Eigen::VectorXd li(k);
+        for (int a = 0; a < k; ++a) {
+          double v = N(chosen[a], i);
+          for (int b = 0; b < a; ++b) v -= Lc(b, chosen[a]) * li[b];
+          li[a] = v / Lc(a, chosen[a]);
+          left2 -= li[a] * li[a];
+        }
+        const double left = std::sqrt(std::max(0.0, left2));
         if (left < opt.rank_tolerance) {
           fixed[i] = true;
           reason[i] = "not identifiable: a combination of the other parameters";
@@ -710,8 +780,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
           reason[i] = buf;
           continue;
         }
-        Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
-        Q.col(Q.cols() - 1) = c / left;
+        for (int a = 0; a < k; ++a) Lc(a, i) = li[a];
+        Lc(k, i) = left;
+        chosen.push_back(i);
       }
     };
     MeasurementSet generic;
@@ -753,9 +824,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // --- stage 2: everything identifiable ---
   ceres::Solver::Summary summary;
   std::unique_ptr<ceres::LossFunction> loss = make_loss(opt);
-  AllRows all(pm, data, x.data());
+  AllRows all(pm, data, x, free_idx);
   ceres::Problem problem(problem_options(all));
-  solve(problem, all, loss.get(), x, fixed_idx, opt, summary, true);
+  solve(problem, all, loss.get(), opt, summary, true);
   res.iterations = static_cast<int>(summary.iterations.size()) - 1;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;
@@ -783,29 +854,29 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
       const double nrm = J.col(free_idx[k]).norm();
       Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
     }
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jf);
-    const auto& s = svd.singularValues();
-    res.condition_number = s(0) / s(s.size() - 1);
+    // singular values from the eigenvalues of the (small) normal matrix
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Jf.transpose() * Jf, Eigen::EigenvaluesOnly);
+    const Eigen::VectorXd s = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    res.condition_number = s.maxCoeff() / s.minCoeff();
     double logsum = 0;
     for (int k = 0; k < s.size(); ++k) logsum += std::log(s(k));
     res.observability_index = std::exp(logsum / s.size()) / std::sqrt(static_cast<double>(data.rows.size()));
     pm.set_params(x);
   }
-  {
+  if (opt.covariance) {
     ceres::Covariance::Options co;
-    co.algorithm_type = ceres::DENSE_SVD;
-    co.null_space_rank = -1;
+    co.algorithm_type = ceres::DENSE_SVD;  // the held parameters are out of the block: full rank
+    co.null_space_rank = 0;
     co.min_reciprocal_condition_number = 1e-14;
     ceres::Covariance cov(co);
-    std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
+    std::vector<std::pair<const double*, const double*>> blocks = {{all.z(), all.z()}};
     if (cov.Compute(blocks, &problem)) {
       const int F = static_cast<int>(free_idx.size());
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(F, F);
-      cov.GetCovarianceBlockInTangentSpace(x.data(), x.data(), C.data());
+      cov.GetCovarianceBlock(all.z(), all.z(), C.data());
       const double dofres = std::max(1, nres - F);
       const double s2 = 2.0 * summary.final_cost / dofres;
       C *= s2;
-      // SubsetManifold's tangent space lists the free parameters in order
       for (int a = 0; a < F; ++a) res.stddev[free_idx[a]] = std::sqrt(std::max(0.0, C(a, a)));
       for (int a = 0; a < F; ++a)
         for (int b = a + 1; b < F; ++b) {

@@ -155,9 +155,63 @@ def cmd_identify(args) -> None:
     print(res.summary())
 
 
+def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
+    """Identification on a simulated kr500 campaign (truth: default_truth(seed), one target, 0.02 mm
+    noise), plain least squares. identify_ms: our Ceres identification (analytic Jacobian; both stages, the
+    identifiability analysis; without the covariance, which is identify_with_covariance_ms);
+    scipy_identify_ms: scipy.optimize.least_squares ('trf') on the same residual function from our
+    core with its own finite-difference Jacobian ('2-point', what a user without our Jacobian
+    has); scipy_analytic_identify_ms: the same with our analytic Jacobian. scipy starts from the
+    output of our first stage (a head start); each reports its final cost."""
+    from scipy.optimize import least_squares
+
+    robot = load_robot("kr500")
+    truth = ident.default_truth(robot, seed=seed)
+    data = ident.simulate(truth, poses, seed=seed, targets=1)
+
+    def median_ms(f, n):
+        ts = []
+        for _ in range(n):
+            t = time.perf_counter()
+            out = f()
+            ts.append(time.perf_counter() - t)
+        return float(np.median(ts)) * 1e3, out
+
+    ours, res = median_ms(lambda: _core.identify(robot, data, True, "none", 0.1, 100, [], None, False, False), repeats)
+    ours_cov, _ = median_ms(lambda: _core.identify(robot, data, True, "none", 0.1, 100, [], None, False, True), repeats)
+    pm = _core.PointModel(robot, 1)
+    free = ~np.asarray(res["fixed"])
+    # scipy starts where our second stage starts (after our first stage fitted the base frame and
+    # target on the nominal geometry): the held parameters then have the same values in both
+    x0 = np.asarray(res["nominal_x"], dtype=float)
+
+    def full(z):
+        x = x0.copy()
+        x[free] = z
+        return x
+
+    def fun(z):
+        return pm.residuals(full(z), data, False)[0]
+
+    def jac(z):
+        return pm.residuals(full(z), data, True)[1][:, free]
+
+    tol = dict(method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    fd_ms, fd = median_ms(lambda: least_squares(fun, x0[free], jac="2-point", **tol), 1)
+    an_ms, an = median_ms(lambda: least_squares(fun, x0[free], jac=jac, **tol), max(1, repeats // 2))
+    return {"identify_poses": poses, "identify_parameters": len(res["names"]),
+            "identify_free_parameters": int(free.sum()), "identify_ms": ours,
+            "identify_with_covariance_ms": ours_cov, "scipy_identify_ms": fd_ms,
+            "scipy_analytic_identify_ms": an_ms, "identify_speedup_vs_scipy": fd_ms / ours,
+            "identify_speedup_vs_scipy_analytic": an_ms / ours, "identify_cost": res["final_cost"],
+            "scipy_identify_cost": float(fd.cost), "scipy_analytic_identify_cost": float(an.cost)}
+
+
 def cmd_bench(args) -> None:
     t0 = time.perf_counter()
     r = _core.run_benchmarks(args.poses, args.seed, args.threads)
+    if not args.no_identify:
+        r.update(bench_identify(args.identify_poses, args.seed))
     r["bench_seconds"] = time.perf_counter() - t0
     print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
 
@@ -282,6 +336,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--poses", type=int, default=2000)
     sp.add_argument("--seed", type=int, default=1)
     sp.add_argument("--threads", type=int, default=0, help="batch threads (default: all cores)")
+    sp.add_argument("--identify-poses", type=int, default=1000, help="poses of the identification benchmark")
+    sp.add_argument("--no-identify", action="store_true", help="skip the identification benchmark")
     sp.set_defaults(func=cmd_bench)
 
     sp = sub.add_parser("demo", help="the whole pipeline on the built-in example")

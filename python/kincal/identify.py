@@ -210,8 +210,8 @@ def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float
     (on the calibrated geometry, and on the nominal one for the "before")."""
     names = list(_core.PointModel(robot, int(np.max(data["target"])) + 1).names)
     frames_only = [n for n in names if not (n.startswith("base.") or n.startswith("target"))]
-    cal = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, True)
-    nom = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, False)
+    cal = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, True, False)
+    nom = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, False, False)
     ea = _core.point_errors(cal["robot"], cal["targets"], data)
     eb = _core.point_errors(nom["robot"], nom["targets"], data)
     return {"rows": int(len(ea)), "before_rms_mm": _rms(eb), "after_rms_mm": _rms(ea),

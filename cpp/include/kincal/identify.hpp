@@ -85,6 +85,8 @@ class PointModel {
   void prepare_payloads(const MeasurementSet& data);
   /// The current geometry as a model spec (base_in_instrument and tool included).
   ModelSpec spec() const;
+  /// Jacobian columns of the base frame and targets only (the others left zero), for fitting the frames.
+  void set_frames_only(bool on) { frames_only_ = on; }
   /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.
   Vec3 predict(const Measurement& m, double* jac) const;
   /// Starting parameters: nominal geometry, base frame from the best rigid fit (Horn) of the
@@ -96,6 +98,7 @@ class PointModel {
   ParamLayout layout_;
   std::vector<Vec3> u_, v_;
   std::vector<double> x_;
+  bool frames_only_ = false;
   ModelSpec spec_;
   std::shared_ptr<const Model> current_;
   std::vector<std::pair<double, std::shared_ptr<const Model>>> payload_models_;
@@ -104,7 +107,18 @@ class PointModel {
   std::vector<Vec3> w_, p_;
   const Model& model_for(double payload) const;
   void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;
-  void add_torque_terms(const Model& model, const Measurement& m, const std::array<Vec3, kMaxJoints>& jp,
+  /// Gravity at the commanded angles: frames, centres of mass, moment arms and joint torques.
+  struct GravityState {
+    std::array<Mat3, kMaxJoints + 1> gr;
+    std::array<Vec3, kMaxJoints + 1> gt, S;
+    std::array<double, kMaxJoints + 1> M;
+    std::array<Vec3, kMaxJoints> wc, oc, arm;
+    std::array<double, kMaxJoints> tau{};
+    Vec3 cp;
+    double mp = 0;
+  };
+  void gravity_state(const Model& model, const Measurement& m, GravityState& gs) const;
+  void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
                         double* jac) const;
 };
 
@@ -117,6 +131,7 @@ struct IdentifyOptions {
   double min_torque_share = 0.05;  ///< compliance of a joint with less gravity torque than this share is held
   double weak_tolerance = 2e-3;    ///< closer than this: so weakly seen that it is held too
   double correlation_threshold = 0.95;
+  bool covariance = true;          ///< parameter standard deviations and correlations (Ceres covariance)
   std::vector<std::string> fix;    ///< parameter names to hold in any case
   std::function<void(int iteration, double cost)> progress;
 };

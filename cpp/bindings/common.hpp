@@ -12,3 +12,4 @@ void define_model(py::module_& m);
 void define_kinematics(py::module_& m);
 void define_programs(py::module_& m);
 void define_identify(py::module_& m);
+void define_fivebar(py::module_& m);

@@ -9,4 +9,5 @@ PYBIND11_MODULE(_core, m) {
   define_kinematics(m);
   define_programs(m);
   define_identify(m);
+  define_fivebar(m);
 }

@@ -89,6 +89,19 @@ void define_programs(py::module_& m) {
       py::arg("path"), py::arg("dof"), "Joint program (CSV q1..qN or G-code A1=..) in degrees");
   m.def("write_file_atomic", &write_file_atomic, py::arg("path"), py::arg("text"));
   m.def(
+      "read_csv_columns",
+      [](const std::string& path, const std::vector<std::string>& names) {
+        const CsvTable t = read_csv(path);
+        std::vector<int> cols;
+        for (const auto& n : names) cols.push_back(t.require(n));
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> out(t.cells.size(), names.size());
+        for (size_t r = 0; r < t.cells.size(); ++r)
+          for (size_t k = 0; k < cols.size(); ++k) out(r, k) = t.number(r, cols[k]);
+        if (t.cells.empty()) throw InputError(path + ": no rows");
+        return out;
+      },
+      py::arg("path"), py::arg("names"), "numeric columns of a CSV (finite numbers; errors name file:line)");
+  m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr) {
         StreamCompensator sc(r, options(true, instr, false, 1e-8, 1e-15, 20, true));

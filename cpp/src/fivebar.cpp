@@ -270,9 +270,6 @@ ErrorMatrix ErrorMatrix::from_points(const std::vector<FiveBarPoint>& grid, cons
   m.y0 = uy.front();
   m.dx = (ux.back() - ux.front()) / (m.nx - 1);
   m.dy = (uy.back() - uy.front()) / (m.ny - 1);
-  if (grid.size() != static_cast<size_t>(m.nx * m.ny))
-    throw InputError(source + ": " + std::to_string(grid.size()) + " points but a " + std::to_string(m.nx) + " x " +
-                     std::to_string(m.ny) + " grid needs " + std::to_string(m.nx * m.ny));
   m.ex.assign(m.nx * m.ny, std::nan(""));
   m.ey = m.ex;
   for (const auto& p : grid) {
@@ -286,6 +283,9 @@ ErrorMatrix ErrorMatrix::from_points(const std::vector<FiveBarPoint>& grid, cons
     m.ex[k] = e.x();
     m.ey[k] = e.y();
   }
+  if (grid.size() != static_cast<size_t>(m.nx * m.ny))
+    throw InputError(source + ": " + std::to_string(grid.size()) + " points but a " + std::to_string(m.nx) + " x " +
+                     std::to_string(m.ny) + " grid needs " + std::to_string(m.nx * m.ny));
   return m;
 }
 

@@ -2,18 +2,100 @@
 //
 //   kincal-compensate --model M --program IN --out OUT [--frame base|instrument]
 //   kincal-compensate --model M --stream [--frame base|instrument] < poses > joints
+//   kincal-compensate --fivebar FIT.json [--matrix MATRIX.json] --program XY.csv --out J.csv
+//   kincal-compensate --fivebar FIT.json [--matrix MATRIX.json] --stream < "x,y" lines > "theta1,theta2"
 //
 // M is a built-in robot name (kr500) or a model JSON written by kincal. Output equals
 // `kincal compensate` (both run this library). Errors: one line "file:line: cause", exit 1, and no
 // output file.
+#include "kincal/fivebar.hpp"
 #include "kincal/io.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <string>
+
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw kincal::InputError(path + ": cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Five-bar corrector: hidden-robot IK, bilinear lookup, Jacobian correction (no allocation per line
+/// in the streaming loop).
+int run_fivebar(const std::string& fit_path, const std::string& matrix_path, const std::string& program,
+                const std::string& out, bool stream) {
+  const kincal::FiveBar fb = kincal::fivebar_from_json(slurp(fit_path), fit_path);
+  kincal::ErrorMatrix m;
+  if (!matrix_path.empty()) m = kincal::ErrorMatrix::from_json(slurp(matrix_path), matrix_path);
+  kincal::FiveBarCorrector corr(fb, matrix_path.empty() ? nullptr : &m);
+  char buf[128];
+  if (stream) {
+    std::string line;
+    line.reserve(4096);
+    long n = 0;
+    while (std::getline(std::cin, line)) {
+      ++n;
+      const char* s = line.c_str();
+      char* end;
+      const double x = std::strtod(s, &end);
+      const bool num_x = end != s;
+      double y = 0;
+      bool ok = num_x && *end == ',';
+      if (ok) {
+        const char* s2 = end + 1;
+        y = std::strtod(s2, &end);
+        ok = end != s2 && std::isfinite(x) && std::isfinite(y);
+        while (ok && (*end == ' ' || *end == '\r' || *end == '\t')) ++end;
+        ok = ok && *end == '\0';
+      }
+      int len;
+      double t1, t2;
+      if (!ok && n == 1 && !num_x) {
+        len = std::snprintf(buf, sizeof buf, "theta1_deg,theta2_deg");  // the header line
+      } else if (!ok) {
+        len = std::snprintf(buf, sizeof buf, "error: stdin:%ld: expected x,y (two finite numbers)", n);
+      } else if (!corr.command(kincal::Vec2(x, y), t1, t2)) {
+        len = std::snprintf(buf, sizeof buf, "error: stdin:%ld: (%g, %g) is out of reach", n, x, y);
+      } else {
+        len = std::snprintf(buf, sizeof buf, "%.10f,%.10f", t1, t2);
+      }
+      buf[len] = '\n';
+      std::fwrite(buf, 1, static_cast<size_t>(len) + 1, stdout);
+      std::fflush(stdout);
+    }
+    return 0;
+  }
+  if (program.empty() || out.empty()) throw kincal::InputError("--program and --out are needed (or --stream)");
+  const kincal::CsvTable t = kincal::read_csv(program);
+  const int cx = t.require("x"), cy = t.require("y");
+  std::string text = "theta1_deg,theta2_deg\n";
+  for (size_t r = 0; r < t.cells.size(); ++r) {
+    double t1, t2;
+    const double x = t.number(r, cx), y = t.number(r, cy);
+    if (!corr.command(kincal::Vec2(x, y), t1, t2))
+      throw kincal::InputError(t.where(r) + ": (" + std::to_string(x) + ", " + std::to_string(y) +
+                               ") is out of the hidden robot's reach");
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g\n", t1, t2);
+    text += buf;
+  }
+  if (t.cells.empty()) throw kincal::InputError(program + ": no targets");
+  kincal::write_file_atomic(out, text);
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"kincal-compensate: Newton compensation of pose programs into joint programs"};
@@ -21,7 +103,10 @@ int main(int argc, char** argv) {
   bool stream = false, fd = false, nominal = false;
   double eps = 1e-15, delta = 1e-8;
   int max_iter = 20;
-  app.add_option("--model", model, "built-in robot name or model JSON")->required();
+  std::string fivebar, matrix;
+  app.add_option("--model", model, "built-in robot name or model JSON");
+  app.add_option("--fivebar", fivebar, "five-bar hidden robot: FIT.json of kincal hidden-robot fit");
+  app.add_option("--matrix", matrix, "five-bar: MATRIX.json of kincal hidden-robot matrix");
   app.add_option("--program", program, "pose program: CSV (x,y,z,a,b,c) or G-code (X Y Z A B C)");
   app.add_option("--out", out, "joint program: .csv (q1..q6) or G-code (A1=..)");
   app.add_option("--frame", frame, "frame of the program poses")->check(CLI::IsMember({"base", "instrument"}));
@@ -34,6 +119,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
+    if (!fivebar.empty()) return run_fivebar(fivebar, matrix, program, out, stream);
+    if (model.empty()) throw kincal::InputError("--model (a serial robot) or --fivebar (a hidden robot) is needed");
     kincal::ProgramOptions opt;
     opt.instrument_frame = frame == "instrument";
     opt.compensate = !nominal;

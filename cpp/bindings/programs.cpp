@@ -1,6 +1,7 @@
 #include "common.hpp"
 
 #include "kincal/bench.hpp"
+#include "kincal/feed.hpp"
 #include "kincal/io.hpp"
 
 using namespace kincal;
@@ -87,6 +88,16 @@ void define_programs(py::module_& m) {
         return std::make_pair(out, p.line);
       },
       py::arg("path"), py::arg("dof"), "Joint program (CSV q1..qN or G-code A1=..) in degrees");
+  m.def(
+      "time_optimal_feed",
+      [](const Eigen::VectorXd& s, const RowsX& d1, const RowsX& d2, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+         const Eigen::VectorXd& cap) {
+        double t = 0;
+        Eigen::VectorXd sd = time_optimal_feed(s, d1, d2, v, a, cap, t);
+        return py::make_tuple(sd, t);
+      },
+      py::arg("s"), py::arg("d1"), py::arg("d2"), py::arg("v"), py::arg("a"), py::arg("cap"),
+      "time-optimal s-dot along the path and the traversal time (see kincal/feed.hpp)");
   m.def("write_file_atomic", &write_file_atomic, py::arg("path"), py::arg("text"));
   m.def(
       "read_csv_columns",

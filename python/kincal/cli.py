@@ -13,6 +13,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core, compensate, fk, ik, line_program, load_robot
+from . import feed as feedmod
 from . import fivebar
 from . import identify as ident
 from .urdf import spec_urdf
@@ -255,6 +256,44 @@ def cmd_hr_simulate(args) -> None:
           f"largest error {fivebar.position_errors(pts).max() * 1000:.1f} um", file=sys.stderr)
 
 
+def cmd_feed(args) -> None:
+    robot = _robot(args)
+    limits = feedmod.robot_limits(robot)
+    if args.limits:
+        limits = feedmod.read_limits(args.limits, robot.dof, limits)
+    for name, lim in zip(("velocity", "acceleration", "jerk"), limits):
+        if not all(x > 0 for x in lim):
+            raise ValueError(f"{args.robot}: the model has no {name} limit for some axis; give --limits L.csv")
+    programs = {"program": args.program}
+    if args.compare:
+        programs["compare"] = args.compare
+    results = {}
+    for key, path in programs.items():
+        q, _ = _core.read_joint_program(path, robot.dof)
+        res = feedmod.analyse(np.asarray(q), *limits, feed=args.feed, samples=args.samples, method=args.method)
+        res["file"] = path
+        res["label"] = Path(path).name
+        results[key] = res
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"feed_rad_s": args.feed, "method": args.method, "samples": args.samples,
+           "limits": {"v_max_deg_s": limits[0], "a_max_deg_s2": limits[1], "j_max_deg_s3": limits[2]},
+           "programs": {k: {kk: vv for kk, vv in r.items() if kk != "arrays"} for k, r in results.items()},
+           "figures": []}
+    for axis in range(1, robot.dof + 1):
+        name = f"axis{axis}.png"
+        feedmod.figure(results, *limits, args.feed, axis, str(out / name))
+        doc["figures"].append(name)
+    _core.write_file_atomic(str(out / "feed.json"), json.dumps(doc) + "\n")
+    for k, r in results.items():
+        t = r.get("time_optimal", {})
+        print(f"{k} ({r['file']}): s = {r['s_total_rad']:.4f} rad, {len(r['violations'])} violation(s) at "
+              f"{args.feed:g} rad/s; time-optimal traversal {t.get('time_s', float('nan')):.3f} s")
+        for v in r["violations"][:10]:
+            print(f"  axis A{v['axis']} {v['limit']} limit from s = {v['s']:.4f} to {v['s_end']:.4f} rad "
+                  f"(allowed feed down to {v['allowed_feed']:.4g} rad/s)")
+
+
 def cmd_bench(args) -> None:
     t0 = time.perf_counter()
     r = _core.run_benchmarks(args.poses, args.seed, args.threads)
@@ -379,6 +418,19 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
     sp.set_defaults(func=cmd_identify)
+
+    sp = sub.add_parser("feed", help="derivative analysis of joint programs (Samak section III)")
+    robot_opts(sp)
+    sp.add_argument("--program", required=True, help="joint program (CSV q1..qN or G-code A1=..)")
+    sp.add_argument("--compare", help="a second joint program drawn beside it (e.g. the uncompensated one)")
+    sp.add_argument("--limits", help="CSV axis,v_max,a_max,j_max (deg/s, deg/s^2, deg/s^3) overriding the robot's")
+    sp.add_argument("--feed", type=float, default=feedmod.DEFAULT_FEED,
+                    help="commanded rate of total axis displacement s (rad/s) against which violations are found")
+    sp.add_argument("--method", choices=list(feedmod.METHODS), default="spline",
+                    help="resampling: quintic spline (default) or the paper's linear interpolation")
+    sp.add_argument("--samples", type=int, default=feedmod.DEFAULT_SAMPLES, help="resampled points along s")
+    sp.add_argument("--out", required=True, help="folder for feed.json and the figures")
+    sp.set_defaults(func=cmd_feed)
 
     hr = sub.add_parser("hidden-robot", help="five-bar hidden-robot calibration (the Kiper paper)")
     hsub = hr.add_subparsers(dest="hr_command", required=True)

@@ -278,7 +278,7 @@ def cmd_feed(args) -> None:
     out.mkdir(parents=True, exist_ok=True)
     doc = {"feed_rad_s": args.feed, "method": args.method, "samples": args.samples,
            "limits": {"v_max_deg_s": limits[0], "a_max_deg_s2": limits[1], "j_max_deg_s3": limits[2]},
-           "programs": {k: {kk: vv for kk, vv in r.items() if kk != "arrays"} for k, r in results.items()},
+           "programs": {k: feedmod.json_ready(r) for k, r in results.items()},
            "figures": []}
     for axis in range(1, robot.dof + 1):
         name = f"axis{axis}.png"
@@ -294,11 +294,35 @@ def cmd_feed(args) -> None:
                   f"(allowed feed down to {v['allowed_feed']:.4g} rad/s)")
 
 
+def bench_feed(seed: int) -> dict:
+    """The derivative analysis (spline resampling at the paper's 2900/297 samples per pose,
+    derivatives, feed limits, violations and the time-optimal profile) of a smooth synthetic 6-axis
+    joint program of 297 and of 100,000 poses: milliseconds, and per pose."""
+    rng = np.random.default_rng(seed)
+    amp, w, ph = rng.uniform(10, 60, 6), rng.uniform(0.5, 2.0, 6), rng.uniform(0, 6.28, 6)
+    lim = ([80.0] * 6, [160.0] * 6, [1600.0] * 6)
+    out = {}
+    for n in (297, 100_000):
+        t = np.linspace(0, 1, n)[:, None]
+        q = amp * np.sin(w * t * 6.28 + ph)
+        samples = max(feedmod.DEFAULT_SAMPLES, int(round(n * feedmod.DEFAULT_SAMPLES / 297)))
+        feedmod.analyse(q[:50], *lim, samples=500)  # imports warm
+        times = []
+        for _ in range(3 if n < 1000 else 1):
+            t0 = time.perf_counter()
+            feedmod.analyse(q, *lim, samples=samples)
+            times.append(time.perf_counter() - t0)
+        out[f"feed_{n}_poses_ms"] = float(np.median(times)) * 1e3
+        out[f"feed_{n}_poses_us_per_pose"] = float(np.median(times)) * 1e6 / n
+    return out
+
+
 def cmd_bench(args) -> None:
     t0 = time.perf_counter()
     r = _core.run_benchmarks(args.poses, args.seed, args.threads)
     if not args.no_identify:
         r.update(bench_identify(args.identify_poses, args.seed))
+    r.update(bench_feed(args.seed))
     r["bench_seconds"] = time.perf_counter() - t0
     print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
 

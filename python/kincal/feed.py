@@ -95,48 +95,57 @@ def analyse(q_deg: np.ndarray, v_max: Sequence[float], a_max: Sequence[float], j
     if not (feed > 0 and math.isfinite(feed)):
         raise ValueError(f"the feed must be a positive number (rad/s), not {feed}")
     s, qs, d1, d2, d3 = resample(q, samples, method)
-    nv = d1 / v                # eq. 20
-    na1 = d1 / a               # eq. 22 (as printed)
-    nj1 = d1 / j               # eq. 23 (as printed)
-    na2 = d2 / a               # eq. 24
-    nj2 = d2 / j               # eq. 25
-    nj3 = d3 / j               # eq. 26
+    a1, a2, a3 = np.abs(d1), np.abs(d2), np.abs(d3)
+    nv = a1 / v                # |eq. 20|
+    na2 = a2 / a               # |eq. 24|
+    nj3 = a3 / j               # |eq. 26|
+    p1, p2, p3 = a1.max(axis=0), a2.max(axis=0), a3.max(axis=0)  # peaks of eqs. 22, 23, 25 follow
     with np.errstate(divide="ignore"):
-        sv = 1.0 / np.max(np.abs(nv), axis=1)                 # eq. 21
-        sa = np.sqrt(1.0 / np.max(np.abs(na2), axis=1))       # eq. 27
-        sj = np.cbrt(1.0 / np.max(np.abs(nj3), axis=1))       # eq. 28
-        s22 = 1.0 / np.max(np.abs(na1), axis=1)               # eq. 22 as printed
-        s23 = 1.0 / np.max(np.abs(nj1), axis=1)               # eq. 23 as printed
+        sv = 1.0 / nv.max(axis=1)                              # eq. 21
+        sa = np.sqrt(1.0 / na2.max(axis=1))                    # eq. 27
+        sj = np.cbrt(1.0 / nj3.max(axis=1))                    # eq. 28
+        s22 = 1.0 / (a1 / a).max(axis=1)                       # eq. 22 as printed
+        s23 = 1.0 / (a1 / j).max(axis=1)                       # eq. 23 as printed
     violations = []
     for limit, curve, norm in (("velocity", sv, nv), ("acceleration", sa, na2), ("jerk", sj, nj3)):
         for i0, i1 in _runs(feed > curve):
             k = i0 + int(np.argmin(curve[i0:i1 + 1]))
-            violations.append({"axis": int(np.argmax(np.abs(norm[k]))) + 1, "s": float(s[i0]), "s_end": float(s[i1]),
+            violations.append({"axis": int(np.argmax(norm[k])) + 1, "s": float(s[i0]), "s_end": float(s[i1]),
                                "limit": limit, "worst_s": float(s[k]), "allowed_feed": float(curve[k])})
     violations.sort(key=lambda d: (d["s"], d["limit"]))
     # chain rule at the constant feed: axis velocity, acceleration and jerk against the limits
-    const = {"velocity_ratio": (np.max(np.abs(d1), axis=0) * feed / v).tolist(),
-             "acceleration_ratio": (np.max(np.abs(d2), axis=0) * feed ** 2 / a).tolist(),
-             "jerk_ratio": (np.max(np.abs(d3), axis=0) * feed ** 3 / j).tolist()}
+    const = {"velocity_ratio": (p1 * feed / v).tolist(), "acceleration_ratio": (p2 * feed ** 2 / a).tolist(),
+             "jerk_ratio": (p3 * feed ** 3 / j).tolist()}
     out = {
         "method": method, "samples": int(samples), "feed_rad_s": feed,
-        "s_total_rad": float(s[-1]), "s": s.tolist(),
-        "axes": [{"axis": i + 1,
-                  "peak_q_s_v": float(np.max(np.abs(nv[:, i]))), "peak_q_s_a": float(np.max(np.abs(na1[:, i]))),
-                  "peak_q_s_j": float(np.max(np.abs(nj1[:, i]))), "peak_q_ss_a": float(np.max(np.abs(na2[:, i]))),
-                  "peak_q_ss_j": float(np.max(np.abs(nj2[:, i]))), "peak_q_sss_j": float(np.max(np.abs(nj3[:, i])))}
+        "s_total_rad": float(s[-1]), "s": s,
+        "axes": [{"axis": i + 1, "peak_q_s_v": float(p1[i] / v[i]), "peak_q_s_a": float(p1[i] / a[i]),
+                  "peak_q_s_j": float(p1[i] / j[i]), "peak_q_ss_a": float(p2[i] / a[i]),
+                  "peak_q_ss_j": float(p2[i] / j[i]), "peak_q_sss_j": float(p3[i] / j[i])}
                  for i in range(dof)],
-        "sdot_v_max": sv.tolist(), "sdot_a_max": sa.tolist(), "sdot_j_max": sj.tolist(),
-        "paper_eq22_sdot_max": s22.tolist(), "paper_eq23_sdot_max": s23.tolist(),
+        "sdot_v_max": sv, "sdot_a_max": sa, "sdot_j_max": sj,
+        "paper_eq22_sdot_max": s22, "paper_eq23_sdot_max": s23,
         "violations": violations,
         "constant_feed": const,
     }
     if optimal:
         sd, t = time_optimal(s, d1, d2, v, a, cap=sj)
-        out["time_optimal"] = {"time_s": t, "constant_feed_time_s": float(s[-1] / feed),
-                               "sdot": sd.tolist()}
+        out["time_optimal"] = {"time_s": t, "constant_feed_time_s": float(s[-1] / feed), "sdot": sd}
     out["arrays"] = {"s": s, "q": qs, "d1": d1, "d2": d2, "d3": d3, "sv": sv, "sa": sa, "sj": sj}
     return out
+
+
+def json_ready(result: dict) -> dict:
+    """A result of analyse() for feed.json: arrays as lists, the raw arrays left out."""
+    def conv(x):
+        if isinstance(x, np.ndarray):
+            return x.tolist()
+        if isinstance(x, dict):
+            return {k: conv(v) for k, v in x.items() if k != "arrays"}
+        if isinstance(x, list):
+            return [conv(v) for v in x]
+        return x
+    return conv(result)
 
 
 def robot_limits(robot) -> tuple[list, list, list]:

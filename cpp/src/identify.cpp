@@ -76,7 +76,10 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
     throw InputError(source + ":1: column q" + std::to_string(dof + 1) + " but the robot has " +
                      std::to_string(dof) + " joints");
   const int cx = t.require("x"), cy = t.require("y"), cz = t.require("z");
-  const int ctarget = t.find("target"), cpay = t.find("payload_kg");
+  const int ctarget = t.find("target"), cpay = t.find("payload_kg"), ctemp = t.find("temperature_c");
+  std::vector<int> cdir;
+  for (int j = 0; j < dof; ++j) cdir.push_back(t.find("dir" + std::to_string(j + 1)));
+  const bool have_dir = std::all_of(cdir.begin(), cdir.end(), [](int c) { return c >= 0; });
   int max_target = 0;
   for (size_t r = 0; r < t.cells.size(); ++r) {
     Measurement row;
@@ -96,6 +99,15 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
     if (cpay >= 0) {
       row.payload_kg = t.number(r, cpay);
       if (row.payload_kg < 0) throw InputError(t.where(r) + ": column 'payload_kg': negative mass");
+    }
+    if (ctemp >= 0) row.temperature_c = t.number(r, ctemp);
+    if (have_dir) {
+      row.dir.resize(dof);
+      for (int j = 0; j < dof; ++j) {
+        row.dir[j] = t.number(r, cdir[j]);
+        if (row.dir[j] != 1 && row.dir[j] != -1)
+          throw InputError(t.where(r) + ": column 'dir" + std::to_string(j + 1) + "': expected +1 or -1");
+      }
     }
     row.line = t.line[r];
     m.rows.push_back(row);
@@ -122,6 +134,11 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
   bool pay = false;
   for (const auto& r : m.rows) pay = pay || !std::isnan(r.payload_kg);
   if (pay) s += ",payload_kg";
+  const bool dir = !m.rows.empty() && m.rows[0].dir.size() == dof;
+  const bool temp = !m.rows.empty() && !std::isnan(m.rows[0].temperature_c);
+  if (temp) s += ",temperature_c";
+  if (dir)
+    for (int j = 0; j < dof; ++j) s += ",dir" + std::to_string(j + 1);
   s += "\n";
   for (const auto& r : m.rows) {
     s += std::to_string(r.pose);
@@ -129,6 +146,9 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
     for (int k = 0; k < 3; ++k) s += "," + fmt(r.xyz[k]);
     s += "," + std::to_string(r.target);
     if (pay) s += "," + fmt(r.payload_kg);
+    if (temp) s += "," + fmt(r.temperature_c);
+    if (dir)
+      for (int j = 0; j < dof; ++j) s += r.dir[j] > 0 ? ",1" : ",-1";
     s += "\n";
   }
   return s;
@@ -137,6 +157,56 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
 // ---------------------------------------------------------------------------------------------
 // Simulation: every effect of the truth in one place
 // ---------------------------------------------------------------------------------------------
+int Effect::size() const {
+  if (name == "transmission_error") return 4;
+  if (name == "backlash" || name == "thermal_expansion") return 1;
+  throw InputError("unknown effect '" + name + "' (transmission_error, backlash, thermal_expansion)");
+}
+
+std::string Effect::label() const {
+  return joint >= 0 ? name + "(joint " + std::to_string(joint + 1) + ")" : name;
+}
+
+namespace {
+
+/// Joint-angle offsets (rad) of the effects at a row, and the thermal scale factor.
+void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measurement& m, double t_ref, VecQ& dq,
+                    double& scale) {
+  scale = 1.0;
+  for (const Effect& e : eff) {
+    if (e.name == "transmission_error") {
+      const double qj = m.q_deg[e.joint] * kDeg;
+      dq[e.joint] += p[0] * std::sin(qj) + p[1] * std::cos(qj) + p[2] * std::sin(2 * qj) + p[3] * std::cos(2 * qj);
+    } else if (e.name == "backlash") {
+      if (m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
+      dq[e.joint] += p[0] * m.dir[e.joint];
+    } else if (e.name == "thermal_expansion") {
+      if (std::isnan(m.temperature_c)) throw InputError("thermal_expansion needs the temperature_c column");
+      scale *= 1.0 + p[0] * (m.temperature_c - t_ref);
+    }
+    p += e.size();
+  }
+}
+
+}  // namespace
+
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target,
+                    const std::vector<EffectValue>& effects, double t_ref) {
+  std::vector<Effect> eff;
+  std::vector<double> p;
+  for (const auto& ev : effects) {
+    if (static_cast<int>(ev.p.size()) != ev.effect.size()) throw InputError(ev.effect.label() + ": wrong parameter count");
+    eff.push_back(ev.effect);
+    p.insert(p.end(), ev.p.begin(), ev.p.end());
+  }
+  const VecQ q = row.q_deg * kDeg;
+  VecQ dq = VecQ::Zero(q.size());
+  double scale = 1.0;
+  effect_offsets(eff, p.data(), row, t_ref, dq, scale);
+  const Eigen::Isometry3d tool = fk(truth, deflected(truth, q) + dq);
+  return truth.base_in_instrument() * (scale * (tool * target));
+}
+
 Vec3 simulate_point(const Model& truth, const VecQ& q_deg, const Vec3& target) {
   const VecQ q = q_deg * kDeg;
   // joint compliance under gravity (truth masses and payload); later effects plug in here
@@ -161,12 +231,19 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
       const double mid = 0.5 * (js.lower_deg + js.upper_deg), span = js.upper_deg - js.lower_deg;
       q[j] = mid + ud(rng) * span * opt.limit_margin;
     }
+    VecQ dir(n);
+    for (int j = 0; j < n; ++j) dir[j] = u01(rng) < 0.5 ? -1.0 : 1.0;
+    // the temperature drifts through [t_min, t_max] over the campaign (a warm-up, then noise)
+    const double frac = opt.poses > 1 ? static_cast<double>(p) / (opt.poses - 1) : 0.0;
+    const double temp = opt.t_min + (opt.t_max - opt.t_min) * std::sqrt(frac) + 0.3 * nd(rng);
     for (int t = 0; t < m.n_targets; ++t) {
       Measurement row;
       row.pose = p;
       row.q_deg = q;
+      row.dir = dir;
+      row.temperature_c = temp;
       row.target = t;
-      row.xyz = simulate_point(truth, q, opt.targets[t]);
+      row.xyz = simulate_point(truth, row, opt.targets[t], opt.effects, opt.t_ref);
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
       if (opt.outlier_fraction > 0 && u01(rng) < opt.outlier_fraction)
         row.xyz += Vec3(nd(rng), nd(rng), nd(rng)).normalized() * opt.outlier_mm;
@@ -179,7 +256,8 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
 // ---------------------------------------------------------------------------------------------
 // Parameter layout and the measurement model
 // ---------------------------------------------------------------------------------------------
-ParamLayout::ParamLayout(const Model& nominal, int nt) : dof(nominal.dof()), n_targets(nt) {
+ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr)
+    : dof(nominal.dof()), n_targets(nt), effect_list(eff), t_ref(tr) {
   for (int j = 0; j < dof; ++j)
     if (nominal.gravity_loaded(j)) loaded.push_back(j);
   joints = 0;
@@ -187,7 +265,14 @@ ParamLayout::ParamLayout(const Model& nominal, int nt) : dof(nominal.dof()), n_t
   tool = compliance + static_cast<int>(loaded.size());
   base = tool + 6;
   targets = base + 6;
-  size = targets + 3 * n_targets;
+  effects = targets + 3 * n_targets;
+  size = effects;
+  for (const Effect& e : effect_list) {
+    if (e.name != "thermal_expansion" && (e.joint < 0 || e.joint >= dof))
+      throw InputError(e.name + ": joint " + std::to_string(e.joint + 1) + " is not one of 1.." + std::to_string(dof));
+    effect_offset.push_back(size);
+    size += e.size();
+  }
   for (int j = 0; j < dof; ++j) {
     const std::string p = "joint" + std::to_string(j + 1);
     for (const char* s : {".tilt_u", ".tilt_v"}) names.push_back(p + s), units.push_back("rad");
@@ -200,9 +285,19 @@ ParamLayout::ParamLayout(const Model& nominal, int nt) : dof(nominal.dof()), n_t
   }
   for (int t = 0; t < n_targets; ++t)
     for (const char* s : {".x", ".y", ".z"}) names.push_back("target" + std::to_string(t) + s), units.push_back("mm");
+  for (const Effect& e : effect_list) {
+    const std::string p = e.joint >= 0 ? "joint" + std::to_string(e.joint + 1) + "." : "";
+    if (e.name == "transmission_error")
+      for (const char* s : {"te_sin1", "te_cos1", "te_sin2", "te_cos2"}) names.push_back(p + s), units.push_back("rad");
+    else if (e.name == "backlash")
+      names.push_back(p + "backlash"), units.push_back("rad");
+    else
+      names.push_back("thermal_expansion"), units.push_back("1/degC");
+  }
 }
 
-PointModel::PointModel(const Model& nominal, int n_targets) : nominal_(nominal), layout_(nominal, n_targets) {
+PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects, double t_ref)
+    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref) {
   const int n = nominal.dof();
   for (int j = 0; j < n; ++j) {
     const Vec3 w = nominal.axis(j);
@@ -400,10 +495,17 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
     gravity_state(model, m, gs);
     for (int j = 0; j < n; ++j) qe[j] += model.compliance(j) * gs.tau[j];
   }
+  double scale = 1.0;
+  const bool effects = !layout_.effect_list.empty();
+  if (effects) {
+    VecQ dq = VecQ::Zero(n);
+    effect_offsets(layout_.effect_list, &x_[layout_.effects], m, layout_.t_ref, dq, scale);
+    qe += dq;
+  }
   // G_j = exp(xi_1 qe_1) ... exp(xi_j qe_j), G_0 = identity
   std::array<Mat3, kMaxJoints + 1> gr;
   std::array<Vec3, kMaxJoints + 1> gt;
-  if (torque && !model.has_compliance()) {
+  if (torque && !model.has_compliance() && !effects) {
     gr = gs.gr;
     gt = gs.gt;
   } else {
@@ -413,7 +515,8 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
                  x_[layout_.targets + 3 * m.target + 2]);
   const Vec3 x0 = rm_ * tkv + tm_;
   const Mat3& rn = gr[n];
-  const Vec3 x = rn * x0 + gt[n];
+  const Vec3 xr = rn * x0 + gt[n];  // the point of the unscaled robot
+  const Vec3 x = scale * xr;
   const Vec3 y = rb_ * x + tb_;
   if (!jac) return y;
   const int P = layout_.size;
@@ -422,11 +525,11 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
   const Mat3 rbn = rb_ * rn;
   J.block<3, 3>(0, layout_.base) = Mat3::Identity();
   J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
-  J.block<3, 3>(0, layout_.targets + 3 * m.target) = rbn * rm_;
+  J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
   if (frames_only_) return y;
   // x in the frames G_j: xl_j = G_j^-1 x
   std::array<Vec3, kMaxJoints + 1> xl;
-  for (int j = 0; j <= n; ++j) xl[j] = gr[j].transpose() * (x - gt[j]);
+  for (int j = 0; j <= n; ++j) xl[j] = gr[j].transpose() * (xr - gt[j]);
   for (int j = 0; j < n; ++j) {
     const Vec3 wraw = nominal_.axis(j) + x_[4 * j] * u_[j] + x_[4 * j + 1] * v_[j];
     const double nn = wraw.norm();
@@ -451,6 +554,26 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
   J.block<3, 3>(0, layout_.tool) = rbn;
   J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * skew(tkv) * jrm_;
   if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, J.data());
+  for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
+    const Effect& ef = layout_.effect_list[e];
+    const int c = layout_.effect_offset[e];
+    if (ef.name == "transmission_error") {
+      const double qj = q[ef.joint];
+      const double b[4] = {std::sin(qj), std::cos(qj), std::sin(2 * qj), std::cos(2 * qj)};
+      for (int k = 0; k < 4; ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
+    } else if (ef.name == "backlash") {
+      J.col(c) = rb_ * jp[ef.joint] * m.dir[ef.joint];
+    } else {
+      J.col(c) = rb_ * xr * (m.temperature_c - layout_.t_ref);
+    }
+  }
+  if (scale != 1.0) {
+    // every column through the robot's point scales with it (not the base's, not thermal's own)
+    J.leftCols(layout_.base) *= scale;
+    for (size_t e = 0; e < layout_.effect_list.size(); ++e)
+      if (layout_.effect_list[e].name != "thermal_expansion")
+        J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
+  }
   return y;
 }
 
@@ -479,6 +602,11 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
 }
 
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data) {
+  return point_errors(model, targets, data, {}, 20.0);
+}
+
+std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
+                                 const std::vector<EffectValue>& effects, double t_ref) {
   std::vector<double> e;
   e.reserve(data.rows.size());
   std::map<double, std::shared_ptr<const Model>> variants;
@@ -494,7 +622,7 @@ std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& ta
       m = v.get();
     }
     const Vec3 t = r.target < static_cast<int>(targets.size()) ? targets[r.target] : Vec3::Zero();
-    e.push_back((simulate_point(*m, r.q_deg, t) - r.xyz).norm());
+    e.push_back((simulate_point(*m, r, t, effects, t_ref) - r.xyz).norm());
   }
   return e;
 }
@@ -656,10 +784,31 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     if (r.q_deg.size() != nominal.dof())
       throw InputError(data.source + ":" + std::to_string(r.line) + ": " + std::to_string(r.q_deg.size()) +
                        " joint angles but the robot has " + std::to_string(nominal.dof()));
-  IdentifyResult res(ParamLayout(nominal, data.n_targets));
+  double t_ref = 20.0;
+  bool thermal = false;
+  for (const Effect& e : opt.effects) {
+    e.size();  // a known name
+    if (e.name == "thermal_expansion") thermal = true;
+  }
+  if (thermal) {
+    double sum = 0;
+    for (const auto& r : data.rows) {
+      if (std::isnan(r.temperature_c))
+        throw InputError(data.source + ":" + std::to_string(r.line) + ": thermal_expansion needs the temperature_c column");
+      sum += r.temperature_c;
+    }
+    t_ref = sum / data.rows.size();
+  }
+  for (const Effect& e : opt.effects)
+    if (e.name == "backlash")
+      for (const auto& r : data.rows)
+        if (r.dir.size() != nominal.dof())
+          throw InputError(data.source + ":" + std::to_string(r.line) + ": backlash needs the dir1..dir" +
+                           std::to_string(nominal.dof()) + " columns");
+  IdentifyResult res(ParamLayout(nominal, data.n_targets, opt.effects, t_ref));
   const ParamLayout& L = res.layout;
   const int P = L.size;
-  PointModel pm(nominal, data.n_targets);
+  PointModel pm(nominal, data.n_targets, opt.effects, t_ref);
   pm.prepare_payloads(data);
   res.start = pm.start(data);
   std::vector<double> x = res.start;
@@ -672,6 +821,13 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
       for (int k = 0; k < 3; ++k) res.fixed[L.targets + 3 * t + k] = true, res.fixed_reason[L.targets + 3 * t + k] = "target never measured";
   if (!opt.compliance)
     for (int i = L.compliance; i < L.tool; ++i) res.fixed[i] = true, res.fixed_reason[i] = "not asked for (--effects)";
+  else if (!opt.compliance_joints.empty())
+    for (size_t i = 0; i < L.loaded.size(); ++i)
+      if (std::find(opt.compliance_joints.begin(), opt.compliance_joints.end(), L.loaded[i]) == opt.compliance_joints.end()) {
+        const int k = L.compliance + static_cast<int>(i);
+        res.fixed[k] = true;
+        res.fixed_reason[k] = "not in the model";
+      }
   // a compliance is only identifiable where gravity loads its joint: below min_torque_share of the
   // largest joint's torque over the measured poses it is held (its effect is lost in the geometry)
   if (opt.compliance && !L.loaded.empty()) {
@@ -706,7 +862,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // start where the targets are where they are, so that the analysis below sees the real geometry)
   {
     std::vector<int> frames;
-    for (int i = L.base; i < P; ++i)
+    for (int i = L.base; i < L.effects; ++i)
       if (i < L.targets || !res.fixed[i]) frames.push_back(i);
     ceres::Solver::Summary s1;
     AllRows all1(pm, data, x, frames);
@@ -735,8 +891,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // determines but the data do not means the data are too few or too alike ---
   {
     std::vector<int> order;
-    for (int i = L.targets; i < P; ++i) order.push_back(i);
+    for (int i = L.targets; i < L.effects; ++i) order.push_back(i);
     for (int i = L.compliance; i < L.tool; ++i) order.push_back(i);
+    for (int i = L.effects; i < P; ++i) order.push_back(i);
     for (int j = 1; j < L.dof; ++j)
       for (int k = 0; k < 4; ++k) order.push_back(4 * j + k);
     for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
@@ -797,6 +954,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
         const JointSpec& js = nominal.spec().joints[j];
         row.q_deg[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg);
       }
+      row.dir.resize(L.dof);
+      for (int j = 0; j < L.dof; ++j) row.dir[j] = ud(rng) < 0 ? -1.0 : 1.0;
+      row.temperature_c = data.rows[rng() % data.rows.size()].temperature_c;
       for (int t = 0; t < data.n_targets; ++t)
         if (targets_used[t]) row.target = t, generic.rows.push_back(row);
     }
@@ -837,9 +997,13 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   res.calibrated.name = nominal.spec().name + "-calibrated";
   for (int t = 0; t < data.n_targets; ++t)
     res.targets.emplace_back(x[L.targets + 3 * t], x[L.targets + 3 * t + 1], x[L.targets + 3 * t + 2]);
+  res.t_ref = t_ref;
+  for (size_t e = 0; e < L.effect_list.size(); ++e)
+    res.effects.push_back({L.effect_list[e], std::vector<double>(x.begin() + L.effect_offset[e],
+                                                                 x.begin() + L.effect_offset[e] + L.effect_list[e].size())});
   {
     const Model cal(res.calibrated);
-    const std::vector<double> e = point_errors(cal, res.targets, data);
+    const std::vector<double> e = point_errors(cal, res.targets, data, res.effects, t_ref);
     double ss = 0;
     for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
     res.rms_mm = std::sqrt(ss / e.size());

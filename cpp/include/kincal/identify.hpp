@@ -23,14 +23,34 @@
 #include <array>
 #include <functional>
 #include <limits>
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace kincal {
 
+/// A non-geometric effect of the measurement model (names of the contract), on one joint or none.
+///   transmission_error: dq_j = p0 sin q_j + p1 cos q_j + p2 sin 2q_j + p3 cos 2q_j (rad)
+///   backlash:           dq_j = p0 dir_j (rad; dir_j = +-1, the sign of the last motion into the pose)
+///   thermal_expansion:  the robot's lengths scale by 1 + p0 (T - t_ref) (p0 per deg C)
+/// (joint_compliance is built in: IdentifyOptions::compliance.)
+struct Effect {
+  std::string name;
+  int joint = -1;  ///< 0-based; -1 for thermal_expansion
+  int size() const;
+  std::string label() const;  ///< e.g. "transmission_error(joint 3)"
+};
+/// An effect with the values of its parameters (a simulation truth).
+struct EffectValue {
+  Effect effect;
+  std::vector<double> p;
+};
+
 struct Measurement {
   int pose = 0;
   VecQ q_deg;
+  VecQ dir;                  ///< sign of the last motion of each joint (empty: unknown)
+  double temperature_c = std::numeric_limits<double>::quiet_NaN();
   Vec3 xyz = Vec3::Zero();   ///< measured point, instrument frame (mm)
   int target = 0;
   double payload_kg = std::numeric_limits<double>::quiet_NaN();  ///< NaN: the model's payload
@@ -57,27 +77,36 @@ struct SimulationOptions {
   double outlier_mm = 5.0;         ///< size of a gross error
   std::vector<Vec3> targets = {Vec3::Zero()};  ///< target offsets in the tool frame (mm)
   double limit_margin = 0.9;       ///< poses drawn in this share of every joint's range
+  std::vector<EffectValue> effects;  ///< effects hidden in the truth (besides its compliance)
+  double t_ref = 20.0;             ///< reference temperature of thermal_expansion
+  double t_min = 18.0, t_max = 30.0;  ///< the temperature drifts through this range over the campaign
 };
 
 /// The point of target t (tool frame) in the instrument frame for commanded joint angles (deg) on a
 /// truth model (compliance and payload included), without noise.
 Vec3 simulate_point(const Model& truth, const VecQ& q_deg, const Vec3& target);
+/// The same with effects acting on the row (its dir and temperature).
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target,
+                    const std::vector<EffectValue>& effects, double t_ref);
 MeasurementSet simulate(const Model& truth, const SimulationOptions& opt);
 
 /// Layout of the identification parameter vector for a model and a number of targets.
 struct ParamLayout {
   int dof = 0, n_targets = 0;
-  int joints = 0, compliance = 0, tool = 0, base = 0, targets = 0, size = 0;
+  int joints = 0, compliance = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
   std::vector<int> loaded;            ///< joint of every compliance parameter
+  std::vector<Effect> effect_list;    ///< extra effects, their parameters from `effects` on
+  std::vector<int> effect_offset;
+  double t_ref = 20.0;
   std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry"
   std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm"
-  ParamLayout(const Model& nominal, int n_targets);
+  ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0);
 };
 
 /// Evaluates the measurement model and its analytic Jacobian for one parameter vector.
 class PointModel {
  public:
-  PointModel(const Model& nominal, int n_targets);
+  PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0);
   const ParamLayout& layout() const { return layout_; }
   /// Set the parameters (size layout().size); builds the current model.
   void set_params(const std::vector<double>& x);
@@ -133,6 +162,8 @@ struct IdentifyOptions {
   double correlation_threshold = 0.95;
   bool covariance = true;          ///< parameter standard deviations and correlations (Ceres covariance)
   std::vector<std::string> fix;    ///< parameter names to hold in any case
+  std::vector<int> compliance_joints;  ///< with compliance: only these joints (0-based; empty: all)
+  std::vector<Effect> effects;     ///< extra effects identified with the rest
   std::function<void(int iteration, double cost)> progress;
 };
 
@@ -148,6 +179,8 @@ struct IdentifyResult {
   std::vector<std::string> fixed_reason;
   ModelSpec calibrated;
   std::vector<Vec3> targets;
+  std::vector<EffectValue> effects;       ///< identified values of the extra effects
+  double t_ref = 20.0;                    ///< reference temperature of thermal_expansion
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
   double rms_mm = 0, max_mm = 0;          ///< on the fitted rows
@@ -166,5 +199,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
 
 /// Position errors (mm) of every row of data predicted by a calibrated spec with the given targets.
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data);
+/// The same with identified effects (values and the reference temperature of thermal_expansion).
+std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
+                                 const std::vector<EffectValue>& effects, double t_ref);
 
 }  // namespace kincal

@@ -3,6 +3,8 @@
 // for the model's payload), line (n: source line, 0 when simulated).
 #include "common.hpp"
 
+#include <tuple>
+
 #include "kincal/identify.hpp"
 #include "kincal/model.hpp"
 
@@ -16,8 +18,12 @@ py::dict to_dict(const MeasurementSet& m, int dof) {
   const size_t n = m.rows.size();
   Eigen::VectorXi pose(n), target(n), line(n);
   RowMat q(n, dof), xyz(n, 3);
-  Eigen::VectorXd pay(n);
+  Eigen::VectorXd pay(n), temp(n);
+  const bool dir = n > 0 && m.rows[0].dir.size() == dof;
+  RowMat dirs(dir ? n : 0, dof);
   for (size_t i = 0; i < n; ++i) {
+    temp[i] = m.rows[i].temperature_c;
+    if (dir) dirs.row(i) = m.rows[i].dir.transpose();
     const Measurement& r = m.rows[i];
     pose[i] = r.pose;
     target[i] = r.target;
@@ -34,6 +40,8 @@ py::dict to_dict(const MeasurementSet& m, int dof) {
   d["payload_kg"] = pay;
   d["line"] = line;
   d["source"] = m.source;
+  if (!std::isnan(temp.sum())) d["temperature_c"] = temp;
+  if (dir) d["dir"] = dirs;
   return d;
 }
 
@@ -69,8 +77,48 @@ MeasurementSet from_dict(const py::dict& d, int dof) {
     nt = std::max(nt, r.target + 1);
     m.rows.push_back(r);
   }
+  if (d.contains("temperature_c")) {
+    const auto t = d["temperature_c"].cast<Eigen::VectorXd>();
+    if (static_cast<size_t>(t.size()) != n) throw InputError(m.source + ": temperature_c of a different length");
+    for (size_t i = 0; i < n; ++i) m.rows[i].temperature_c = t[i];
+  }
+  if (d.contains("dir")) {
+    const auto dd = d["dir"].cast<RowMat>();
+    if (static_cast<size_t>(dd.rows()) != n || dd.cols() != dof) throw InputError(m.source + ": dir of a different shape");
+    for (size_t i = 0; i < n; ++i) m.rows[i].dir = dd.row(i).transpose();
+  }
   m.n_targets = nt;
   return m;
+}
+
+/// ("name", joint from 1 or 0 for none) pairs
+std::vector<Effect> effects_from(const std::vector<std::pair<std::string, int>>& e) {
+  std::vector<Effect> out;
+  for (const auto& p : e) {
+    Effect ef{p.first, p.second - 1};
+    ef.size();
+    out.push_back(ef);
+  }
+  return out;
+}
+
+std::vector<EffectValue> effect_values_from(const std::vector<std::tuple<std::string, int, std::vector<double>>>& e) {
+  std::vector<EffectValue> out;
+  for (const auto& [name, joint, p] : e) {
+    EffectValue v;
+    v.effect = Effect{name, joint - 1};
+    if (static_cast<int>(p.size()) != v.effect.size())
+      throw InputError(v.effect.label() + ": " + std::to_string(v.effect.size()) + " values needed");
+    v.p = p;
+    out.push_back(v);
+  }
+  return out;
+}
+
+py::list effect_values_to(const std::vector<EffectValue>& e) {
+  py::list l;
+  for (const auto& v : e) l.append(py::make_tuple(v.effect.name, v.effect.joint + 1, v.p));
+  return l;
 }
 
 std::vector<Vec3> targets_from(const RowMat& t) {
@@ -98,8 +146,11 @@ void define_identify(py::module_& m) {
   m.def(
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
-         const RowMat& targets, double limit_margin) {
+         const RowMat& targets, double limit_margin,
+         const std::vector<std::tuple<std::string, int, std::vector<double>>>& effects, double t_ref) {
         SimulationOptions o;
+        o.effects = effect_values_from(effects);
+        o.t_ref = t_ref;
         o.poses = poses;
         o.seed = seed;
         o.noise_mm = noise_mm;
@@ -111,19 +162,24 @@ void define_identify(py::module_& m) {
       },
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
+      py::arg("effects") = std::vector<std::tuple<std::string, int, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
       "A measurement campaign on the calibrated (true) model of a robot");
   m.def(
       "point_errors",
-      [](const Robot& r, const RowMat& targets, const py::dict& d) {
-        const auto e = point_errors(*r.calibrated, targets_from(targets), from_dict(d, r.calibrated->dof()));
+      [](const Robot& r, const RowMat& targets, const py::dict& d,
+         const std::vector<std::tuple<std::string, int, std::vector<double>>>& effects, double t_ref) {
+        const auto e = point_errors(*r.calibrated, targets_from(targets), from_dict(d, r.calibrated->dof()),
+                                    effect_values_from(effects), t_ref);
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("targets"), py::arg("data"),
+      py::arg("effects") = std::vector<std::tuple<std::string, int, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
       "Distance (mm) between every measured point and the calibrated model's prediction");
   m.def(
       "identify",
       [](const Robot& robot, const py::dict& d, bool compliance, const std::string& loss, double loss_scale_mm,
-         int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated, bool covariance) {
+         int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated, bool covariance,
+         const std::vector<std::pair<std::string, int>>& effects, const std::vector<int>& compliance_joints) {
         const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
         const MeasurementSet data = from_dict(d, nominal.dof());
         IdentifyOptions o;
@@ -133,6 +189,8 @@ void define_identify(py::module_& m) {
         o.max_iterations = max_iterations;
         o.fix = fix;
         o.covariance = covariance;
+        o.effects = effects_from(effects);
+        for (int j : compliance_joints) o.compliance_joints.push_back(j - 1);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
         const IdentifyResult r = identify(nominal, data, o);
         py::dict out;
@@ -164,17 +222,24 @@ void define_identify(py::module_& m) {
         out["correlations"] = corr;
         out["termination"] = r.termination;
         out["compliance_joints"] = r.layout.loaded;
+        out["effects"] = effect_values_to(r.effects);
+        out["t_ref"] = r.t_ref;
         return out;
       },
       py::arg("robot"), py::arg("data"), py::arg("compliance") = true, py::arg("loss") = "huber",
       py::arg("loss_scale_mm") = 0.1, py::arg("max_iterations") = 100, py::arg("fix") = std::vector<std::string>{},
       py::arg("progress") = py::none(), py::arg("from_calibrated") = false, py::arg("covariance") = true,
+      py::arg("effects") = std::vector<std::pair<std::string, int>>{}, py::arg("compliance_joints") = std::vector<int>{},
       "Identify from measurements, starting from the nominal model (or from the calibrated one: then\n"
       "the parameters are corrections to it, e.g. to refit only the base frame and targets)");
 
   py::class_<PointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
-      .def(py::init([](const Robot& r, int n_targets) { return new PointModel(*r.nominal, n_targets); }),
-           py::arg("robot"), py::arg("n_targets"), py::keep_alive<1, 2>())
+      .def(py::init([](const Robot& r, int n_targets, const std::vector<std::pair<std::string, int>>& effects,
+                       double t_ref, bool from_calibrated) {
+             return new PointModel(from_calibrated ? *r.calibrated : *r.nominal, n_targets, effects_from(effects), t_ref);
+           }),
+           py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<std::pair<std::string, int>>{},
+           py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::keep_alive<1, 2>())
       .def_property_readonly("names", [](const PointModel& p) { return p.layout().names; })
       .def("start", [](const PointModel& p, const py::dict& d) { return p.start(from_dict(d, p.layout().dof)); })
       .def(

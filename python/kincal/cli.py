@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -13,6 +14,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core, compensate, fk, ik, line_program, load_robot
+from . import diagnose as diagnosis
 from . import feed as feedmod
 from . import fivebar
 from . import identify as ident
@@ -124,6 +126,30 @@ def _progress(label: str):
     return report
 
 
+def _hidden_effect(text: str, dof: int) -> tuple:
+    """NAME:JOINT:V1,V2.. of --hide: transmission_error and backlash values in degrees,
+    thermal_expansion in 1/C (joint 0)."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
+    name, joint, vals = parts[0], parts[1], parts[2]
+    n = {"transmission_error": 4, "backlash": 1, "thermal_expansion": 1}.get(name)
+    if n is None:
+        raise ValueError(f"--hide {text}: unknown effect '{name}' (transmission_error, backlash, thermal_expansion)")
+    try:
+        j = int(joint)
+        v = [float(x) for x in vals.split(",")]
+    except ValueError:
+        raise ValueError(f"--hide {text}: joint and values must be numbers") from None
+    if len(v) != n or not all(math.isfinite(x) for x in v):
+        raise ValueError(f"--hide {text}: {name} takes {n} finite value(s)")
+    if name != "thermal_expansion":
+        if not 1 <= j <= dof:
+            raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
+        v = [math.radians(x) for x in v]
+    return name, (j if name != "thermal_expansion" else 0), v
+
+
 def cmd_simulate(args) -> None:
     robot = _robot(args)
     if args.truth:
@@ -135,7 +161,8 @@ def cmd_simulate(args) -> None:
         if args.truth_out:
             _core.write_file_atomic(args.truth_out, truth.to_json())
     data = ident.simulate(truth, args.poses, seed=args.seed, noise_mm=args.noise, targets=args.targets,
-                          outlier_fraction=args.outliers, outlier_mm=args.outlier_mm)
+                          outlier_fraction=args.outliers, outlier_mm=args.outlier_mm,
+                          effects=[_hidden_effect(h, robot.dof) for h in args.hide])
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
@@ -317,6 +344,25 @@ def bench_feed(seed: int) -> dict:
     return out
 
 
+def cmd_diagnose(args) -> None:
+    robot = _robot(args)
+    data = ident.read_measurements(args.data, robot)
+    t0 = time.perf_counter()
+    diag = diagnosis.diagnose(robot, data, folds=args.folds, seed=args.seed,
+                              progress=lambda s: print(s, file=sys.stderr, flush=True))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    diagnosis.write_report(robot, data, diag, out, title=f"kincal diagnose: {Path(args.data).name}")
+    _core.write_file_atomic(str(out / "diagnosis.json"), json.dumps(diagnosis.contract_json(diag), indent=1) + "\n")
+    for st in diag["steps"]:
+        j = f" joint {st['joint']}" if st["joint"] else ""
+        print(f"{st['effect']}{j}: cross-validated RMS {st['rms_before_mm'] * 1000:.1f} -> "
+              f"{st['rms_after_mm'] * 1000:.1f} um (F = {st['evidence']['F']:.3g})")
+    print(f"final cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um, noise estimate "
+          f"{diag['noise_rms_mm'] * 1000:.1f} um: {diag['verdict']} ({time.perf_counter() - t0:.1f} s); "
+          f"report: {out / 'report.html'}")
+
+
 def cmd_bench(args) -> None:
     t0 = time.perf_counter()
     r = _core.run_benchmarks(args.poses, args.seed, args.threads)
@@ -426,6 +472,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--noise", type=float, default=0.02, help="instrument noise per coordinate (mm)")
     sp.add_argument("--outliers", type=float, default=0.0, help="share of points with a gross error")
     sp.add_argument("--outlier-mm", type=float, default=5.0, help="size of a gross error (mm)")
+    sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
+                    help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg), backlash:J:b (deg per "
+                         "direction sign), thermal_expansion:0:alpha (1/C, about 20 C); repeatable")
     sp.add_argument("--seed", type=int, default=1)
     sp.set_defaults(func=cmd_simulate)
 
@@ -455,6 +504,14 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--samples", type=int, default=feedmod.DEFAULT_SAMPLES, help="resampled points along s")
     sp.add_argument("--out", required=True, help="folder for feed.json and the figures")
     sp.set_defaults(func=cmd_feed)
+
+    sp = sub.add_parser("diagnose", help="find the effect a model misses, add it, show the gap shrink")
+    robot_opts(sp)
+    sp.add_argument("--data", required=True, help="measurement CSV (with dir1..dirN, temperature_c when present)")
+    sp.add_argument("--out", required=True, help="folder for diagnosis.json, report.html and figures")
+    sp.add_argument("--folds", type=int, default=5, help="folds of poses for the cross-validation")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
+    sp.set_defaults(func=cmd_diagnose)
 
     hr = sub.add_parser("hidden-robot", help="five-bar hidden-robot calibration (the Kiper paper)")
     hsub = hr.add_subparsers(dest="hr_command", required=True)

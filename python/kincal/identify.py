@@ -34,9 +34,14 @@ def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg:
 
 
 def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
-             outlier_fraction: float = 0.0, outlier_mm: float = 5.0) -> dict:
+             outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence = (),
+             t_ref: float = 20.0) -> dict:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
-    model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers."""
+    model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
+    ``effects`` hides more effects in the truth: (name, joint from 1 or 0, values) with the values in
+    radians (transmission_error: sin q, cos q, sin 2q, cos 2q amplitudes; backlash: offset per
+    direction sign) or per degree C (thermal_expansion, about t_ref). Every row gets dir1..dirN and
+    temperature_c (drifting from 18 to 30 C over the campaign)."""
     if poses < 1:
         raise ValueError(f"the number of poses must be positive, not {poses}")
     if not 1 <= targets <= len(DEFAULT_TARGETS):
@@ -45,7 +50,8 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
         raise ValueError(f"the noise must be a finite non-negative number, not {noise_mm}")
     if not 0.0 <= outlier_fraction <= 1.0:
         raise ValueError(f"the outlier fraction must be in 0..1, not {outlier_fraction}")
-    return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets])
+    return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets], 0.9,
+                          [(str(n), int(j), [float(v) for v in vals]) for n, j, vals in effects], t_ref)
 
 
 def read_measurements(path: str, robot: Robot) -> dict:

@@ -25,6 +25,7 @@ def main() -> None:
                                                   "ipa-robot-accuracy"))
     p.add_argument("--fit", default="B", choices=sorted(SERIES))
     p.add_argument("--effects", default="joint_compliance")
+    p.add_argument("--diagnose", metavar="DIR", help="also run the diagnosis on the fit series, report in DIR")
     args = p.parse_args()
     robot = kincal.load_robot("ur10")
     data = {k: datasets.read_ipa(Path(args.data) / v) for k, v in SERIES.items()}
@@ -42,6 +43,18 @@ def main() -> None:
         r = ident.validate(res.robot, data[k])
         print(f"{k + ' (frames refitted)':<34}{r['rows']:>8}{r['before_rms_mm']:>12.3f}{r['after_rms_mm']:>12.3f}"
               f"{r['before_max_mm']:>12.3f}{r['after_max_mm']:>12.3f}")
+    if args.diagnose:
+        import json
+        from kincal import diagnose as dg
+        out = Path(args.diagnose)
+        out.mkdir(parents=True, exist_ok=True)
+        d = dg.diagnose(robot, data[args.fit], progress=print)
+        dg.write_report(robot, data[args.fit], d, out, title=f"kincal diagnose: UR10 series {args.fit}")
+        (out / "diagnosis.json").write_text(json.dumps(dg.contract_json(d), indent=1))
+        for st in d["steps"]:
+            print(f"  {st['effect']} joint {st['joint']}: {st['rms_before_mm']:.3f} -> {st['rms_after_mm']:.3f} mm "
+                  f"(F = {st['evidence']['F']:.3g}, p = {st['evidence']['p_value']:.2g})")
+        print(f"  {d['verdict']}")
 
 
 if __name__ == "__main__":

@@ -348,7 +348,7 @@ def cmd_diagnose(args) -> None:
     robot = _robot(args)
     data = ident.read_measurements(args.data, robot)
     t0 = time.perf_counter()
-    diag = diagnosis.diagnose(robot, data, folds=args.folds, seed=args.seed,
+    diag = diagnosis.diagnose(robot, data, folds=args.folds, seed=args.seed, noise_mm=args.noise,
                               progress=lambda s: print(s, file=sys.stderr, flush=True))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -363,12 +363,25 @@ def cmd_diagnose(args) -> None:
           f"report: {out / 'report.html'}")
 
 
+def bench_diagnose(seed: int) -> dict:
+    """kincal diagnose on 500 simulated kr500 poses (one reflector; truth: default_truth with a
+    hidden backlash on joint 2), every candidate on every joint, 5 folds: seconds."""
+    robot = load_robot("kr500")
+    data = ident.simulate(ident.default_truth(robot, seed=seed), 500, seed=seed, targets=1,
+                          effects=[("backlash", 2, [math.radians(0.01)])])
+    t0 = time.perf_counter()
+    d = diagnosis.diagnose(robot, data)
+    return {"diagnose_500_poses_s": time.perf_counter() - t0, "diagnose_500_poses_steps": len(d["steps"])}
+
+
 def cmd_bench(args) -> None:
     t0 = time.perf_counter()
     r = _core.run_benchmarks(args.poses, args.seed, args.threads)
     if not args.no_identify:
         r.update(bench_identify(args.identify_poses, args.seed))
     r.update(bench_feed(args.seed))
+    if not args.no_identify:
+        r.update(bench_diagnose(args.seed))
     r["bench_seconds"] = time.perf_counter() - t0
     print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
 
@@ -511,6 +524,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", required=True, help="folder for diagnosis.json, report.html and figures")
     sp.add_argument("--folds", type=int, default=5, help="folds of poses for the cross-validation")
     sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
+    sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
     sp.set_defaults(func=cmd_diagnose)
 
     hr = sub.add_parser("hidden-robot", help="five-bar hidden-robot calibration (the Kiper paper)")

@@ -152,8 +152,14 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, pose_rows: np.ndarray, f
 
 
 def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03,
-             max_steps: int = 6, seed: int = 0, progress: Optional[Callable[[str], None]] = None) -> dict:
-    """The workflow; returns the diagnosis.json of the contract (plus details for the report)."""
+             max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
+             progress: Optional[Callable[[str], None]] = None) -> dict:
+    """The workflow; returns the diagnosis.json of the contract (plus details for the report).
+
+    noise_rms_mm: with ``noise_mm`` (the instrument's noise per coordinate, if known) its RMS per
+    point; otherwise the final fit's own scatter, an upper bound of the noise. The verdict says "at
+    the noise level" when the cross-validated RMS is within 1.3 times the known noise, or, with the
+    noise unknown, when no candidate is even significant."""
     say = progress or (lambda s: None)
     cands, notes = candidates(robot, data)
     fold_masks = ident.folds(data, folds, seed)
@@ -204,12 +210,24 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
     final = spec.fit(robot, data)
     e = spec.errors(final, data)
     n_res, n_par = 3 * len(e), int(np.sum(~np.asarray(final["fixed"])))
-    noise = math.sqrt(float(np.sum(e ** 2)) / max(1, n_res - n_par)) * math.sqrt(3.0)
-    verdict = ("what remains is at the noise level" if cur <= 1.2 * noise else
-               "what remains is structured but not explained by the library")
+    scatter = math.sqrt(float(np.sum(e ** 2)) / max(1, n_res - n_par)) * math.sqrt(3.0)
+    left = [s for s in history[-1].get("candidates", []) if s["p_value"] < alpha]
+    if noise_mm is not None:
+        noise = noise_mm * math.sqrt(3.0)
+        at_noise = cur <= 1.3 * noise
+    else:
+        noise = scatter  # an upper bound of the instrument noise: the fit's own scatter
+        at_noise = not left
+    if at_noise:
+        verdict = "what remains is at the noise level"
+    else:
+        best = ", ".join(f"{_effect_name((s['effect'], s['joint'] or 0))} {s['cv_gain']:.1%}" for s in left[:3])
+        verdict = ("what remains is structured but not explained by the library"
+                   + (f" (significant candidates gain too little: {best})" if left else ""))
     say(f"{len(steps)} effect(s) named; cross-validated RMS {cur * 1000:.1f} um, noise estimate "
         f"{noise * 1000:.1f} um: {verdict}")
-    return {"steps": steps, "final_rms_mm": cur, "noise_rms_mm": noise, "verdict": verdict, "notes": notes,
+    return {"steps": steps, "final_rms_mm": cur, "noise_rms_mm": noise, "noise_known": noise_mm is not None,
+            "fit_scatter_mm": scatter, "verdict": verdict, "notes": notes,
             "history": history, "folds": folds,
             "final_model": {"compliance_joints": spec.compliance, "effects": [list(x) for x in spec.effects]},
             "_final_fit": final, "_spec": spec}

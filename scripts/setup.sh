@@ -5,7 +5,7 @@ set -eu
 cd "$(dirname "$0")/.."
 export DEBIAN_FRONTEND=noninteractive
 PKGS="g++ cmake ninja-build python3 python3-venv python3-dev libeigen3-dev liborocos-kdl-dev libceres-dev \
-nlohmann-json3-dev libcli11-dev libgtest-dev"
+nlohmann-json3-dev libcli11-dev libgtest-dev chromium"
 missing=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

@@ -387,55 +387,21 @@ def cmd_bench(args) -> None:
 
 
 def cmd_demo(args) -> None:
+    from . import demo
+
+    def say(i: int, n: int, what: str) -> None:
+        print(f"[{i}/{n}] {what}", file=sys.stderr, flush=True)
+
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    steps = ["robot", "programs", "compensation", "summary"]
-    t0 = time.perf_counter()
-
-    def step(i: int, what: str) -> None:
-        print(f"[{i}/{len(steps)}] {what}", file=sys.stderr, flush=True)
-
-    step(1, "kr500 with a simulated calibration (1 mm, 0.05 deg errors, joint compliance)")
-    nominal = load_robot("kr500")
-    robot = nominal.with_calibrated(seed=7, sigma_mm=1.0, sigma_deg=0.05, compliance=0.003)
-    _core.write_file_atomic(str(out / "model.json"), robot.to_json())
-
-    step(2, "the paper's line program: 297 poses 5 mm apart, constant orientation")
-    poses = line_program()
-    _core.write_file_atomic(str(out / "line.csv"), _fmt_rows(["x", "y", "z", "a", "b", "c"], poses))
-    gcode = ["; kincal demo: 1480 mm straight tool path, 297 poses, tool pointing down", "G90"]
-    gcode += [f"N{10 * (i + 1)} G1 X{p[0]:.3f} Y{p[1]:.3f} Z{p[2]:.3f} A{p[3]:.3f} B{p[4]:.3f} C{p[5]:.3f}"
-              for i, p in enumerate(poses)]
-    gcode.append("M30")
-    _core.write_file_atomic(str(out / "line.gcode"), "\n".join(gcode) + "\n")
-
-    step(3, "nominal IK (uncompensated) and Newton compensation on the calibrated model")
-    unc = _core.compensate_program(robot, str(out / "line.gcode"), str(out / "uncompensated.gcode"), compensate=False)
-    com = _core.compensate_program(robot, str(out / "line.gcode"), str(out / "compensated.gcode"))
-    _core.compensate_program(robot, str(out / "line.csv"), str(out / "compensated.csv"))
-
-    step(4, "summary")
-    q_unc, q_com = np.asarray(unc["q_deg"]), np.asarray(com["q_deg"])
-    reached_unc = fk(robot, q_unc)  # where the real (calibrated) robot goes
-    reached_com = fk(robot, q_com)
-    err_unc = np.linalg.norm(reached_unc[:, :3] - poses[:, :3], axis=1)
-    err_com = np.linalg.norm(reached_com[:, :3] - poses[:, :3], axis=1)
-    it = np.asarray(com["iterations"])
-    summary = {
-        "robot": "kr500 (simulated calibrated model, seed 7)",
-        "poses": int(len(poses)),
-        "position_error_uncompensated_mm": {"mean": float(err_unc.mean()), "max": float(err_unc.max())},
-        "position_error_compensated_mm": {"mean": float(err_com.mean()), "max": float(err_com.max())},
-        "newton_iterations": {"min": int(it.min()), "max": int(it.max()), "mean": float(it.mean())},
-        "max_joint_correction_deg": [float(v) for v in np.abs(q_com - q_unc).max(axis=0)],
-        "files": sorted(p.name for p in out.iterdir()) + ["summary.json"],
-        "seconds": time.perf_counter() - t0,
-    }
-    _core.write_file_atomic(str(out / "summary.json"), json.dumps(summary, indent=2) + "\n")
-    print(f"position error on the calibrated robot: uncompensated mean {err_unc.mean():.3f} mm "
-          f"(max {err_unc.max():.3f}), compensated mean {err_com.mean():.2e} mm (max {err_com.max():.2e}); "
-          f"Newton iterations {it.min()}..{it.max()}", file=sys.stderr)
-    print(f"wrote {out}/: " + ", ".join(summary["files"]), file=sys.stderr)
+    summary = demo.run(out, say)
+    print(f"identification: held-out RMS {summary['identification']['held_out_rms_before_mm']:.3f} -> "
+          f"{summary['identification']['held_out_rms_after_mm']:.3f} mm; diagnosis named "
+          + ", ".join(f"{d['effect']}" + (f" (joint {d['joint']})" if d["joint"] else "") for d in summary["diagnosis"])
+          + f"; the line on the true robot: uncompensated {summary['position_error_uncompensated_mm']['mean']:.3f} mm, "
+          f"compensated {summary['position_error_compensated_mm']['mean']:.3f} mm (mean); feed violations "
+          f"{summary['feed_violations']}; five-bar {summary['fivebar_max_error_mm']['fit_and_matrix'] * 1000:.1f} um "
+          f"after fit + matrix ({summary['seconds']:.0f} s)", file=sys.stderr)
+    print(f"report: {out / 'report.html'}", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:

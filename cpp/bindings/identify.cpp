@@ -140,6 +140,10 @@ void define_identify(py::module_& m) {
       "read_measurements", [](const std::string& path, int dof) { return to_dict(read_measurements(path, dof), dof); },
       py::arg("path"), py::arg("dof"));
   m.def(
+      "parse_measurements",
+      [](const std::string& text, const std::string& src, int dof) { return to_dict(parse_measurements(text, src, dof), dof); },
+      py::arg("text"), py::arg("source") = "<text>", py::arg("dof") = 6);
+  m.def(
       "format_measurements",
       [](const py::dict& d, int dof) { return format_measurements(from_dict(d, dof), dof); }, py::arg("data"),
       py::arg("dof"));

@@ -98,6 +98,26 @@ void define_programs(py::module_& m) {
       },
       py::arg("s"), py::arg("d1"), py::arg("d2"), py::arg("v"), py::arg("a"), py::arg("cap"),
       "time-optimal s-dot along the path and the traversal time (see kincal/feed.hpp)");
+  // text parsers (the file readers without the file): for tests and fuzzing
+  m.def(
+      "parse_csv",
+      [](const std::string& text, const std::string& src) {
+        const CsvTable t = parse_csv(text, src);
+        return py::make_tuple(t.header, t.cells);
+      },
+      py::arg("text"), py::arg("source") = "<text>");
+  m.def(
+      "parse_pose_program",
+      [](const std::string& text, const std::string& src, bool gcode) {
+        return parse_pose_program(text, src, gcode).poses.size();
+      },
+      py::arg("text"), py::arg("source") = "<text>", py::arg("gcode") = false);
+  m.def(
+      "parse_joint_program",
+      [](const std::string& text, const std::string& src, bool gcode, int dof) {
+        return parse_joint_program(text, src, gcode, dof).q.size();
+      },
+      py::arg("text"), py::arg("source") = "<text>", py::arg("gcode") = false, py::arg("dof") = 6);
   m.def("write_file_atomic", &write_file_atomic, py::arg("path"), py::arg("text"));
   m.def(
       "read_csv_columns",

@@ -223,7 +223,7 @@ ErrorMatrix ErrorMatrix::from_json(const std::string& text, const std::string& s
   json j;
   try {
     j = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers out of range (1e999)
     throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
   try {
@@ -324,7 +324,7 @@ FiveBar fivebar_from_json(const std::string& text, const std::string& source) {
   json j;
   try {
     j = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers out of range (1e999)
     throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
   FiveBar m;

@@ -137,7 +137,10 @@ int scan_gcode(const char* s, size_t n, bool joint_mode, int dof, WordSpan* span
     } else if (single && (c == 'A' || c == 'a') && j < n && std::isdigit(static_cast<unsigned char>(s[j]))) {
       size_t k = j;
       int axis = 0;
-      while (k < n && std::isdigit(static_cast<unsigned char>(s[k]))) axis = axis * 10 + (s[k++] - '0');
+      while (k < n && std::isdigit(static_cast<unsigned char>(s[k]))) {
+        if (axis < 1000) axis = axis * 10 + (s[k] - '0');  // a huge index stays huge, never overflows
+        ++k;
+      }
       if (k < n && s[k] == '=') {
         const std::string word = std::string(s + i, s + k) + "=";
         if (axis < 1 || axis > dof)

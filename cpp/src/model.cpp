@@ -425,6 +425,8 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
       }
     }
     throw InputError(source + ":" + std::to_string(line) + ":" + std::to_string(col) + ": not valid JSON");
+  } catch (const json::exception& e) {  // e.g. a number out of range (1e999)
+    throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
   Reader r{source};
   if (!o.is_object() || !o.contains("format") || o["format"] != "kincal-model")

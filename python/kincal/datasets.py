@@ -24,9 +24,9 @@ def read_ipa(path: str | Path) -> dict:
         raise ValueError(f"{path}: empty file")
     header = [h.strip() for h in lines[0].split(";")]
     need = UR_JOINTS + ["measurement_x", "measurement_y", "measurement_z", "measurement_temperature"]
-    for n in need:
-        if n not in header:
-            raise ValueError(f"{path}:1: missing column '{n}'")
+    for name in need:
+        if name not in header:
+            raise ValueError(f"{path}:1: missing column '{name}'")
     col = [header.index(n) for n in need]
     rows = []
     for i, line in enumerate(lines[1:], start=2):

@@ -14,7 +14,7 @@ RMS must fall; otherwise, or when no candidate is significant, the workflow stop
 from __future__ import annotations
 
 import math
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -106,7 +106,7 @@ def _regressors(robot: Robot, res: dict, data: dict, spec: Spec, cand: tuple):
     for nme, val in zip(cur_names, res["x"]):
         if nme in pos and ("te_" in nme or "backlash" in nme or nme == "thermal_expansion"):
             x[pos[nme]] = val
-    r, J = pm.residuals(x, data, True)
+    r, J = pm.residuals(list(x), data, True)
     fixed = dict(zip(cur_names, res["fixed"]))
     cur_cols = [pos[nme] for nme in cur_names if nme in pos and not fixed[nme]]
     if cand[0] == "joint_compliance":
@@ -131,7 +131,7 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, pose_rows: np.ndarray, f
 
     Q, _ = np.linalg.qr(Jc)
     Rp = R - Q @ (Q.T @ R)
-    keep = np.linalg.norm(Rp, axis=0) > 1e-9 * max(1.0, np.linalg.norm(R))
+    keep = np.linalg.norm(Rp, axis=0) > 1e-9 * max(1.0, float(np.linalg.norm(R)))
     if not keep.any():
         return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": True}
     Rp = Rp[:, keep]
@@ -169,8 +169,8 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
     spec = Spec()
     say("fitting the geometric model")
     cur = cv_rms(spec, robot, data, fold_masks)
-    history = [{"model": "geometry", "cv_rms_mm": cur}]
-    steps = []
+    history: list[dict[str, Any]] = [{"model": "geometry", "cv_rms_mm": cur}]
+    steps: list[dict[str, Any]] = []
     for _ in range(max_steps):
         res = spec.fit(robot, data)
         scored = []
@@ -221,9 +221,9 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
     if at_noise:
         verdict = "what remains is at the noise level"
     else:
-        best = ", ".join(f"{_effect_name((s['effect'], s['joint'] or 0))} {s['cv_gain']:.1%}" for s in left[:3])
+        gains = ", ".join(f"{_effect_name((s['effect'], s['joint'] or 0))} {s['cv_gain']:.1%}" for s in left[:3])
         verdict = ("what remains is structured but not explained by the library"
-                   + (f" (significant candidates gain too little: {best})" if left else ""))
+                   + (f" (significant candidates gain too little: {gains})" if left else ""))
     say(f"{len(steps)} effect(s) named; cross-validated RMS {cur * 1000:.1f} um, noise estimate "
         f"{noise * 1000:.1f} um: {verdict}")
     return {"steps": steps, "final_rms_mm": cur, "noise_rms_mm": noise, "noise_known": noise_mm is not None,
@@ -235,14 +235,15 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
 
 def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
     """The natural variable of an effect for plots: (values per point, axis label)."""
+    j = joint or 1
     if effect == "transmission_error":
-        return data["q_deg"][:, joint - 1], f"q{joint} (deg)"
+        return data["q_deg"][:, j - 1], f"q{joint} (deg)"
     if effect == "backlash":
-        return data["dir"][:, joint - 1] + np.random.default_rng(0).uniform(-0.15, 0.15, len(data["pose"])), \
+        return data["dir"][:, j - 1] + np.random.default_rng(0).uniform(-0.15, 0.15, len(data["pose"])), \
             f"dir{joint} (sign of the last motion, jittered)"
     if effect == "thermal_expansion":
         return data["temperature_c"], "temperature (C)"
-    tau = np.array([_core.gravity_torque(robot, q)[0][joint - 1] for q in data["q_deg"]]) / 1000.0
+    tau = np.array([_core.gravity_torque(robot, q)[0][j - 1] for q in data["q_deg"]]) / 1000.0
     return tau, f"gravity torque on joint {joint} (N m)"
 
 

@@ -55,6 +55,15 @@ def _abc(r: np.ndarray) -> list[float]:
     return [math.degrees(a), math.degrees(b), math.degrees(c)]
 
 
+def _link_of(joint: ET.Element, tag: str, path: str) -> str:
+    """The link named by a joint's <parent> or <child> (an error naming the joint when absent)."""
+    el = joint.find(tag)
+    name = el.get("link") if el is not None else None
+    if not name:
+        raise ValueError(f"{path}: joint '{joint.get('name')}' lacks <{tag} link=...>")
+    return name
+
+
 def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None) -> dict:
     """The kincal geometry (model JSON "nominal" section) of a URDF serial chain."""
     path = str(path)
@@ -67,16 +76,13 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
         raise ValueError(f"{path}:{line}:{col}: not valid XML") from None
     if root.tag != "robot":
         raise ValueError(f"{path}: the root element is <{root.tag}>, not <robot>")
-    links = {l.get("name"): l for l in root.findall("link")}
+    links = {str(l.get("name")): l for l in root.findall("link")}
     joints = root.findall("joint")
-    by_child = {}
+    by_child: dict[str, ET.Element] = {}
     children: dict[str, list] = {}
     for j in joints:
-        parent, child = j.find("parent"), j.find("child")
-        if parent is None or child is None:
-            raise ValueError(f"{path}: joint '{j.get('name')}' lacks <parent> or <child>")
-        by_child[child.get("link")] = j
-        children.setdefault(parent.get("link"), []).append(j)
+        by_child[_link_of(j, "child", path)] = j
+        children.setdefault(_link_of(j, "parent", path), []).append(j)
     roots = [n for n in links if n not in by_child]
     if base is None:
         if len(roots) != 1:
@@ -92,20 +98,20 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
             kids = children.get(n, [])
             if not kids:
                 leaves.append(n)
-            stack.extend(k.find("child").get("link") for k in kids)
+            stack.extend(_link_of(k, "child", path) for k in kids)
         if len(leaves) != 1:
             raise ValueError(f"{path}: {len(leaves)} leaf links below '{base}' ({', '.join(leaves)}); name the tip with --tip")
         tip = leaves[0]
     if tip not in links:
         raise ValueError(f"{path}: no link '{tip}'")
-    chain = []
+    chain: list[ET.Element] = []
     n = tip
     while n != base:
-        j = by_child.get(n)
-        if j is None:
+        up = by_child.get(n)
+        if up is None:
             raise ValueError(f"{path}: link '{tip}' is not below '{base}'")
-        chain.append(j)
-        n = j.find("parent").get("link")
+        chain.append(up)
+        n = _link_of(up, "parent", path)
     chain.reverse()
 
     t = np.eye(4)
@@ -124,7 +130,7 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
         name, typ = j.get("name"), j.get("type")
         where = f"{path}: joint '{name}'"
         t = t @ _origin(j.find("origin"), where + " origin")
-        child = j.find("child").get("link")
+        child = _link_of(j, "child", path)
         if typ == "fixed":
             m, c = inertial(child, t)
             if out_joints and m > 0:
@@ -136,7 +142,8 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
             continue
         if typ not in ("revolute", "continuous"):
             raise ValueError(f"{where}: type '{typ}' is not supported (a serial revolute chain is needed)")
-        axis = _floats(j.find("axis").get("xyz") if j.find("axis") is not None else "1 0 0", 3, where + " axis")
+        axis_el = j.find("axis")
+        axis = _floats(axis_el.get("xyz") if axis_el is not None else "1 0 0", 3, where + " axis")
         lim = j.find("limit")
         lo, hi, vel = -180.0, 180.0, 0.0
         if lim is not None:

@@ -1,0 +1,26 @@
+"""The `.pyi` stubs of the private core agree with the compiled module (mypy's stubtest) and the
+typed package passes mypy."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_stubs_match_the_module():
+    pytest.importorskip("mypy")
+    r = subprocess.run([sys.executable, "-m", "mypy.stubtest", "kincal._core", "--allowlist",
+                        str(ROOT / "tests" / "stubtest_allowlist.txt")], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-2000:]
+
+
+def test_package_passes_mypy():
+    pytest.importorskip("mypy")
+    r = subprocess.run([sys.executable, "-m", "mypy", "--ignore-missing-imports", str(ROOT / "python" / "kincal")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-3000:]

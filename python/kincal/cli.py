@@ -160,9 +160,12 @@ def cmd_simulate(args) -> None:
         truth = ident.default_truth(robot, seed=args.seed)
         if args.truth_out:
             _core.write_file_atomic(args.truth_out, truth.to_json())
-    data = ident.simulate(truth, args.poses, seed=args.seed, noise_mm=args.noise, targets=args.targets,
+    pool = args.poses * (10 if args.select == "observability" else 1)
+    data = ident.simulate(truth, pool, seed=args.seed, noise_mm=args.noise, targets=args.targets,
                           outlier_fraction=args.outliers, outlier_mm=args.outlier_mm,
                           effects=[_hidden_effect(h, robot.dof) for h in args.hide])
+    if args.select == "observability":
+        data = ident.select_observable(robot, data, args.poses)
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
@@ -487,6 +490,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--noise", type=float, default=0.02, help="instrument noise per coordinate (mm)")
     sp.add_argument("--outliers", type=float, default=0.0, help="share of points with a gross error")
     sp.add_argument("--outlier-mm", type=float, default=5.0, help="size of a gross error (mm)")
+    sp.add_argument("--select", choices=["random", "observability"], default="random",
+                    help="poses drawn at random inside the limits, or the most observable of 10 times as many")
     sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
                     help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg), backlash:J:b (deg per "
                          "direction sign), thermal_expansion:0:alpha (1/C, about 20 C); repeatable")

@@ -41,6 +41,11 @@ py::dict to_dict(const MeasurementSet& m, int dof) {
   d["line"] = line;
   d["source"] = m.source;
   if (!std::isnan(temp.sum())) d["temperature_c"] = temp;
+  if (m.orientation) {
+    RowMat abc(n, 3);
+    for (size_t i = 0; i < n; ++i) abc.row(i) = m.rows[i].abc.transpose();
+    d["abc"] = abc;
+  }
   if (dir) d["dir"] = dirs;
   return d;
 }
@@ -81,6 +86,12 @@ MeasurementSet from_dict(const py::dict& d, int dof) {
     const auto t = d["temperature_c"].cast<Eigen::VectorXd>();
     if (static_cast<size_t>(t.size()) != n) throw InputError(m.source + ": temperature_c of a different length");
     for (size_t i = 0; i < n; ++i) m.rows[i].temperature_c = t[i];
+  }
+  if (d.contains("abc")) {
+    const auto a = d["abc"].cast<RowMat>();
+    if (static_cast<size_t>(a.rows()) != n || a.cols() != 3) throw InputError(m.source + ": abc of a different shape");
+    for (size_t i = 0; i < n; ++i) m.rows[i].has_abc = true, m.rows[i].abc = a.row(i).transpose();
+    m.orientation = true;
   }
   if (d.contains("dir")) {
     const auto dd = d["dir"].cast<RowMat>();
@@ -151,8 +162,10 @@ void define_identify(py::module_& m) {
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
          const RowMat& targets, double limit_margin,
-         const std::vector<std::tuple<std::string, int, std::vector<double>>>& effects, double t_ref) {
+         const std::vector<std::tuple<std::string, int, std::vector<double>>>& effects, double t_ref,
+         double orientation_noise_deg) {
         SimulationOptions o;
+        o.orientation_noise_deg = orientation_noise_deg;
         o.effects = effect_values_from(effects);
         o.t_ref = t_ref;
         o.poses = poses;
@@ -167,6 +180,7 @@ void define_identify(py::module_& m) {
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
       py::arg("effects") = std::vector<std::tuple<std::string, int, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
+      py::arg("orientation_noise_deg") = -1.0,
       "A measurement campaign on the calibrated (true) model of a robot");
   m.def(
       "point_errors",
@@ -183,7 +197,8 @@ void define_identify(py::module_& m) {
       "identify",
       [](const Robot& robot, const py::dict& d, bool compliance, const std::string& loss, double loss_scale_mm,
          int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated, bool covariance,
-         const std::vector<std::pair<std::string, int>>& effects, const std::vector<int>& compliance_joints) {
+         const std::vector<std::pair<std::string, int>>& effects, const std::vector<int>& compliance_joints,
+         double orientation_weight) {
         const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
         const MeasurementSet data = from_dict(d, nominal.dof());
         IdentifyOptions o;
@@ -194,6 +209,7 @@ void define_identify(py::module_& m) {
         o.fix = fix;
         o.covariance = covariance;
         o.effects = effects_from(effects);
+        o.orientation_weight = orientation_weight;
         for (int j : compliance_joints) o.compliance_joints.push_back(j - 1);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
         const IdentifyResult r = identify(nominal, data, o);
@@ -234,6 +250,7 @@ void define_identify(py::module_& m) {
       py::arg("loss_scale_mm") = 0.1, py::arg("max_iterations") = 100, py::arg("fix") = std::vector<std::string>{},
       py::arg("progress") = py::none(), py::arg("from_calibrated") = false, py::arg("covariance") = true,
       py::arg("effects") = std::vector<std::pair<std::string, int>>{}, py::arg("compliance_joints") = std::vector<int>{},
+      py::arg("orientation_weight") = 100.0,
       "Identify from measurements, starting from the nominal model (or from the calibrated one: then\n"
       "the parameters are corrections to it, e.g. to refit only the base frame and targets)");
 
@@ -248,17 +265,20 @@ void define_identify(py::module_& m) {
       .def("start", [](const PointModel& p, const py::dict& d) { return p.start(from_dict(d, p.layout().dof)); })
       .def(
           "residuals",
-          [](PointModel& p, const std::vector<double>& x, const py::dict& d, bool jac) {
+          [](PointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
             const MeasurementSet data = from_dict(d, p.layout().dof);
             if (static_cast<int>(x.size()) != p.layout().size) throw InputError("PointModel: wrong parameter count");
             p.prepare_payloads(data);
             p.set_params(x);
-            const int P = p.layout().size;
-            Eigen::VectorXd r(3 * data.rows.size());
-            RowMat J(jac ? 3 * data.rows.size() : 0, P);
-            for (size_t i = 0; i < data.rows.size(); ++i)
-              r.segment<3>(3 * i) = p.predict(data.rows[i], jac ? J.data() + 3 * i * P : nullptr) - data.rows[i].xyz;
+            const int P = p.layout().size, RS = data.orientation ? 6 : 3;
+            Eigen::VectorXd r(RS * data.rows.size());
+            RowMat J(jac ? RS * data.rows.size() : 0, P);
+            std::vector<double> full(6 * static_cast<size_t>(P));
+            for (size_t i = 0; i < data.rows.size(); ++i) {
+              row_residuals(p, data.rows[i], weight, RS == 6, r.data() + RS * i, jac ? full.data() : nullptr);
+              if (jac) std::copy_n(full.data(), RS * P, J.data() + RS * i * P);
+            }
             return py::make_tuple(r, J);
           },
-          py::arg("x"), py::arg("data"), py::arg("jacobian") = false);
+          py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0);
 }

@@ -76,6 +76,11 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
     throw InputError(source + ":1: column q" + std::to_string(dof + 1) + " but the robot has " +
                      std::to_string(dof) + " joints");
   const int cx = t.require("x"), cy = t.require("y"), cz = t.require("z");
+  const int ca = t.find("a"), cb = t.find("b"), cc = t.find("c");
+  const bool abc = ca >= 0 && cb >= 0 && cc >= 0;
+  if (!abc && (ca >= 0 || cb >= 0 || cc >= 0))
+    throw InputError(source + ":1: an orientation needs all three columns a, b, c");
+  m.orientation = abc;
   const int ctarget = t.find("target"), cpay = t.find("payload_kg"), ctemp = t.find("temperature_c");
   std::vector<int> cdir;
   for (int j = 0; j < dof; ++j) cdir.push_back(t.find("dir" + std::to_string(j + 1)));
@@ -89,6 +94,10 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
     row.q_deg.resize(dof);
     for (int j = 0; j < dof; ++j) row.q_deg[j] = t.number(r, cq[j]);
     row.xyz = Vec3(t.number(r, cx), t.number(r, cy), t.number(r, cz));
+    if (abc) {
+      row.has_abc = true;
+      row.abc = Vec3(t.number(r, ca), t.number(r, cb), t.number(r, cc));
+    }
     if (ctarget >= 0) {
       const double tv = t.number(r, ctarget);
       if (tv < 0 || tv != std::floor(tv) || tv > 99)
@@ -130,7 +139,7 @@ MeasurementSet read_measurements(const std::string& path, int dof) {
 std::string format_measurements(const MeasurementSet& m, int dof) {
   std::string s = "pose";
   for (int j = 0; j < dof; ++j) s += ",q" + std::to_string(j + 1);
-  s += ",x,y,z,target";
+  s += m.orientation ? ",x,y,z,a,b,c,target" : ",x,y,z,target";
   bool pay = false;
   for (const auto& r : m.rows) pay = pay || !std::isnan(r.payload_kg);
   if (pay) s += ",payload_kg";
@@ -144,6 +153,8 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
     s += std::to_string(r.pose);
     for (int j = 0; j < dof; ++j) s += "," + fmt(r.q_deg[j]);
     for (int k = 0; k < 3; ++k) s += "," + fmt(r.xyz[k]);
+    if (m.orientation)
+      for (int k = 0; k < 3; ++k) s += "," + fmt(r.abc[k]);
     s += "," + std::to_string(r.target);
     if (pay) s += "," + fmt(r.payload_kg);
     if (temp) s += "," + fmt(r.temperature_c);
@@ -220,6 +231,7 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
   MeasurementSet m;
   m.source = "simulated";
   m.n_targets = static_cast<int>(opt.targets.size());
+  m.orientation = opt.orientation_noise_deg >= 0;
   std::mt19937_64 rng(opt.seed);
   std::uniform_real_distribution<double> ud(-0.5, 0.5), u01(0.0, 1.0);
   std::normal_distribution<double> nd(0.0, 1.0);
@@ -245,6 +257,19 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
       row.target = t;
       row.xyz = simulate_point(truth, row, opt.targets[t], opt.effects, opt.t_ref);
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
+      if (opt.orientation_noise_deg >= 0) {
+        // the measured tool frame (a 6-D probe): truth orientation, then a small random rotation
+        VecQ dq = VecQ::Zero(n);
+        double scale = 1.0;
+        std::vector<Effect> eff;
+        std::vector<double> pv;
+        for (const auto& ev : opt.effects) eff.push_back(ev.effect), pv.insert(pv.end(), ev.p.begin(), ev.p.end());
+        effect_offsets(eff, pv.data(), row, opt.t_ref, dq, scale);
+        const Mat3 r = truth.base_in_instrument().linear() * fk(truth, deflected(truth, q * kDeg) + dq).linear();
+        const Vec3 e = Vec3(nd(rng), nd(rng), nd(rng)) * opt.orientation_noise_deg * kDeg;
+        row.has_abc = true;
+        row.abc = rotation_to_abc(so3_exp(e) * r);
+      }
       if (opt.outlier_fraction > 0 && u01(rng) < opt.outlier_fraction)
         row.xyz += Vec3(nd(rng), nd(rng), nd(rng)).normalized() * opt.outlier_mm;
       m.rows.push_back(row);
@@ -409,9 +434,10 @@ void PointModel::gravity_state(const Model& model, const Measurement& m, Gravity
 }
 
 void PointModel::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
-                                  double* jac) const {
+                                  const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const {
   const int n = layout_.dof, P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot, 3, P);
   // the torque is taken at the commanded angles (frames of gs), the point moves at the deflected ones
   const auto& gr = gs.gr;
   const auto& gt = gs.gt;
@@ -429,9 +455,13 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
   };
   // effect on the point of a torque change dtau (N mm) on every loaded joint
   auto apply = [&](int col, const std::array<double, kMaxJoints>& dtau) {
-    Vec3 dx = Vec3::Zero();
-    for (int j : layout_.loaded) dx += jp[j] * (model.compliance(j) * dtau[j]);
+    Vec3 dx = Vec3::Zero(), dw = Vec3::Zero();
+    for (int j : layout_.loaded) {
+      dx += jp[j] * (model.compliance(j) * dtau[j]);
+      dw += jw[j] * (model.compliance(j) * dtau[j]);
+    }
     J.col(col) += rb_ * dx;
+    W.col(col) += rb_ * dw;
   };
   for (int i = 0; i < n; ++i) {
     const Vec3 wraw = nominal_.axis(i) + x_[4 * i] * u_[i] + x_[4 * i + 1] * v_[i];
@@ -484,7 +514,7 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
   }
 }
 
-Vec3 PointModel::predict(const Measurement& m, double* jac) const {
+Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
   const Model& model = model_for(m.payload_kg);
   const int n = layout_.dof;
   const VecQ q = m.q_deg * kDeg;
@@ -518,10 +548,17 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
   const Vec3 xr = rn * x0 + gt[n];  // the point of the unscaled robot
   const Vec3 x = scale * xr;
   const Vec3 y = rb_ * x + tb_;
+  if (rot) *rot = rb_ * rn * rm_;
   if (!jac) return y;
   const int P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
   J.setZero();
+  // angular velocity of the tool frame (instrument frame) per parameter, when asked for
+  thread_local std::vector<double> wbuf;
+  if (!jac_rot) wbuf.assign(3 * static_cast<size_t>(P), 0.0);
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot ? jac_rot : wbuf.data(), 3, P);
+  W.setZero();
+  W.block<3, 3>(0, layout_.base + 3) = rb_ * jrb_;
   const Mat3 rbn = rb_ * rn;
   J.block<3, 3>(0, layout_.base) = Mat3::Identity();
   J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
@@ -539,6 +576,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
       const Vec3 om = w_[j].cross(dw);  // the line turns about p_j
       const Vec3 dx = gr[j] * om.cross(xl[j] - p_[j]) - gr[j + 1] * om.cross(xl[j + 1] - p_[j]);
       J.col(4 * j + k) = rb_ * dx;
+      W.col(4 * j + k) = rb_ * (gr[j] * om - gr[j + 1] * om);
       const Vec3 dxt = gr[j] * d - gr[j + 1] * d;  // the line moves along d
       J.col(4 * j + 2 + k) = rb_ * dxt;
     }
@@ -550,10 +588,14 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
     const int j = layout_.loaded[i];
     const double dq = gs.tau[j] * kDeg / 1e6;  // per deg/kNm
     J.col(layout_.compliance + static_cast<int>(i)) = rb_ * jp[j] * dq;
+    W.col(layout_.compliance + static_cast<int>(i)) = rb_ * (gr[j] * w_[j]) * dq;
   }
   J.block<3, 3>(0, layout_.tool) = rbn;
   J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * skew(tkv) * jrm_;
-  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, J.data());
+  W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
+  std::array<Vec3, kMaxJoints> jw;  // angular velocity per unit rotation of each joint (base frame)
+  for (int j = 0; j < n; ++j) jw[j] = gr[j] * w_[j];
+  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, jw, J.data(), W.data());
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
@@ -561,8 +603,10 @@ Vec3 PointModel::predict(const Measurement& m, double* jac) const {
       const double qj = q[ef.joint];
       const double b[4] = {std::sin(qj), std::cos(qj), std::sin(2 * qj), std::cos(2 * qj)};
       for (int k = 0; k < 4; ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
+      for (int k = 0; k < 4; ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
     } else if (ef.name == "backlash") {
       J.col(c) = rb_ * jp[ef.joint] * m.dir[ef.joint];
+      W.col(c) = rb_ * jw[ef.joint] * m.dir[ef.joint];
     } else {
       J.col(c) = rb_ * xr * (m.temperature_c - layout_.t_ref);
     }
@@ -632,6 +676,44 @@ std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& ta
 // ---------------------------------------------------------------------------------------------
 namespace {
 
+/// Inverse of the right Jacobian of SO(3).
+Mat3 so3_right_jacobian_inv(const Vec3& e) {
+  const double th = e.norm();
+  const Mat3 s = skew(e);
+  const double c = th < 1e-4 ? 1.0 / 12.0 + th * th / 720.0
+                             : 1.0 / (th * th) - (1.0 + std::cos(th)) / (2.0 * th * std::sin(th));
+  return Mat3::Identity() + 0.5 * s + c * s * s;
+}
+
+}  // namespace
+
+int row_residuals(const PointModel& pm, const Measurement& m, double weight, bool orientation, double* r, double* J) {
+  const int P = pm.layout().size;
+  Mat3 rot;
+  thread_local std::vector<double> jw;
+  if (J && orientation) jw.resize(3 * static_cast<size_t>(P));
+  const Vec3 y = pm.predict(m, J, orientation ? &rot : nullptr, (J && orientation) ? jw.data() : nullptr);
+  for (int k = 0; k < 3; ++k) r[k] = y[k] - m.xyz[k];
+  if (!orientation) return 3;
+  if (!m.has_abc) throw InputError("a row without a measured orientation in a 6-D measurement set");
+  const Vec3 e = so3_log(abc_to_rotation(m.abc).transpose() * rot);
+  for (int k = 0; k < 3; ++k) r[3 + k] = weight * e[k];
+  if (J) {
+    // e' = log(Rm^T Exp(w) R) ~ e + Jr^-1(e) R^T w
+    const Mat3 d = weight * so3_right_jacobian_inv(e) * rot.transpose();
+    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jw.data(), 3, P);
+    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>> JJ(J, 6, P);
+    // predict() wrote the 3 position rows at J: move them into the 6-row layout
+    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> pos =
+        Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>>(J, 3, P);
+    JJ.topRows(3) = pos;
+    JJ.bottomRows(3) = d * W;
+  }
+  return 6;
+}
+
+namespace {
+
 /// Run f(i) for i in [0, n) on all cores (rows are independent; PointModel::predict is const).
 template <class F>
 void parallel_rows(size_t n, F&& f) {
@@ -655,9 +737,9 @@ class AllRows : public ceres::EvaluationCallback {
  public:
   /// x: the full parameter vector (held values stay, free ones are written back by finish());
   /// Ceres sees only the free parameters (z), so no manifold is needed.
-  AllRows(PointModel& pm, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx)
+  AllRows(PointModel& pm, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx, double weight)
       : pm_(pm), d_(d), x_(x), free_(std::move(free_idx)), P_(pm.layout().size), F_(static_cast<int>(free_.size())),
-        r_(3 * d.rows.size()), j_(3 * d.rows.size() * F_) {
+        RS_(d.orientation ? 6 : 3), w_(weight), r_(RS_ * d.rows.size()), j_(RS_ * d.rows.size() * F_) {
     for (int i : free_) z_.push_back(x_[i]);
   }
   void PrepareForEvaluation(bool jacobians, bool new_point) override {
@@ -669,13 +751,11 @@ class AllRows : public ceres::EvaluationCallback {
     if (valid_ && (!jacobians || have_j_)) return;
     parallel_rows(d_.rows.size(), [&](size_t i) {
       thread_local std::vector<double> full;
-      if (jacobians) full.resize(3 * P_);
-      const Vec3 y = pm_.predict(d_.rows[i], jacobians ? full.data() : nullptr);
-      const Vec3 res = y - d_.rows[i].xyz;
-      for (int k = 0; k < 3; ++k) r_[3 * i + k] = res[k];
+      if (jacobians) full.resize(6 * static_cast<size_t>(P_));
+      row_residuals(pm_, d_.rows[i], w_, RS_ == 6, &r_[RS_ * i], jacobians ? full.data() : nullptr);
       if (jacobians)
-        for (int r = 0; r < 3; ++r)
-          for (int k = 0; k < F_; ++k) j_[(3 * i + r) * F_ + k] = full[r * P_ + free_[k]];
+        for (int r = 0; r < RS_; ++r)
+          for (int k = 0; k < F_; ++k) j_[(RS_ * i + r) * F_ + k] = full[r * P_ + free_[k]];
     });
     valid_ = true;
     have_j_ = jacobians;
@@ -685,8 +765,9 @@ class AllRows : public ceres::EvaluationCallback {
     pm_.set_params(x_);
   }
   double* z() { return z_.data(); }
-  const double* residual(size_t i) const { return &r_[3 * i]; }
-  const double* jacobian(size_t i) const { return &j_[3 * i * F_]; }
+  const double* residual(size_t i) const { return &r_[RS_ * i]; }
+  const double* jacobian(size_t i) const { return &j_[RS_ * i * F_]; }
+  int row_size() const { return RS_; }
   int size() const { return F_; }
   size_t rows() const { return d_.rows.size(); }
 
@@ -695,7 +776,8 @@ class AllRows : public ceres::EvaluationCallback {
   const MeasurementSet& d_;
   std::vector<double>& x_;
   std::vector<int> free_;
-  int P_, F_;
+  int P_, F_, RS_;
+  double w_;
   std::vector<double> z_, r_, j_;
   bool valid_ = false, have_j_ = false;
 };
@@ -703,12 +785,12 @@ class AllRows : public ceres::EvaluationCallback {
 class RowCost : public ceres::CostFunction {
  public:
   RowCost(const AllRows& all, size_t i) : all_(all), i_(i) {
-    set_num_residuals(3);
+    set_num_residuals(all.row_size());
     mutable_parameter_block_sizes()->push_back(all.size());
   }
   bool Evaluate(double const* const*, double* residuals, double** jacobians) const override {
-    std::copy_n(all_.residual(i_), 3, residuals);
-    if (jacobians && jacobians[0]) std::copy_n(all_.jacobian(i_), 3 * all_.size(), jacobians[0]);
+    std::copy_n(all_.residual(i_), all_.row_size(), residuals);
+    if (jacobians && jacobians[0]) std::copy_n(all_.jacobian(i_), all_.row_size() * all_.size(), jacobians[0]);
     return true;
   }
 
@@ -769,11 +851,16 @@ int count_poses(const MeasurementSet& d) {
 }
 
 /// Full identification Jacobian (3 rows per measurement) at x.
-Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std::vector<double>& x) {
+Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std::vector<double>& x, double weight) {
   pm.set_params(x);
-  const int P = pm.layout().size;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(3 * d.rows.size(), P);
-  parallel_rows(d.rows.size(), [&](size_t i) { pm.predict(d.rows[i], J.data() + 3 * i * P); });
+  const int P = pm.layout().size, RS = d.orientation ? 6 : 3;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(RS * d.rows.size(), P);
+  parallel_rows(d.rows.size(), [&](size_t i) {
+    thread_local std::vector<double> full, r(6);
+    full.resize(6 * static_cast<size_t>(P));
+    row_residuals(pm, d.rows[i], weight, RS == 6, r.data(), full.data());
+    std::copy_n(full.data(), RS * P, J.data() + RS * i * P);
+  });
   return J;
 }
 
@@ -865,7 +952,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     for (int i = L.base; i < L.effects; ++i)
       if (i < L.targets || !res.fixed[i]) frames.push_back(i);
     ceres::Solver::Summary s1;
-    AllRows all1(pm, data, x, frames);
+    AllRows all1(pm, data, x, frames, opt.orientation_weight);
     ceres::Problem p1(problem_options(all1));
     std::unique_ptr<ceres::LossFunction> loss1 = make_loss(opt);
     pm.set_frames_only(true);  // only the base and target columns are needed here
@@ -896,9 +983,12 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     for (int i = L.effects; i < P; ++i) order.push_back(i);
     for (int j = 1; j < L.dof; ++j)
       for (int k = 0; k < 4; ++k) order.push_back(4 * j + k);
+    // with measured orientations the tool's rotation is seen: keep it, hold the base's gauge instead
+    if (data.orientation)
+      for (int i = L.tool + 3; i < L.tool + 6; ++i) order.push_back(i);
     for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
     for (int k = 0; k < 4; ++k) order.push_back(k);
-    for (int i = L.tool; i < L.tool + 6; ++i) order.push_back(i);
+    for (int i = L.tool; i < L.tool + (data.orientation ? 3 : 6); ++i) order.push_back(i);
     // greedy on the normal matrix of the unit-scaled columns: the squared distance of column i from
     // the span of the chosen ones is N_ii - N_iS N_SS^-1 N_Si (an incremental Cholesky factor)
     auto select = [&](const Eigen::MatrixXd& J, std::vector<bool>& fixed, std::vector<std::string>& reason) {
@@ -944,6 +1034,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     };
     MeasurementSet generic;
     generic.n_targets = data.n_targets;
+    generic.orientation = data.orientation;  // the same kind of rows (J_r^-1 keeps the rank for any abc)
     std::mt19937_64 rng(12345);
     std::uniform_real_distribution<double> ud(-0.45, 0.45);
     for (int p = 0; p < 100; ++p) {
@@ -957,17 +1048,20 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
       row.dir.resize(L.dof);
       for (int j = 0; j < L.dof; ++j) row.dir[j] = ud(rng) < 0 ? -1.0 : 1.0;
       row.temperature_c = data.rows[rng() % data.rows.size()].temperature_c;
+      row.has_abc = data.orientation;
       for (int t = 0; t < data.n_targets; ++t)
         if (targets_used[t]) row.target = t, generic.rows.push_back(row);
     }
     std::vector<bool> gfixed = res.fixed;
     std::vector<std::string> greason = res.fixed_reason;
-    select(full_jacobian(pm, generic, x), gfixed, greason);
-    select(full_jacobian(pm, data, x), res.fixed, res.fixed_reason);
+    select(full_jacobian(pm, generic, x, opt.orientation_weight), gfixed, greason);
+    select(full_jacobian(pm, data, x, opt.orientation_weight), res.fixed, res.fixed_reason);
     std::string missing;
     int n_missing = 0;
+    // only what the data make exactly redundant counts (near the weak threshold the two may differ)
     for (int i = 0; i < P; ++i)
-      if (res.fixed[i] && !gfixed[i]) missing += (n_missing++ ? ", " : "") + L.names[i];
+      if (res.fixed[i] && !gfixed[i] && res.fixed_reason[i].rfind("not identifiable", 0) == 0)
+        missing += (n_missing++ ? ", " : "") + L.names[i];
     if (n_missing)
       throw InputError(data.source + ": the " + std::to_string(data.rows.size()) + " measured points of " +
                        std::to_string(count_poses(data)) + " poses cannot determine " + missing +
@@ -975,7 +1069,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   }
   std::vector<int> free_idx, fixed_idx;
   for (int i = 0; i < P; ++i) (res.fixed[i] ? fixed_idx : free_idx).push_back(i);
-  const int nres = 3 * static_cast<int>(data.rows.size());
+  const int nres = (data.orientation ? 6 : 3) * static_cast<int>(data.rows.size());
   if (nres <= static_cast<int>(free_idx.size()))
     throw InputError(data.source + ": " + std::to_string(data.rows.size()) + " measured points give " +
                      std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
@@ -984,7 +1078,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // --- stage 2: everything identifiable ---
   ceres::Solver::Summary summary;
   std::unique_ptr<ceres::LossFunction> loss = make_loss(opt);
-  AllRows all(pm, data, x, free_idx);
+  AllRows all(pm, data, x, free_idx, opt.orientation_weight);
   ceres::Problem problem(problem_options(all));
   solve(problem, all, loss.get(), opt, summary, true);
   res.iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -1012,7 +1106,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // --- condition, observability, covariance ---
   res.stddev.assign(P, std::nan(""));
   {
-    const Eigen::MatrixXd J = full_jacobian(pm, data, x);
+    const Eigen::MatrixXd J = full_jacobian(pm, data, x, opt.orientation_weight);
     Eigen::MatrixXd Jf(J.rows(), free_idx.size());
     for (size_t k = 0; k < free_idx.size(); ++k) {
       const double nrm = J.col(free_idx[k]).norm();

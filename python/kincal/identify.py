@@ -35,13 +35,14 @@ def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg:
 
 def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
              outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence = (),
-             t_ref: float = 20.0) -> dict:
+             t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None) -> dict:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
     model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
     ``effects`` hides more effects in the truth: (name, joint from 1 or 0, values) with the values in
     radians (transmission_error: sin q, cos q, sin 2q, cos 2q amplitudes; backlash: offset per
     direction sign) or per degree C (thermal_expansion, about t_ref). Every row gets dir1..dirN and
-    temperature_c (drifting from 18 to 30 C over the campaign)."""
+    temperature_c (drifting from 18 to 30 C over the campaign). With ``orientation_noise_deg`` the
+    tool frame's orientation is measured too (a 6-D probe): columns a, b, c."""
     if poses < 1:
         raise ValueError(f"the number of poses must be positive, not {poses}")
     if not 1 <= targets <= len(DEFAULT_TARGETS):
@@ -51,7 +52,8 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
     if not 0.0 <= outlier_fraction <= 1.0:
         raise ValueError(f"the outlier fraction must be in 0..1, not {outlier_fraction}")
     return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets], 0.9,
-                          [(str(n), int(j), [float(v) for v in vals]) for n, j, vals in effects], t_ref)
+                          [(str(n), int(j), [float(v) for v in vals]) for n, j, vals in effects], t_ref,
+                          -1.0 if orientation_noise_deg is None else float(orientation_noise_deg))
 
 
 def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
@@ -170,6 +172,9 @@ class Identification:
         if v.get("held_rows"):
             lines.append(f"{'held-out poses (' + v['scheme'] + ')':<28}{v['before_rms_mm']:>12.4f}{v['after_rms_mm']:>12.4f}"
                          f"{v['before_max_mm']:>12.4f}{v['after_max_mm']:>12.4f}")
+        if "after_rms_deg" in v:
+            lines.append(f"{'orientation (deg), held out':<28}{v['before_rms_deg']:>12.4f}{v['after_rms_deg']:>12.4f}"
+                         f"{v['before_max_deg']:>12.4f}{v['after_max_deg']:>12.4f}")
         lines.append("")
         lines.append(f"condition number {f['condition_number']:.4g}, observability index {f['observability_index']:.4g}")
         fixed = [(n, r) for n, fx, r in zip(f["names"], f["fixed"], f["fixed_reason"]) if fx]
@@ -190,8 +195,19 @@ class Identification:
 
 
 def _fit(robot: Robot, data: dict, effects: Sequence[str], loss: str, loss_scale_mm: float,
-         progress: Optional[Callable[[int, float], None]] = None) -> dict:
-    return _core.identify(robot, data, "joint_compliance" in effects, loss, loss_scale_mm, 100, [], progress)
+         progress: Optional[Callable[[int, float], None]] = None, orientation_weight: float = 100.0) -> dict:
+    return _core.identify(robot, data, "joint_compliance" in effects, loss, loss_scale_mm, 100, [], progress,
+                          False, True, [], [], orientation_weight)
+
+
+def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
+    """Angle (deg) between the measured and the predicted tool orientation of every 6-D row."""
+    pred = _core.fk(robot, np.asarray(data["q_deg"], dtype=float), True, True)
+    out = np.empty(len(pred))
+    for i, (p, m) in enumerate(zip(pred[:, 3:], data["abc"])):
+        r = _core.abc_to_rotation(m).T @ _core.abc_to_rotation(p)
+        out[i] = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2))))
+    return out
 
 
 def check_effects(effects: Sequence[str]) -> list:
@@ -207,7 +223,8 @@ def check_effects(effects: Sequence[str]) -> list:
 
 def identify(robot: Robot, data: dict, *, effects: Sequence[str] = ("joint_compliance",), loss: str = "huber",
              loss_scale_mm: float = 0.1, holdout: float = 0.25, k_folds: int = 0, seed: int = 0,
-             progress: Optional[Callable[[int, float], None]] = None) -> Identification:
+             progress: Optional[Callable[[int, float], None]] = None,
+             orientation_weight: float = 100.0) -> Identification:
     """Identify the robot's parameters from measurements.
 
     Validation: ``k_folds`` > 1 fits k times, each time predicting the fold it did not see;
@@ -224,7 +241,7 @@ def identify(robot: Robot, data: dict, *, effects: Sequence[str] = ("joint_compl
     if k_folds > 1:
         e_before, e_after = [], []
         for held in folds(data, k_folds, seed):
-            r = _fit(robot, subset(data, ~held), effects, loss, loss_scale_mm)
+            r = _fit(robot, subset(data, ~held), effects, loss, loss_scale_mm, None, orientation_weight)
             e_after.append(_core.point_errors(r["robot"], r["targets"], subset(data, held)))
             e_before.append(_core.point_errors(r["nominal_fitted"], r["nominal_targets"], subset(data, held)))
         fit_mask = np.ones(len(data["pose"]), dtype=bool)
@@ -233,7 +250,7 @@ def identify(robot: Robot, data: dict, *, effects: Sequence[str] = ("joint_compl
     else:
         fit_mask, held = split_poses(data, holdout, seed)
         val = {"scheme": f"{holdout:.0%} held out", "held_rows": int(held.sum())}
-    r = _fit(robot, subset(data, fit_mask), effects, loss, loss_scale_mm, progress)
+    r = _fit(robot, subset(data, fit_mask), effects, loss, loss_scale_mm, progress, orientation_weight)
     if k_folds <= 1 and val["held_rows"]:
         held_data = subset(data, ~fit_mask)
         ea = _core.point_errors(r["robot"], r["targets"], held_data)
@@ -241,6 +258,12 @@ def identify(robot: Robot, data: dict, *, effects: Sequence[str] = ("joint_compl
     if val["held_rows"]:
         val.update(before_rms_mm=_rms(eb), after_rms_mm=_rms(ea), before_max_mm=float(np.max(eb)),
                    after_max_mm=float(np.max(ea)))
+        if "abc" in data and k_folds <= 1:
+            held_data = subset(data, ~fit_mask)
+            ob = orientation_errors_deg(r["nominal_fitted"], held_data)
+            oa = orientation_errors_deg(r["robot"], held_data)
+            val.update(before_rms_deg=_rms(ob), after_rms_deg=_rms(oa), before_max_deg=float(np.max(ob)),
+                       after_max_deg=float(np.max(oa)))
     val["fit_rows"] = int(fit_mask.sum())
     return Identification(robot=r["robot"], targets=np.asarray(r["targets"]), fit=r, effects=list(effects),
                           validation=val)

@@ -52,6 +52,8 @@ struct Measurement {
   VecQ dir;                  ///< sign of the last motion of each joint (empty: unknown)
   double temperature_c = std::numeric_limits<double>::quiet_NaN();
   Vec3 xyz = Vec3::Zero();   ///< measured point, instrument frame (mm)
+  bool has_abc = false;      ///< a full 6-D pose: the tool frame's orientation was measured too
+  Vec3 abc = Vec3::Zero();   ///< measured orientation of the tool frame, instrument frame (KUKA ABC, deg)
   int target = 0;
   double payload_kg = std::numeric_limits<double>::quiet_NaN();  ///< NaN: the model's payload
   int line = 0;              ///< line in the source file (0: simulated)
@@ -61,6 +63,7 @@ struct MeasurementSet {
   std::string source;
   std::vector<Measurement> rows;
   int n_targets = 1;
+  bool orientation = false;  ///< every row carries a measured orientation (a, b, c columns)
 };
 
 /// Read the measurement CSV of the contract (pose, q1..qN, x, y, z, optional target, payload_kg).
@@ -80,6 +83,7 @@ struct SimulationOptions {
   std::vector<EffectValue> effects;  ///< effects hidden in the truth (besides its compliance)
   double t_ref = 20.0;             ///< reference temperature of thermal_expansion
   double t_min = 18.0, t_max = 30.0;  ///< the temperature drifts through this range over the campaign
+  double orientation_noise_deg = -1;  ///< >= 0: the tool frame's orientation is measured too (6-D)
 };
 
 /// The point of target t (tool frame) in the instrument frame for commanded joint angles (deg) on a
@@ -117,7 +121,9 @@ class PointModel {
   /// Jacobian columns of the base frame and targets only (the others left zero), for fitting the frames.
   void set_frames_only(bool on) { frames_only_ = on; }
   /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.
-  Vec3 predict(const Measurement& m, double* jac) const;
+  /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
+  /// (instrument frame) per parameter.
+  Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
   /// Starting parameters: nominal geometry, base frame from the best rigid fit (Horn) of the
   /// nominal prediction of target 0 at the tool point, targets at the tool point.
   std::vector<double> start(const MeasurementSet& data) const;
@@ -148,7 +154,7 @@ class PointModel {
   };
   void gravity_state(const Model& model, const Measurement& m, GravityState& gs) const;
   void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
-                        double* jac) const;
+                        const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const;
 };
 
 struct IdentifyOptions {
@@ -165,6 +171,7 @@ struct IdentifyOptions {
   std::vector<int> compliance_joints;  ///< with compliance: only these joints (0-based; empty: all)
   std::vector<Effect> effects;     ///< extra effects identified with the rest
   std::function<void(int iteration, double cost)> progress;
+  double orientation_weight = 100.0;  ///< mm per rad: how orientation residuals weigh against positions
 };
 
 struct IdentifyResult {
@@ -192,6 +199,11 @@ struct IdentifyResult {
   std::vector<Correlation> correlations;
   std::string termination;
 };
+
+/// The residual of one row (3 position components in mm; with orientation 3 more: weight times the
+/// rotation vector log(R_measured^T R_model)) and, when J is not null, its Jacobian (row-major,
+/// rows x size; J must hold 6 x size). Returns the number of residuals.
+int row_residuals(const PointModel& pm, const Measurement& m, double weight, bool orientation, double* r, double* J);
 
 /// Identify the parameters from measurements (rows of the set). Throws InputError when the data
 /// are too few for the free parameters.

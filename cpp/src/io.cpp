@@ -264,7 +264,16 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
   }
   // nominal robots without closed-form IK, and every calibrated robot: Newton on the model
   const Model& target_model = opt.compensate ? cal : nom;
-  const CompensationResult r = compensate(target_model, pose, q0, opt.comp);
+  CompensationResult r = compensate(target_model, pose, q0, opt.comp);
+  if (!nom.ik_structure().spherical_wrist_parallel_23) {
+    if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
+    if (r.status != CompStatus::Converged || !target_model.within_limits_deg(r.q_deg)) {
+      // no closed form to start from: a numerical IK from the reference, home and seeded starts
+      Q6 qn;
+      if (numeric_ik(target_model, pose, ref, qn, opt.comp)) r = compensate(target_model, pose, qn, opt.comp);
+      if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
+    }
+  }
   if (r.status != CompStatus::Converged && approximate_start) {
     err = "pose out of reach of the robot (beyond the nominal reach, and the model does not reach it either)";
     return false;

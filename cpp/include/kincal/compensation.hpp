@@ -36,4 +36,15 @@ Vec6 pose_deviation(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, 
 CompensationResult compensate(const Model& cal, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& q0_deg,
                               const CompensationOptions& opt = {});
 
+/// Each joint moved by whole turns to the position nearest the reference, inside its limits when one is.
+Eigen::Matrix<double, 6, 1> wrap_near(const Model& m, const Eigen::Matrix<double, 6, 1>& q_deg,
+                                      const Eigen::Matrix<double, 6, 1>& ref_deg);
+
+/// Numerical inverse kinematics for robots without a closed form (e.g. the UR10): damped least
+/// squares (Levenberg-Marquardt) on position and rotation-vector error from the reference, then from
+/// home and from seeded starts inside the joint limits; the converged solution within the limits
+/// nearest the reference (largest joint difference), polished by compensate(). false when none.
+bool numeric_ik(const Model& m, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& ref_deg,
+                Eigen::Matrix<double, 6, 1>& q_deg, const CompensationOptions& opt, int starts = 48);
+
 }  // namespace kincal

@@ -63,8 +63,14 @@ std::vector<FiveBarPoint> points_from(const py::dict& d) {
 
 void define_fivebar(py::module_& m) {
   py::class_<FiveBar>(m, "FiveBar", "The hidden robot: a 5-bar with concurrent fixed joints (lengths in mm)")
-      .def(py::init([](double a, double b, double c, double d) { return FiveBar{a, b, c, d, +1}; }), py::arg("a") = 150.0,
-           py::arg("b") = 150.0, py::arg("c") = 150.0, py::arg("d") = 150.0)
+      .def(py::init([](double a, double b, double c, double d, int assembly, int working1, int working2) {
+             return FiveBar{a, b, c, d, assembly, working1, working2};
+           }),
+           py::arg("a") = 150.0, py::arg("b") = 150.0, py::arg("c") = 150.0, py::arg("d") = 150.0,
+           py::arg("assembly") = 1, py::arg("working1") = 1, py::arg("working2") = -1)
+      .def_readwrite("assembly", &FiveBar::assembly)
+      .def_readwrite("working1", &FiveBar::working1)
+      .def_readwrite("working2", &FiveBar::working2)
       .def_readwrite("a", &FiveBar::a)
       .def_readwrite("b", &FiveBar::b)
       .def_readwrite("c", &FiveBar::c)

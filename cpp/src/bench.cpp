@@ -210,7 +210,7 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
         grid.push_back(p);
       }
     const ErrorMatrix em = ErrorMatrix::from_points(grid, "bench");
-    FiveBarCorrector corr(FiveBar{149.9, 150.05, 149.95, 150.1, +1}, &em);
+    FiveBarCorrector corr(FiveBar{149.9, 150.05, 149.95, 150.1, +1, +1, -1}, &em);
     const int m = 200000;
     std::vector<double> lat(m);
     std::uniform_real_distribution<double> ux(162.132, 262.132), uy(-75, 75);

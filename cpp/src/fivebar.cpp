@@ -52,8 +52,8 @@ bool fivebar_ik(const FiveBar& m, const Vec2& c, double& t1, double& t2, const d
   const double k1 = (r2 + m.a * m.a - m.b * m.b) / (2 * m.a * r);
   const double k2 = (r2 + m.d * m.d - m.c * m.c) / (2 * m.d * r);
   if (std::abs(k1) > 1 || std::abs(k2) > 1) return false;
-  t1 = phi + std::acos(k1);
-  t2 = phi - std::acos(k2);
+  t1 = phi + (m.working1 >= 0 ? 1.0 : -1.0) * std::acos(k1);
+  t2 = phi + (m.working2 >= 0 ? 1.0 : -1.0) * std::acos(k2);
   if (ref) {
     t1 = wrap_near(t1, ref[0]);
     t2 = wrap_near(t2, ref[1]);

@@ -15,7 +15,7 @@ class PointCost : public ceres::SizedCostFunction<2, 4> {
  public:
   explicit PointCost(const FiveBarPoint& p) : p_(p) {}
   bool Evaluate(double const* const* x, double* r, double** jac) const override {
-    const FiveBar m{x[0][0], x[0][1], x[0][2], x[0][3], +1};
+    const FiveBar m{x[0][0], x[0][1], x[0][2], x[0][3], +1, +1, -1};
     const double t1 = p_.t1_deg * kDeg, t2 = p_.t2_deg * kDeg;
     Vec2 c;
     if (!fivebar_fk(m, t1, t2, c)) return false;
@@ -51,7 +51,7 @@ FiveBar fivebar_fit_nonlinear(const std::vector<FiveBarPoint>& pts, const FiveBa
   ceres::Solve(so, &problem, &sum);
   if (!sum.IsSolutionUsable()) throw InputError("nonlinear fit: Ceres failed (" + sum.BriefReport() + ")");
   if (rms) *rms = std::sqrt(2 * sum.final_cost / pts.size());
-  return FiveBar{x[0], x[1], x[2], x[3], +1};
+  return FiveBar{x[0], x[1], x[2], x[3], +1, +1, -1};
 }
 
 }  // namespace kincal

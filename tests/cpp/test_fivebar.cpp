@@ -24,7 +24,7 @@ TEST(FiveBar, IkFkRoundTripAndJacobian) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> ul(145, 155), ux(162.132, 262.132), uy(-75, 75);
   for (int k = 0; k < 2000; ++k) {
-    const FiveBar m{ul(rng), ul(rng), ul(rng), ul(rng), +1};
+    const FiveBar m{ul(rng), ul(rng), ul(rng), ul(rng), +1, +1, -1};
     const Vec2 c(ux(rng), uy(rng));
     double t1, t2;
     ASSERT_TRUE(fivebar_ik(m, c, t1, t2));
@@ -58,7 +58,7 @@ TEST(FiveBar, IkFkRoundTripAndJacobian) {
   double t1, t2;
   EXPECT_FALSE(fivebar_ik(FiveBar{}, Vec2(400, 0), t1, t2));
   Vec2 c;
-  EXPECT_FALSE(fivebar_fk(FiveBar{100, 10, 10, 100, +1}, 0.5, -0.5, c));
+  EXPECT_FALSE(fivebar_fk(FiveBar{100, 10, 10, 100, +1, +1, -1}, 0.5, -0.5, c));
 }
 
 TEST(FiveBar, Table1ReproducesThePapersPicks) {
@@ -166,4 +166,27 @@ TEST(FiveBar, CorrectorDoesNotAllocate) {
   EXPECT_TRUE(ok);
   EXPECT_EQ(during, 0);
   EXPECT_TRUE(std::isfinite(sum));
+}
+
+TEST(FiveBar, BothWorkingAndAssemblyModes) {
+  // every working-mode pair of the IK puts C back under one of the two assembly modes of the FK
+  // (lengths 150, 155, 148, 140 mm)
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> ux(170, 250), uy(-60, 60);
+  for (int k = 0; k < 300; ++k) {
+    const Vec2 c(ux(rng), uy(rng));
+    for (int w1 : {+1, -1})
+      for (int w2 : {+1, -1}) {
+        FiveBar m{150, 155, 148, 140, +1, w1, w2};  // unequal: with equal dyads both modes alike make A = B
+        double t1, t2;
+        ASSERT_TRUE(fivebar_ik(m, c, t1, t2));
+        double best = 1e9;
+        for (int as : {+1, -1}) {
+          m.assembly = as;
+          Vec2 back;
+          if (fivebar_fk(m, t1, t2, back)) best = std::min(best, (back - c).norm());
+        }
+        EXPECT_LT(best, 1e-9) << w1 << " " << w2;
+      }
+  }
 }

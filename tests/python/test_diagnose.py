@@ -70,16 +70,27 @@ def test_nothing_hidden_nothing_named(kr500):
     assert "noise level" in out["verdict"]
 
 
-def test_urdf_robot(tmp_path, kr500):
-    """A URDF robot (the kr500 geometry and masses written as URDF, without kincal's payload):
-    a transmission error hidden on its joint 4 is named."""
+@pytest.mark.parametrize("hidden,expect", [
+    ([("transmission_error", 4, [0, D(0.03), 0, 0])], [("transmission_error", 4)]),
+    ([("backlash", 3, [D(0.01)])], [("backlash", 3)]),
+    ([("thermal_expansion", 0, [2e-5])], [("thermal_expansion", None)]),
+    (None, [("joint_compliance", 2), ("joint_compliance", 3)]),
+])
+def test_urdf_robot(tmp_path, kr500, hidden, expect):
+    """A URDF robot (the kr500 geometry and link masses written as URDF, so without kincal's
+    300 kg head): each effect hidden in turn is named (joint compliance: ~0.01 deg/kN m, the arm's
+    own weight loads joints 2 and 3 most)."""
     spec = json.loads(kr500.to_json())["nominal"]
     (tmp_path / "r.urdf").write_text(spec_urdf(spec, "urdf_robot"))
     robot = kincal.load_robot(str(tmp_path / "r.urdf"))
-    data = ident.simulate(_truth(robot), 250, seed=5, targets=3,
-                          effects=[("transmission_error", 4, [0, D(0.03), 0, 0])])
+    truth = _truth(robot, 0.01 if hidden is None else 0.0)
+    data = ident.simulate(truth, 250, seed=5, targets=3, effects=hidden or [])
     out = dg.diagnose(robot, data)
-    assert [(s["effect"], s["joint"]) for s in out["steps"]] == [("transmission_error", 4)]
+    named = [(s["effect"], s["joint"]) for s in out["steps"]]
+    if hidden is None:
+        assert named[:2] == expect and all(e == "joint_compliance" for e, _ in named)
+    else:
+        assert named == expect
     assert out["final_rms_mm"] <= 1.3 * NOISE
 
 

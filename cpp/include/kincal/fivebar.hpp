@@ -22,13 +22,16 @@ struct FiveBar {
   /// Assembly mode: the sign of (B - A) x (C - A); +1 puts C beyond the line AB, away from the
   /// fixed joints (the nominal mechanism of the paper).
   int assembly = +1;
+  /// Working modes of the IK: +1 puts the crank's joint A left of the line from the origin to C
+  /// (seen from the origin), -1 right of it; the paper's mechanism: A left (+1), B right (-1).
+  int working1 = +1, working2 = -1;
 };
 
 /// End-effector C for actuator angles (rad); false when the couplers cannot close the loop.
 bool fivebar_fk(const FiveBar& m, double t1, double t2, Vec2& c);
-/// Actuator angles (rad) for C in the working mode of the paper (A left of OC, B right of it, seen
-/// from the origin); the angles are put next to ref (2 pi periodic) when ref is given. false when
-/// C is out of reach.
+/// Actuator angles (rad) for C in the model's working modes (the paper's: A left of OC, B right of
+/// it, seen from the origin); the angles are put next to ref (2 pi periodic) when ref is given.
+/// false when C is out of reach.
 bool fivebar_ik(const FiveBar& m, const Vec2& c, double& t1, double& t2, const double* ref = nullptr);
 /// The Jacobian dC/d(theta1, theta2) (eq. 8 is its inverse); false at a singular pose.
 bool fivebar_jacobian(const FiveBar& m, double t1, double t2, Mat2& j);

@@ -287,6 +287,16 @@ def cmd_hr_simulate(args) -> None:
           f"largest error {fivebar.position_errors(pts).max() * 1000:.1f} um", file=sys.stderr)
 
 
+def _pair(text: str) -> tuple:
+    try:
+        a, b = (float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected two numbers S0,S1, not '{text}'") from None
+    if not a < b:
+        raise argparse.ArgumentTypeError(f"S0 must be below S1 in '{text}'")
+    return a, b
+
+
 def cmd_feed(args) -> None:
     robot = _robot(args)
     limits = feedmod.robot_limits(robot)
@@ -313,7 +323,7 @@ def cmd_feed(args) -> None:
            "figures": []}
     for axis in range(1, robot.dof + 1):
         name = f"axis{axis}.png"
-        feedmod.figure(results, *limits, args.feed, axis, str(out / name))
+        feedmod.figure(results, *limits, args.feed, axis, str(out / name), window=args.window, zoom=args.zoom)
         doc["figures"].append(name)
     _core.write_file_atomic(str(out / "feed.json"), json.dumps(doc) + "\n")
     for k, r in results.items():
@@ -528,6 +538,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--method", choices=list(feedmod.METHODS), default="spline",
                     help="resampling: quintic spline (default) or the paper's linear interpolation")
     sp.add_argument("--samples", type=int, default=feedmod.DEFAULT_SAMPLES, help="resampled points along s")
+    sp.add_argument("--window", type=_pair, help="S0,S1: the s range of the figures' left column (rad; default all)")
+    sp.add_argument("--zoom", type=_pair, help="S0,S1: the s range of the right column (default 1.5%% around the middle)")
     sp.add_argument("--out", required=True, help="folder for feed.json and the figures")
     sp.set_defaults(func=cmd_feed)
 

@@ -25,7 +25,10 @@ namespace {
 
 using Q6 = Eigen::Matrix<double, 6, 1>;
 
-inline double wrap180(double a) { return std::remainder(a, 360.0); }
+inline double wrap180(double a) {  // to [-180, 180] without std::remainder (slow)
+  if (a > 180.0 || a < -180.0) a -= 360.0 * std::floor((a + 180.0) / 360.0);
+  return a;
+}
 
 inline Vec6 deviation(const Eigen::Isometry3d& t, const Pose6& d, Vec3& abc) {
   abc = rotation_to_abc(t.linear());

@@ -63,9 +63,10 @@ void polish_wrist(const Vec3& w4, const Vec3& w5, const Vec3& w6, const Mat3& ta
   }
 }
 
-inline double wrap(double a) {  // to (-pi, pi]
-  a = std::remainder(a, 2 * kPi);
-  return a <= -kPi ? a + 2 * kPi : a;
+inline double wrap(double a) {  // to (-pi, pi]; a few turns at most here, so no std::remainder (slow)
+  constexpr double two_pi = 2 * kPi;
+  if (a > kPi || a <= -kPi) a -= two_pi * std::floor((a + kPi) / two_pi);
+  return a <= -kPi ? a + two_pi : (a > kPi ? a - two_pi : a);
 }
 
 }  // namespace
@@ -210,15 +211,17 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
         b45 = dist(1) < dist(0) ? 1 : 0;
       }
       for (int i45 = greedy ? b45 : 0; i45 < (greedy ? std::min(b45 + 1, n45) : n45); ++i45) {
-        const Mat3 r45 = rot(w4, t4[i45]) * rot(w5, t5[i45]);
+        const Mat3 r5 = rot(w5, t5[i45]);
+        const Mat3 r45 = rot(w4, t4[i45]) * r5;
         // any vector normal to w6
         const Vec3 v = w6.unitOrthogonal();
         const double q6 = pk_sub1(w6, v, r45.transpose() * r456 * v);
         IkSolution& s = out.sol[out.count];
         double q[6] = {q1, q2, q3, t4[i45], t5[i45], q6};
-        if (std::abs(w4.cross(rot(w5, q[4]) * w6).norm()) < 1e-6) polish_wrist(w4, w5, w6, r456, q + 3);
+        const double wrist = w4.cross(r5 * w6).norm();  // sin of the angle between axes 4 and 6
+        if (wrist < 1e-6) polish_wrist(w4, w5, w6, r456, q + 3);
         for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) / kDeg;
-        s.wrist_singular = std::abs(w4.cross(rot(w5, t5[i45]) * w6).norm()) < 1e-7;
+        s.wrist_singular = wrist < 1e-7;
         s.shoulder_singular = shoulder;
         s.approximate = t_clamped;
         ++out.count;

@@ -19,9 +19,11 @@ Mat3 abc_to_rotation(const Vec3& abc) {
 }
 
 Vec3 rotation_to_abc(const Mat3& r) {
-  const double b = std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0)));
+  // the entries of a rotation are at most 1: a plain square root is safe (and much faster than hypot)
+  const double cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
+  const double b = std::atan2(-r(2, 0), cb);
   double a, c;
-  if (std::hypot(r(0, 0), r(1, 0)) < 1e-12) {  // gimbal lock: put everything in a
+  if (cb < 1e-12) {  // gimbal lock: put everything in a
     c = 0;
     a = std::atan2(-r(0, 1), r(1, 1));
   } else {

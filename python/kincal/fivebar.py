@@ -110,22 +110,22 @@ def model_of(fit_json: dict) -> FiveBar:
     return _core.fivebar_from_json(json.dumps(fit_json))
 
 
-def load_fit(path: str) -> FiveBar:
+def _read(path: str) -> str:
     try:
         with open(path) as f:
-            text = f.read()
+            return f.read()
     except OSError as e:
         raise ValueError(f"{path}: {e.strerror}") from None
-    return _core.fivebar_from_json(text, str(path))
+
+
+def load_fit(path: str) -> FiveBar:
+    """A FIT.json of `kincal hidden-robot fit` (errors name the file and cause)."""
+    return _core.fivebar_from_json(_read(path), str(path))
 
 
 def load_matrix(path: str) -> ErrorMatrix:
-    try:
-        with open(path) as f:
-            text = f.read()
-    except OSError as e:
-        raise ValueError(f"{path}: {e.strerror}") from None
-    return ErrorMatrix.from_json(text, str(path))
+    """A MATRIX.json of `kincal hidden-robot matrix`."""
+    return ErrorMatrix.from_json(_read(path), str(path))
 
 
 def grid_targets(spacing: float = 5.0, workspace=WORKSPACE) -> np.ndarray:

@@ -437,7 +437,9 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
                                   const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const {
   const int n = layout_.dof, P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
-  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot, 3, P);
+  double dummy[3];
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot ? jac_rot : dummy, 3,
+                                                                         jac_rot ? P : 1);
   // the torque is taken at the commanded angles (frames of gs), the point moves at the deflected ones
   const auto& gr = gs.gr;
   const auto& gt = gs.gt;
@@ -461,7 +463,7 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
       dw += jw[j] * (model.compliance(j) * dtau[j]);
     }
     J.col(col) += rb_ * dx;
-    W.col(col) += rb_ * dw;
+    if (jac_rot) W.col(col) += rb_ * dw;
   };
   for (int i = 0; i < n; ++i) {
     const Vec3 wraw = nominal_.axis(i) + x_[4 * i] * u_[i] + x_[4 * i + 1] * v_[i];
@@ -554,11 +556,13 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
   J.setZero();
   // angular velocity of the tool frame (instrument frame) per parameter, when asked for
-  thread_local std::vector<double> wbuf;
-  if (!jac_rot) wbuf.assign(3 * static_cast<size_t>(P), 0.0);
-  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot ? jac_rot : wbuf.data(), 3, P);
-  W.setZero();
-  W.block<3, 3>(0, layout_.base + 3) = rb_ * jrb_;
+  const bool ang = jac_rot != nullptr;
+  double dummy[3];
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(ang ? jac_rot : dummy, 3, ang ? P : 1);
+  if (ang) {
+    W.setZero();
+    W.block<3, 3>(0, layout_.base + 3) = rb_ * jrb_;
+  }
   const Mat3 rbn = rb_ * rn;
   J.block<3, 3>(0, layout_.base) = Mat3::Identity();
   J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
@@ -576,7 +580,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
       const Vec3 om = w_[j].cross(dw);  // the line turns about p_j
       const Vec3 dx = gr[j] * om.cross(xl[j] - p_[j]) - gr[j + 1] * om.cross(xl[j + 1] - p_[j]);
       J.col(4 * j + k) = rb_ * dx;
-      W.col(4 * j + k) = rb_ * (gr[j] * om - gr[j + 1] * om);
+      if (ang) W.col(4 * j + k) = rb_ * (gr[j] * om - gr[j + 1] * om);
       const Vec3 dxt = gr[j] * d - gr[j + 1] * d;  // the line moves along d
       J.col(4 * j + 2 + k) = rb_ * dxt;
     }
@@ -588,14 +592,14 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
     const int j = layout_.loaded[i];
     const double dq = gs.tau[j] * kDeg / 1e6;  // per deg/kNm
     J.col(layout_.compliance + static_cast<int>(i)) = rb_ * jp[j] * dq;
-    W.col(layout_.compliance + static_cast<int>(i)) = rb_ * (gr[j] * w_[j]) * dq;
+    if (ang) W.col(layout_.compliance + static_cast<int>(i)) = rb_ * (gr[j] * w_[j]) * dq;
   }
   J.block<3, 3>(0, layout_.tool) = rbn;
   J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * skew(tkv) * jrm_;
-  W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
+  if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
   std::array<Vec3, kMaxJoints> jw;  // angular velocity per unit rotation of each joint (base frame)
   for (int j = 0; j < n; ++j) jw[j] = gr[j] * w_[j];
-  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, jw, J.data(), W.data());
+  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, jw, J.data(), ang ? W.data() : nullptr);
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
@@ -603,10 +607,11 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
       const double qj = q[ef.joint];
       const double b[4] = {std::sin(qj), std::cos(qj), std::sin(2 * qj), std::cos(2 * qj)};
       for (int k = 0; k < 4; ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
-      for (int k = 0; k < 4; ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
+      if (ang)
+        for (int k = 0; k < 4; ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
     } else if (ef.name == "backlash") {
       J.col(c) = rb_ * jp[ef.joint] * m.dir[ef.joint];
-      W.col(c) = rb_ * jw[ef.joint] * m.dir[ef.joint];
+      if (ang) W.col(c) = rb_ * jw[ef.joint] * m.dir[ef.joint];
     } else {
       J.col(c) = rb_ * xr * (m.temperature_c - layout_.t_ref);
     }

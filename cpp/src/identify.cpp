@@ -1,5 +1,5 @@
 // kincal: measurement files, the campaign simulator and Ceres identification.
-// The only translation unit that includes Ceres (builds stay quick).
+// With fivebar_fit.cpp one of the two translation units that include Ceres (builds stay quick).
 #include "kincal/identify.hpp"
 
 #include "kincal/io.hpp"

@@ -27,8 +27,6 @@ TOKENS = [b"nan", b"inf", b"-inf", b"1e309", b"1e-400", b"-0", b",", b"\n", b";"
 
 def _seeds() -> list:
     robot = _core.Robot.load("kr500").to_json().encode()
-    grid = [{"id": 1}]
-    del grid
     em = {"format": "kincal-error-matrix", "version": 1, "x0_mm": 0, "y0_mm": 0, "dx_mm": 5, "dy_mm": 5, "nx": 2,
           "ny": 2, "error_x_mm": [0, 0.1, 0, 0.1], "error_y_mm": [0, 0, 0.1, 0.1]}
     return [

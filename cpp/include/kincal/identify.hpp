@@ -12,7 +12,10 @@
 //   per gravity-loaded joint 1: compliance (deg per kN m, absolute);
 //   tool 6: translation (mm) and rotation vector (rad, R = R0 Exp(phi));
 //   base 6: the same for the base frame in the instrument frame;
-//   per target 3: offset in the tool frame (mm, absolute).
+//   per target 3: offset in the tool frame (mm, absolute);
+//   per extra effect (transmission_error 4, backlash 1, thermal_expansion 1), see Effect.
+// Rows with a measured orientation (a, b, c) add 3 residuals: the weighted rotation vector from the
+// measured to the predicted tool frame.
 // Identification is Ceres Levenberg-Marquardt with an analytic Jacobian. Parameters the data cannot
 // determine are found from the scaled Jacobian (greedy column selection in a preferred order) and
 // held at their start value.

@@ -53,7 +53,10 @@ def cmd_fk(args) -> None:
     if "target" in extra:
         targets = _identified_targets(args.robot)
         for i, t in enumerate(extra["target"]):
-            k = int(float(t))
+            try:
+                k = int(t)
+            except ValueError:
+                raise ValueError(f"{args.joints}:{i + 2}: column 'target': '{t}' is not an integer") from None
             if not 0 <= k < len(targets):
                 raise ValueError(f"{args.joints}:{i + 2}: target {t} but the model knows {len(targets)} target(s)")
             r = _core.abc_to_rotation(poses[i, 3:]) if targets[k].any() else None

@@ -26,11 +26,20 @@ def main() -> None:
     p.add_argument("--fit", default="B", choices=sorted(SERIES))
     p.add_argument("--effects", default="joint_compliance")
     p.add_argument("--diagnose", metavar="DIR", help="also run the diagnosis on the fit series, report in DIR")
+    p.add_argument("--orientation", action="store_true",
+                   help="use the probe's measured orientations too (6-D poses, weighted by the tracker's "
+                        "median standard deviations: 0.012 mm against 0.00225 deg)")
     args = p.parse_args()
     robot = kincal.load_robot("ur10")
     data = {k: datasets.read_ipa(Path(args.data) / v) for k, v in SERIES.items()}
     effects = [e for e in args.effects.split(",") if e and e != "none"]
-    res = ident.identify(robot, data[args.fit], effects=effects)
+    if args.orientation:
+        import math
+
+        fit = datasets.read_ipa(Path(args.data) / SERIES[args.fit], orientation=True)
+        res = ident.identify(robot, fit, effects=effects, orientation_weight=0.012 / math.radians(0.00225))
+    else:
+        res = ident.identify(robot, data[args.fit], effects=effects)
     print(res.summary())
     print()
     print(f"{'series':<34}{'points':>8}{'RMS before':>12}{'RMS after':>12}{'max before':>12}{'max after':>12}")

@@ -567,7 +567,11 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   J.block<3, 3>(0, layout_.base) = Mat3::Identity();
   J.block<3, 3>(0, layout_.base + 3) = -rb_ * skew(x) * jrb_;
   J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
-  if (frames_only_) return y;
+  if (frames_only_) {
+    J.block<3, 3>(0, layout_.tool + 3) = -scale * rbn * rm_ * skew(tkv) * jrm_;
+    if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
+    return y;
+  }
   // x in the frames G_j: xl_j = G_j^-1 x
   std::array<Vec3, kMaxJoints + 1> xl;
   for (int j = 0; j <= n; ++j) xl[j] = gr[j].transpose() * (xr - gt[j]);
@@ -954,6 +958,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // start where the targets are where they are, so that the analysis below sees the real geometry)
   {
     std::vector<int> frames;
+    // with measured orientations the probe's mounting (the tool frame's rotation) is a frame too
+    if (data.orientation)
+      for (int i = L.tool + 3; i < L.tool + 6; ++i) frames.push_back(i);
     for (int i = L.base; i < L.effects; ++i)
       if (i < L.targets || !res.fixed[i]) frames.push_back(i);
     ceres::Solver::Summary s1;

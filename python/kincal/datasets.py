@@ -10,11 +10,12 @@ UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_
              "wrist_3_joint"]
 
 
-def read_ipa(path: str | Path) -> dict:
+def read_ipa(path: str | Path, orientation: bool = False) -> dict:
     """A series of the UR10 laser-tracker data of Landgraf et al. (CASE 2021; ../shared/data/
     ipa-robot-accuracy): ';' separated, ',' decimal mark, joints in rad, the T-Mac probe's position
     in the tracker frame in mm. Returns a measurement set (one target: the probe) with the
-    temperature (deg C) of every row as ``temperature_c``."""
+    temperature (deg C) of every row as ``temperature_c``; with ``orientation`` also the probe's measured
+    orientation (intrinsic XYZ Euler angles in the file) as KUKA ABC angles ``abc``: 6-D poses."""
     path = Path(path)
     try:
         lines = path.read_text().splitlines()
@@ -23,7 +24,8 @@ def read_ipa(path: str | Path) -> dict:
     if not lines:
         raise ValueError(f"{path}: empty file")
     header = [h.strip() for h in lines[0].split(";")]
-    need = UR_JOINTS + ["measurement_x", "measurement_y", "measurement_z", "measurement_temperature"]
+    need = UR_JOINTS + ["measurement_x", "measurement_y", "measurement_z", "measurement_temperature",
+                        "measurement_rx", "measurement_ry", "measurement_rz"]
     for name in need:
         if name not in header:
             raise ValueError(f"{path}:1: missing column '{name}'")
@@ -42,7 +44,8 @@ def read_ipa(path: str | Path) -> dict:
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{path}: row {bad + 2}: not a finite number")
     n = len(a)
-    return {
+    abc = np.array([_abc_of_xyz_intrinsic(*np.radians(r)) for r in a[:, 10:13]])
+    out = {
         "pose": np.arange(n, dtype=np.int32),
         "q_deg": np.degrees(a[:, :6]),
         "xyz": a[:, 6:9].copy(),
@@ -52,3 +55,17 @@ def read_ipa(path: str | Path) -> dict:
         "source": str(path),
         "temperature_c": a[:, 9].copy(),
     }
+    if orientation:
+        out["abc"] = abc
+    return out
+
+
+def _abc_of_xyz_intrinsic(rx: float, ry: float, rz: float) -> list:
+    """KUKA ABC (deg) of the rotation Rx(rx) Ry(ry) Rz(rz) (intrinsic XYZ Euler angles, rad)."""
+    cx, sx, cy, sy, cz, sz = np.cos(rx), np.sin(rx), np.cos(ry), np.sin(ry), np.cos(rz), np.sin(rz)
+    rxm = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    rym = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rzm = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    r = rxm @ rym @ rzm
+    b = np.degrees(np.arctan2(-r[2, 0], np.hypot(r[0, 0], r[1, 0])))
+    return [float(np.degrees(np.arctan2(r[1, 0], r[0, 0]))), float(b), float(np.degrees(np.arctan2(r[2, 1], r[2, 2])))]

@@ -14,7 +14,7 @@ if [ -n "$missing" ]; then
 fi
 [ -x .venv/bin/python ] || python3 -m venv .venv
 .venv/bin/pip install -q --upgrade pip
-.venv/bin/pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" numpy scipy matplotlib tqdm pytest eaik toppra atheris mypy
+.venv/bin/pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" numpy scipy matplotlib pytest eaik toppra atheris mypy
 .venv/bin/pip install -q --no-build-isolation .
 cmake -S . -B build/cpp -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build/cpp -j2

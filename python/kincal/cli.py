@@ -193,7 +193,9 @@ def cmd_identify(args) -> None:
 
 def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
     """Identification on a simulated kr500 campaign (truth: default_truth(seed), one target, 0.02 mm
-    noise), plain least squares. identify_ms: our Ceres identification (analytic Jacobian; both stages, the
+    noise), plain least squares. scipy_numpy_identify_ms: scipy.optimize.least_squares on the same
+    residuals written in numpy (kincal/_numpy_model.py, checked against ours in the tests) with its
+    2-point Jacobian, what a script has. identify_ms: our Ceres identification (analytic Jacobian; both stages, the
     identifiability analysis; without the covariance, which is identify_with_covariance_ms);
     scipy_identify_ms: scipy.optimize.least_squares ('trf') on the same residual function from our
     core with its own finite-difference Jacobian ('2-point', what a user without our Jacobian
@@ -235,9 +237,17 @@ def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
     tol = dict(method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12)
     fd_ms, fd = median_ms(lambda: least_squares(fun, x0[free], jac="2-point", **tol), 1)
     an_ms, an = median_ms(lambda: least_squares(fun, x0[free], jac=jac, **tol), max(1, repeats // 2))
+    # what a script has: the same measurement model written in numpy, scipy's own Jacobian
+    from ._numpy_model import NumpyPointModel
+
+    npm = NumpyPointModel(robot, 1)
+    np_ms, npr = median_ms(lambda: least_squares(lambda z: npm.residuals(full(z), data), x0[free], jac="2-point",
+                                                 **tol), 1)
     return {"identify_poses": poses, "identify_parameters": len(res["names"]),
             "identify_free_parameters": int(free.sum()), "identify_ms": ours,
-            "identify_with_covariance_ms": ours_cov, "scipy_identify_ms": fd_ms,
+            "identify_with_covariance_ms": ours_cov, "scipy_numpy_identify_ms": np_ms,
+            "identify_speedup_vs_scipy_numpy": np_ms / ours, "scipy_numpy_identify_cost": float(npr.cost),
+            "scipy_identify_ms": fd_ms,
             "scipy_analytic_identify_ms": an_ms, "identify_speedup_vs_scipy": fd_ms / ours,
             "identify_speedup_vs_scipy_analytic": an_ms / ours, "identify_cost": res["final_cost"],
             "scipy_identify_cost": float(fd.cost), "scipy_analytic_identify_cost": float(an.cost)}

@@ -167,3 +167,25 @@ def test_observability_selection_beats_random_poses():
         out[name] = (r["observability_index"], float(np.sqrt(np.mean(e ** 2))))
     assert out["chosen"][0] > out["random"][0]
     assert out["chosen"][1] < out["random"][1]
+
+
+def test_numpy_residuals_equal_the_core():
+    """The numpy measurement model of the scipy benchmark baseline computes the core's residuals
+    (kr500, compliance, two targets, a random parameter point) to 1e-9 mm."""
+    from kincal._numpy_model import NumpyPointModel
+
+    robot = kincal.load_robot("kr500")
+    data = ident.simulate(ident.default_truth(robot, seed=1), 50, seed=1, targets=2)
+    pm = _core.PointModel(robot, 2)
+    x = np.asarray(pm.start(data))
+    rng = np.random.default_rng(0)
+    for i, n in enumerate(pm.names):
+        if n.endswith(".compliance"):
+            x[i] = 0.003
+        elif "tilt" in n or n.endswith((".rx", ".ry", ".rz")):
+            x[i] += 1e-3 * rng.normal()
+        else:
+            x[i] += rng.normal()
+    r_core = np.asarray(pm.residuals(list(x), data, False)[0])
+    r_np = NumpyPointModel(robot, 2).residuals(x, data)
+    assert np.max(np.abs(r_core - r_np)) < 1e-9

@@ -397,7 +397,7 @@ def _diagnose_fivebar(args) -> None:
 <p>{html.escape(diag['verdict'])}: cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um.</p>
 <img src="residual_map.png" alt="residual map" style="max-width:100%"></body></html>
 """)
-    _core.write_file_atomic(str(out / "diagnosis.json"), json.dumps(diag, indent=1) + "\n")
+    _core.write_file_atomic(str(out / "diagnosis.json"), json.dumps(diagnosis.contract_json(diag), indent=1) + "\n")
     for st in diag["steps"]:
         print(f"{st['effect']} {st.get('link') or st['joint']}: cross-validated RMS "
               f"{st['rms_before_mm'] * 1000:.1f} -> {st['rms_after_mm'] * 1000:.1f} um")

@@ -337,5 +337,14 @@ refits everything and checks that the cross-validated RMS ({diag['folds']} folds
 
 
 def contract_json(diag: dict) -> dict:
-    """diagnosis.json: the contract's keys and the evidence, without the fitted objects."""
-    return {k: v for k, v in diag.items() if not k.startswith("_")}
+    """diagnosis.json: the contract's keys and the evidence, without the fitted objects (an infinite
+    F statistic, from a perfect fit, is written as null: JSON has no infinity)."""
+    def clean(x):
+        if isinstance(x, float) and not math.isfinite(x):
+            return None
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v) for v in x]
+        return x
+    return clean({k: v for k, v in diag.items() if not k.startswith("_")})

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -71,6 +72,7 @@ int run_fivebar(const std::string& fit_path, const std::string& matrix_path, con
       } else {
         len = std::snprintf(buf, sizeof buf, "%.10f,%.10f", t1, t2);
       }
+      len = std::min(std::max(len, 0), static_cast<int>(sizeof buf) - 2);  // snprintf may truncate
       buf[len] = '\n';
       std::fwrite(buf, 1, static_cast<size_t>(len) + 1, stdout);
       std::fflush(stdout);

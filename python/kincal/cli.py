@@ -183,6 +183,8 @@ def cmd_identify(args) -> None:
                          progress=_progress("identify"), orientation_weight=args.orientation_weight)
     if sys.stderr.isatty():
         print(file=sys.stderr)
+    if args.tool_targets:
+        res = ident.tool_from_targets(res, _core.read_csv_columns(args.tool_targets, ["x", "y", "z"]))
     text = res.model_json()
     if args.urdf:
         cal = json.loads(text)["calibrated"]
@@ -536,6 +538,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--folds", type=int, default=0, help="k-fold cross-validation instead of a split (k >= 2)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
+    sp.add_argument("--tool-targets", metavar="CSV",
+                    help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
+                         "order): places the tool frame (TCP), which reflectors alone cannot")
     sp.add_argument("--orientation-weight", type=float, default=100.0, metavar="MM_PER_RAD",
                     help="with measured orientations (a,b,c): mm of position residual worth one rad (default 100: "
                          "0.02 mm against 0.011 deg of noise)")

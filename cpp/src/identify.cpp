@@ -201,8 +201,12 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
 
 }  // namespace
 
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target,
-                    const std::vector<EffectValue>& effects, double t_ref) {
+namespace {
+
+/// The truth's tool frame (instrument frame) at a row with every effect acting, and the thermal
+/// scale of its lengths: the one place the simulator computes where the robot really is.
+Eigen::Isometry3d truth_tool(const Model& truth, const Measurement& row, const std::vector<EffectValue>& effects,
+                             double t_ref, double& scale) {
   std::vector<Effect> eff;
   std::vector<double> p;
   for (const auto& ev : effects) {
@@ -212,9 +216,17 @@ Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& targ
   }
   const VecQ q = row.q_deg * kDeg;
   VecQ dq = VecQ::Zero(q.size());
-  double scale = 1.0;
+  scale = 1.0;
   effect_offsets(eff, p.data(), row, t_ref, dq, scale);
-  const Eigen::Isometry3d tool = fk(truth, deflected(truth, q) + dq);
+  return fk(truth, deflected(truth, q) + dq);
+}
+
+}  // namespace
+
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target,
+                    const std::vector<EffectValue>& effects, double t_ref) {
+  double scale;
+  const Eigen::Isometry3d tool = truth_tool(truth, row, effects, t_ref, scale);
   return truth.base_in_instrument() * (scale * (tool * target));
 }
 
@@ -259,13 +271,8 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
       if (opt.orientation_noise_deg >= 0) {
         // the measured tool frame (a 6-D probe): truth orientation, then a small random rotation
-        VecQ dq = VecQ::Zero(n);
-        double scale = 1.0;
-        std::vector<Effect> eff;
-        std::vector<double> pv;
-        for (const auto& ev : opt.effects) eff.push_back(ev.effect), pv.insert(pv.end(), ev.p.begin(), ev.p.end());
-        effect_offsets(eff, pv.data(), row, opt.t_ref, dq, scale);
-        const Mat3 r = truth.base_in_instrument().linear() * fk(truth, deflected(truth, q * kDeg) + dq).linear();
+        double scale;
+        const Mat3 r = truth.base_in_instrument().linear() * truth_tool(truth, row, opt.effects, opt.t_ref, scale).linear();
         const Vec3 e = Vec3(nd(rng), nd(rng), nd(rng)) * opt.orientation_noise_deg * kDeg;
         row.has_abc = true;
         row.abc = rotation_to_abc(so3_exp(e) * r);

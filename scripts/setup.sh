@@ -15,6 +15,9 @@ fi
 [ -x .venv/bin/python ] || python3 -m venv .venv
 .venv/bin/pip install -q --upgrade pip
 .venv/bin/pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" numpy scipy matplotlib pytest eaik toppra atheris mypy
+# toppra's C++ library (the double-precision peer of eq. 21 in the tests), without its Python deps
+.venv/bin/pip install -q --no-deps cmeel-toppra
 .venv/bin/pip install -q --no-build-isolation .
-cmake -S . -B build/cpp -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+PEERS="$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/cmeel.prefix"
+cmake -S . -B build/cpp -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PEERS" >/dev/null
 cmake --build build/cpp -j2

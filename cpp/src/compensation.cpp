@@ -8,6 +8,8 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "kincal/fastmath.hpp"
+
 namespace kincal {
 
 const char* to_string(CompStatus s) {
@@ -90,13 +92,14 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
         jf.col(i) = (fi - f) / opt.delta;
       }
     } else {
-      const double cb = std::cos(abc[1] * kDeg);
+      double sa, ca, sb, cb;
+      fastmath::sincos(abc[0] * kDeg, sa, ca);
+      fastmath::sincos(abc[1] * kDeg, sb, cb);
       if (std::abs(cb) < 1e-9) {
         res.status = CompStatus::OrientationSingular;
         return res;
       }
       // angular velocity w = E(a, b, c) [a', b', c'] for R = Rz(a) Ry(b) Rx(c)
-      const double sa = std::sin(abc[0] * kDeg), ca = std::cos(abc[0] * kDeg), sb = std::sin(abc[1] * kDeg);
       Mat3 einv;  // inverse of [[0, -sa, ca cb], [0, ca, sa cb], [1, 0, -sb]]
       einv << ca * sb / cb, sa * sb / cb, 1, -sa, ca, 0, ca / cb, sa / cb, 0;
       // columns per degree of q; rows mm and degrees

@@ -5,13 +5,17 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kincal/fastmath.hpp"
+
 namespace kincal {
 
 namespace {
 
 inline Mat3 rot(const Vec3& k, double t) {
   // Rodrigues, k unit
-  const double c = std::cos(t), s = std::sin(t), v = 1 - c;
+  double s, c;
+  fastmath::sincos(t, s, c);
+  const double v = 1 - c;
   Mat3 r;
   r << c + k[0] * k[0] * v, k[0] * k[1] * v - k[2] * s, k[0] * k[2] * v + k[1] * s,  //
       k[1] * k[0] * v + k[2] * s, c + k[1] * k[1] * v, k[1] * k[2] * v - k[0] * s,    //
@@ -19,30 +23,10 @@ inline Mat3 rot(const Vec3& k, double t) {
   return r;
 }
 
-// acos with tolerance: values a hair outside [-1, 1] are tangency (one solution), beyond is none.
+// Subproblems at tangency: values a hair outside [-1, 1] are one solution, beyond is none, unless
+// the nearest configuration is asked for.
 thread_local bool t_clamp = false;   // ik_all(..., nearest_if_unreachable) is running
 thread_local bool t_clamped = false;  // a subproblem was clamped to tangency
-
-inline bool safe_acos(double x, double& out, bool& tangent) {
-  constexpr double tol = 1e-10;
-  tangent = false;
-  if (!std::isfinite(x)) return false;
-  if (x > 1 + tol || x < -1 - tol) {
-    if (!t_clamp) return false;
-    t_clamped = true;
-    x = x > 0 ? 1.0 : -1.0;
-  }
-  if (x >= 1 - 1e-14) {
-    out = 0;
-    tangent = true;
-  } else if (x <= -1 + 1e-14) {
-    out = kPi;
-    tangent = true;
-  } else {
-    out = std::acos(x);
-  }
-  return true;
-}
 
 // Near the wrist singularity SP2 loses half the digits (q5 comes from a square root of a
 // difference): two Gauss-Newton steps with a pseudo-inverse restore the orientation to round-off.
@@ -63,27 +47,83 @@ void polish_wrist(const Vec3& w4, const Vec3& w5, const Vec3& w6, const Mat3& ta
   }
 }
 
-inline double wrap(double a) {  // to (-pi, pi]; a few turns at most here, so no std::remainder (slow)
+inline double wrap(double a) {  // to (-pi, pi]; the angles here are at most a few turns off
   constexpr double two_pi = 2 * kPi;
-  if (a > kPi || a <= -kPi) a -= two_pi * std::floor((a + kPi) / two_pi);
-  return a <= -kPi ? a + two_pi : (a > kPi ? a - two_pi : a);
+  if (!(std::abs(a) < 4 * two_pi)) {  // far references (and inf, NaN): the general reduction
+    a -= two_pi * std::floor((a + kPi) / two_pi);
+    return a <= -kPi ? a + two_pi : (a > kPi ? a - two_pi : a);
+  }
+  while (a > kPi) a -= two_pi;
+  while (a <= -kPi) a += two_pi;
+  return a;
 }
 
 }  // namespace
 
-double pk_sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
-  const Vec3 up = u - k * k.dot(u), vp = v - k * k.dot(v);
-  return std::atan2(k.dot(up.cross(vp)), up.dot(vp));
+namespace {
+
+// An angle with its cosine and sine, taken from the atan2 arguments that define it: the rotations
+// of the IK are built from these, with no trigonometric call.
+struct Angle {
+  double q = 0, c = 1, s = 0;
+};
+
+inline Angle from_xy(double x, double y) {
+  const double h = std::sqrt(x * x + y * y);
+  if (!(h > 0)) return Angle{};
+  const double inv = 1 / h;
+  return Angle{fastmath::atan2(y, x), x * inv, y * inv};
 }
 
-int pk_sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, double t1[2], double t2[2]) {
-  // c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|.
+inline Angle negated(const Angle& a) { return Angle{-a.q, a.c, -a.s}; }
+
+// phi + a and phi - a, a from its cosine (clamped by the caller to [-1, 1])
+inline void plus_minus(const Angle& phi, double ca, Angle& plus, Angle& minus) {
+  const double sa = std::sqrt((1 - ca) * (1 + ca));
+  const double a = fastmath::atan2(sa, ca);
+  plus = Angle{phi.q + a, phi.c * ca - phi.s * sa, phi.s * ca + phi.c * sa};
+  minus = Angle{phi.q - a, phi.c * ca + phi.s * sa, phi.s * ca - phi.c * sa};
+}
+
+// rot(k, a) v by Rodrigues, k unit
+inline Vec3 rotv(const Vec3& k, double c, double s, const Vec3& v) {
+  return c * v + s * k.cross(v) + ((1 - c) * k.dot(v)) * k;
+}
+
+// cosine of the half-angle of a subproblem, with the tolerance of safe_acos: false when none
+inline bool cos_of(double x, double& out, bool& tangent) {
+  constexpr double tol = 1e-10;
+  tangent = false;
+  if (!std::isfinite(x)) return false;
+  if (x > 1 + tol || x < -1 - tol) {
+    if (!t_clamp) return false;
+    t_clamped = true;
+  }
+  if (x >= 1 - 1e-14 || x <= -1 + 1e-14) {
+    tangent = true;
+    x = x > 0 ? 1.0 : -1.0;
+  }
+  out = x;
+  return true;
+}
+
+// Paden-Kahan subproblems on unit axes k through the origin (callers subtract the axis point).
+// SP1: theta with rot(k, theta) u = v (u, v projected on the plane normal to k):
+// cos ~ up . vp = u . v - (k.u)(k.v), sin ~ k . (up x vp) = k . (u x v).
+inline Angle sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
+  return from_xy(u.dot(v) - k.dot(u) * k.dot(v), k.dot(u.cross(v)));
+}
+
+// SP2: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v. Returns the count (0, 1 or 2).
+int sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, Angle t1[2], Angle t2[2]) {
+  // c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|; c = a k1 + b k2 +- g n
   const double k12 = k1.dot(k2);
   const double den = k12 * k12 - 1;
-  const double alpha = (k12 * k2.dot(u) - k1.dot(v)) / den;
-  const double beta = (k12 * k1.dot(v) - k2.dot(u)) / den;
-  const Vec3 k1xk2 = k1.cross(k2);
-  const double g2 = (u.squaredNorm() - alpha * alpha - beta * beta - 2 * alpha * beta * k12) / k1xk2.squaredNorm();
+  const double k2u = k2.dot(u), k1v = k1.dot(v);
+  const double alpha = (k12 * k2u - k1v) / den;
+  const double beta = (k12 * k1v - k2u) / den;
+  const Vec3 n = k1.cross(k2);
+  const double g2 = (u.squaredNorm() - alpha * alpha - beta * beta - 2 * alpha * beta * k12) / n.squaredNorm();
   const double scale = std::max(1.0, u.squaredNorm());
   if (!std::isfinite(g2)) return 0;
   if (g2 < -1e-10 * scale) {
@@ -92,55 +132,65 @@ int pk_sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, double
   }
   const double g = g2 > 0 ? std::sqrt(g2) : 0.0;
   const int count = g > 0 ? 2 : 1;
+  // both subproblem-1 solutions are linear in +-g: theta2 takes u to c about k2, theta1 takes c to v
+  // about k1 (the projections of c on the planes normal to k2 and k1 written out)
+  const Vec3 up = u - k2 * k2u, vp = v - k1 * k1v;
+  const Vec3 c0 = alpha * k1 + (beta - k2u) * k2;  // c - k2 (k2.c) without the n term
+  const double x20 = up.dot(c0), x21 = up.dot(n);
+  const double y20 = k2.dot(up.cross(c0)), y21 = k2.dot(up.cross(n));
+  const double x10 = beta * k2.dot(vp), x11 = n.dot(vp);
+  const double y10 = beta * k1.dot(k2.cross(vp)), y11 = k1.dot(n.cross(vp));
   for (int i = 0; i < count; ++i) {
-    const Vec3 c = alpha * k1 + beta * k2 + (i == 0 ? g : -g) * k1xk2;
-    t2[i] = pk_sub1(k2, u, c);
-    t1[i] = pk_sub1(k1, c, v);
+    const double sg = i == 0 ? g : -g;
+    t2[i] = from_xy(x20 + sg * x21, y20 + sg * y21);
+    t1[i] = from_xy(x10 + sg * x11, y10 + sg * y11);
   }
   return count;
 }
 
-int pk_sub3(const Vec3& k, const Vec3& u, const Vec3& v, double d, double t[2]) {
+// SP3: theta with |rot(k, theta) u - v| = d. Returns the count (0, 1 or 2).
+int sub3(const Vec3& k, const Vec3& u, const Vec3& v, double d, Angle t[2]) {
   const Vec3 up = u - k * k.dot(u), vp = v - k * k.dot(v);
   const double dz = k.dot(u - v);
   const double dp2 = d * d - dz * dz;
   const double nu = up.norm(), nv = vp.norm();
   if (nu < 1e-12 || nv < 1e-12) return 0;
-  const double theta0 = std::atan2(k.dot(up.cross(vp)), up.dot(vp));
-  double a;
+  const Angle theta0 = from_xy(up.dot(vp), k.dot(up.cross(vp)));
+  double ca;
   bool tangent;
-  if (!safe_acos((nu * nu + nv * nv - dp2) / (2 * nu * nv), a, tangent)) return 0;
-  t[0] = theta0 - a;
+  if (!cos_of((nu * nu + nv * nv - dp2) / (2 * nu * nv), ca, tangent)) return 0;
+  plus_minus(theta0, ca, t[1], t[0]);
   if (tangent) return 1;
-  t[1] = theta0 + a;
   return 2;
 }
 
-int pk_sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, double t[2]) {
+// SP4: theta with h . rot(k, theta) u = d. Returns the count (0, 1 or 2).
+int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2]) {
   // h . (k (k.u) + cos t (u - k (k.u)) + sin t (k x u)) = d
   const double A = h.dot(u - k * k.dot(u));
   const double B = h.dot(k.cross(u));
   const double C = d - h.dot(k) * k.dot(u);
-  const double r = std::hypot(A, B);
+  const double r = std::sqrt(A * A + B * B);  // mm-sized terms: no overflow
   if (r < 1e-12) return 0;
-  const double phi = std::atan2(B, A);
-  double a;
+  const Angle phi{fastmath::atan2(B, A), A / r, B / r};
+  double ca;
   bool tangent;
-  if (!safe_acos(C / r, a, tangent)) return 0;
-  t[0] = phi + a;
+  if (!cos_of(C / r, ca, tangent)) return 0;
+  plus_minus(phi, ca, t[0], t[1]);
   if (tangent) return 1;
-  t[1] = phi - a;
   return 2;
 }
+
+}  // namespace
 
 IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg,
                    bool nearest_if_unreachable, bool nearest_branch) {
   const bool greedy = nearest_branch && ref_deg != nullptr;
   // index of the candidate nearest the reference angle (deg), comparing modulo 360
-  auto nearer = [&](const double* cand, int n, int joint) {
+  auto nearer = [&](const Angle* cand, int n, int joint) {
     if (!greedy || n < 2) return 0;
     const double r = ref_deg[joint] * kDeg;
-    return std::abs(wrap(cand[1] - r)) < std::abs(wrap(cand[0] - r)) ? 1 : 0;
+    return std::abs(wrap(cand[1].q - r)) < std::abs(wrap(cand[0].q - r)) ? 1 : 0;
   };
   IkSolutions out;
   t_clamp = nearest_if_unreachable;
@@ -161,13 +211,17 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
   const Vec3 &w1 = m.axis(0), &w2 = m.axis(1), &w3 = m.axis(2), &w4 = m.axis(3), &w5 = m.axis(4),
              &w6 = m.axis(5);
   const Vec3 &p1 = m.point(0), &p2 = m.point(1), &p3 = m.point(2);
+  // The wrist rotation R456 = (R1 R2 R3)^T G is needed only applied to w6 (for q4, q5) and to a
+  // vector v normal to w6 (for q6): both are carried through the rotations as vectors.
+  const Vec3 v6 = w6.unitOrthogonal();
+  const Vec3 gw6 = gr * w6, gv6 = gr * v6;
 
   // q1: rotations about axes 2 and 3 keep the component along w2, so w2 . rot(w1, -q1)(p - p1)
   // must equal w2 . (pw - p1).
-  double t1[2];
-  const int n1 = pk_sub4(w2, w1, p - p1, w2.dot(pw - p1), t1);
+  Angle t1[2];
+  const int n1 = sub4(w2, w1, p - p1, w2.dot(pw - p1), t1);
   bool shoulder = false;
-  double q1s[2];
+  Angle q1s[2];
   int nq1 = 0;
   if (n1 == 0) {
     // wrist centre on axis 1 (shoulder singularity): any q1 satisfies it when the residual is zero
@@ -175,51 +229,53 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     const Vec3 along = w1 * w1.dot(u);
     if ((u - along).norm() < 1e-9 && std::abs(w2.dot(along) - w2.dot(pw - p1)) < 1e-9) {
       shoulder = true;
-      q1s[0] = ref_deg ? ref_deg[0] * kDeg : 0.0;
+      const double q = ref_deg ? ref_deg[0] * kDeg : 0.0;
+      q1s[0] = Angle{q, std::cos(q), std::sin(q)};
       nq1 = 1;
     }
   } else {
-    for (int i = 0; i < n1; ++i) q1s[i] = -t1[i];
+    for (int i = 0; i < n1; ++i) q1s[i] = negated(t1[i]);
     nq1 = n1;
   }
   const bool clamped1 = t_clamped;  // q1 itself came from a tangency
   const int b1 = nearer(q1s, nq1, 0);
   for (int i1 = greedy ? b1 : 0; i1 < (greedy ? std::min(b1 + 1, nq1) : nq1); ++i1) {
-    const double q1 = q1s[i1];
-    const Mat3 r1 = rot(w1, q1);
-    const Vec3 pp = r1.transpose() * (p - p1) + p1;  // e^{-xi1 q1} p
-    double t3[2];
+    const Angle& a1 = q1s[i1];
+    const Vec3 pp = rotv(w1, a1.c, -a1.s, p - p1) + p1;  // e^{-xi1 q1} p
+    const Vec3 w6_1 = rotv(w1, a1.c, -a1.s, gw6), v6_1 = rotv(w1, a1.c, -a1.s, gv6);
+    Angle t3[2];
     t_clamped = clamped1;
-    const int n3 = pk_sub3(w3, pw - p3, p2 - p3, (pp - p2).norm(), t3);
+    const int n3 = sub3(w3, pw - p3, p2 - p3, (pp - p2).norm(), t3);
     const bool clamped3 = t_clamped;  // flags of this shoulder and elbow branch only
     const int b3 = nearer(t3, n3, 2);
     for (int i3 = greedy ? b3 : 0; i3 < (greedy ? std::min(b3 + 1, n3) : n3); ++i3) {
-      const double q3 = t3[i3];
-      const Mat3 r3 = rot(w3, q3);
-      const Vec3 x = r3 * (pw - p3) + p3;
-      const double q2 = pk_sub1(w2, x - p2, pp - p2);
-      const Mat3 r123 = r1 * rot(w2, q2) * r3;
-      const Mat3 r456 = r123.transpose() * gr;
-      double t4[2], t5[2];
+      const Angle& a3 = t3[i3];
+      const Vec3 x = rotv(w3, a3.c, a3.s, pw - p3) + p3;
+      const Angle a2 = sub1(w2, x - p2, pp - p2);
+      // R456 w6 and R456 v6: rotated back by -q2, then -q3
+      const Vec3 w6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, w6_1));
+      const Vec3 v6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, v6_1));
+      Angle t4[2], t5[2];
       t_clamped = clamped3;
-      const int n45 = pk_sub2(w4, w5, w6, r456 * w6, t4, t5);
+      const int n45 = sub2(w4, w5, w6, w6_456, t4, t5);
       int b45 = 0;
       if (greedy && n45 == 2) {
         auto dist = [&](int i) {
-          return std::abs(wrap(t4[i] - ref_deg[3] * kDeg)) + std::abs(wrap(t5[i] - ref_deg[4] * kDeg));
+          return std::abs(wrap(t4[i].q - ref_deg[3] * kDeg)) + std::abs(wrap(t5[i].q - ref_deg[4] * kDeg));
         };
         b45 = dist(1) < dist(0) ? 1 : 0;
       }
       for (int i45 = greedy ? b45 : 0; i45 < (greedy ? std::min(b45 + 1, n45) : n45); ++i45) {
-        const Mat3 r5 = rot(w5, t5[i45]);
-        const Mat3 r45 = rot(w4, t4[i45]) * r5;
-        // any vector normal to w6
-        const Vec3 v = w6.unitOrthogonal();
-        const double q6 = pk_sub1(w6, v, r45.transpose() * r456 * v);
+        const Angle &a4 = t4[i45], &a5 = t5[i45];
+        // q6 takes v6 to rot(w5, -q5) rot(w4, -q4) R456 v6
+        const Angle a6 = sub1(w6, v6, rotv(w5, a5.c, -a5.s, rotv(w4, a4.c, -a4.s, v6_456)));
         IkSolution& s = out.sol[out.count];
-        double q[6] = {q1, q2, q3, t4[i45], t5[i45], q6};
-        const double wrist = w4.cross(r5 * w6).norm();  // sin of the angle between axes 4 and 6
-        if (wrist < 1e-6) polish_wrist(w4, w5, w6, r456, q + 3);
+        double q[6] = {a1.q, a2.q, a3.q, a4.q, a5.q, a6.q};
+        const double wrist = w4.cross(rotv(w5, a5.c, a5.s, w6)).norm();  // sin of the angle between axes 4 and 6
+        if (wrist < 1e-6) {
+          const Mat3 r456 = (rot(w1, a1.q) * rot(w2, a2.q) * rot(w3, a3.q)).transpose() * gr;
+          polish_wrist(w4, w5, w6, r456, q + 3);
+        }
         for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) / kDeg;
         s.wrist_singular = wrist < 1e-7;
         s.shoulder_singular = shoulder;
@@ -229,18 +285,30 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     }
   }
   // shift by 360 deg into the limits, nearest the reference
+  double lo[6], hi[6];
+  for (int j = 0; j < 6; ++j) {
+    lo[j] = m.spec().joints[j].lower_deg - 1e-9;
+    hi[j] = m.spec().joints[j].upper_deg + 1e-9;
+  }
   for (int i = 0; i < out.count; ++i) {
     IkSolution& s = out.sol[i];
     bool ok = true;
     for (int j = 0; j < 6; ++j) {
-      const auto& js = m.spec().joints[j];
-      const double ref = ref_deg ? ref_deg[j] : 0.0;
-      double best = s.q_deg[j];
+      // the whole turn nearest the reference (|k| <= 2); when it falls outside the limits, the
+      // nearest of the five that lie inside
+      const double q = s.q_deg[j], ref = ref_deg ? ref_deg[j] : 0.0;
+      const double kn = fastmath::round_nearest((ref - q) / 360.0);
+      const double c = q + 360.0 * (kn > 2 ? 2 : (kn < -2 ? -2 : kn));
+      if (c >= lo[j] && c <= hi[j]) {
+        s.q_deg[j] = c;
+        continue;
+      }
+      double best = q;
       bool found = false;
       for (int k = -2; k <= 2; ++k) {
-        const double c = s.q_deg[j] + 360.0 * k;
-        if (c < js.lower_deg - 1e-9 || c > js.upper_deg + 1e-9) continue;
-        if (!found || std::abs(c - ref) < std::abs(best - ref)) best = c;
+        const double ck = q + 360.0 * k;
+        if (ck < lo[j] || ck > hi[j]) continue;
+        if (!found || std::abs(ck - ref) < std::abs(best - ref)) best = ck;
         found = true;
       }
       s.q_deg[j] = best;

@@ -2,13 +2,16 @@
 
 #include <cmath>
 
+#include "kincal/fastmath.hpp"
+
 namespace kincal {
 
 namespace {
 
 // T <- T * Rz(q): mixes the first two columns of the rotation.
 inline void rotate_z(Mat3& r, double q) {
-  const double c = std::cos(q), s = std::sin(q);
+  double s, c;
+  fastmath::sincos(q, s, c);
   const Vec3 x = r.col(0), y = r.col(1);
   r.col(0) = c * x + s * y;
   r.col(1) = c * y - s * x;

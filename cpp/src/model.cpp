@@ -1,5 +1,7 @@
 #include "kincal/model.hpp"
 
+#include "kincal/fastmath.hpp"
+
 #include <kdl/chain.hpp>
 #include <kdl/frames.hpp>
 #include <nlohmann/json.hpp>
@@ -21,14 +23,14 @@ Mat3 abc_to_rotation(const Vec3& abc) {
 Vec3 rotation_to_abc(const Mat3& r) {
   // the entries of a rotation are at most 1: a plain square root is safe (and much faster than hypot)
   const double cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
-  const double b = std::atan2(-r(2, 0), cb);
+  const double b = fastmath::atan2(-r(2, 0), cb);
   double a, c;
   if (cb < 1e-12) {  // gimbal lock: put everything in a
     c = 0;
-    a = std::atan2(-r(0, 1), r(1, 1));
+    a = fastmath::atan2(-r(0, 1), r(1, 1));
   } else {
-    a = std::atan2(r(1, 0), r(0, 0));
-    c = std::atan2(r(2, 1), r(2, 2));
+    a = fastmath::atan2(r(1, 0), r(0, 0));
+    c = fastmath::atan2(r(2, 1), r(2, 2));
   }
   return Vec3(a, b, c) / kDeg;
 }

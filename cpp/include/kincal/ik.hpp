@@ -10,16 +10,6 @@
 
 namespace kincal {
 
-// Paden-Kahan subproblems on unit axes k through the origin (callers subtract the axis point).
-/// SP1: theta with rot(k, theta) u = v (u, v projected on the plane normal to k).
-double pk_sub1(const Vec3& k, const Vec3& u, const Vec3& v);
-/// SP2: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v. Returns the count (0, 1 or 2).
-int pk_sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, double t1[2], double t2[2]);
-/// SP3: theta with |rot(k, theta) u - v| = d. Returns the count (0, 1 or 2).
-int pk_sub3(const Vec3& k, const Vec3& u, const Vec3& v, double d, double t[2]);
-/// SP4: theta with h . rot(k, theta) u = d. Returns the count (0, 1 or 2).
-int pk_sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, double t[2]);
-
 enum class IkStatus { Ok, OutOfReach, Unsupported };
 
 struct IkSolution {

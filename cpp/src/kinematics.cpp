@@ -45,23 +45,33 @@ Eigen::Isometry3d fk(const Model& m, const VecQ& q) {
   return out;
 }
 
-void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac) {
-  const int n = m.dof();
-  std::array<Vec3, kMaxJoints> z, o;
+void fk_frames(const Model& m, const VecQ& q, ChainFrames& f) {
   Mat3 r;
   Vec3 t;
   walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
-    z[j] = rj.col(2);
-    o[j] = tj;
+    f.z[j] = rj.col(2);
+    f.o[j] = tj;
   });
-  jac.resize(6, n);
-  for (int j = 0; j < n; ++j) {
-    jac.block<3, 1>(0, j) = z[j].cross(t - o[j]);
-    jac.block<3, 1>(3, j) = z[j];
+  f.n = m.dof();
+  f.tool.linear() = r;
+  f.tool.translation() = t;
+  f.tool.makeAffine();
+}
+
+void jacobian_from(const ChainFrames& f, Jac& jac) {
+  const Vec3 t = f.tool.translation();
+  jac.resize(6, f.n);
+  for (int j = 0; j < f.n; ++j) {
+    jac.block<3, 1>(0, j) = f.z[j].cross(t - f.o[j]);
+    jac.block<3, 1>(3, j) = f.z[j];
   }
-  tool.linear() = r;
-  tool.translation() = t;
-  tool.makeAffine();
+}
+
+void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac) {
+  ChainFrames f;
+  fk_frames(m, q, f);
+  jacobian_from(f, jac);
+  tool = f.tool;
 }
 
 void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {

@@ -10,6 +10,19 @@ namespace kincal {
 /// Tool pose in the base frame (rigid model: no compliance).
 Eigen::Isometry3d fk(const Model& m, const VecQ& q);
 
+/// The joint frames of one FK pass: axis z_j and origin o_j of every joint (base frame) and the tool.
+struct ChainFrames {
+  std::array<Vec3, kMaxJoints> z, o;
+  Eigen::Isometry3d tool;
+  int n = 0;
+};
+
+/// FK keeping the joint frames, so that the Jacobian can follow only when it is needed.
+void fk_frames(const Model& m, const VecQ& q, ChainFrames& f);
+
+/// The geometric Jacobian (as fk_jacobian) from the frames of fk_frames.
+void jacobian_from(const ChainFrames& f, Jac& jac);
+
 /// Geometric Jacobian 6xN at the tool point: rows 0-2 linear velocity (mm/rad), rows 3-5 angular
 /// velocity, both in the base frame (the same convention as KDL::ChainJntToJacSolver).
 void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac);

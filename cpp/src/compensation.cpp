@@ -46,6 +46,7 @@ inline VecQ to_rad(const Q6& q) { return q * kDeg; }
 // 6 x 6 system (unrolled by the compiler: about a third of the time of the general LU); returns |det a|.
 inline double solve6(Mat6 a, Vec6& b) {
   double det = 1;
+#pragma GCC unroll 6
   for (int k = 0; k < 6; ++k) {
     int p = k;
     for (int i = k + 1; i < 6; ++i)
@@ -58,14 +59,18 @@ inline double solve6(Mat6 a, Vec6& b) {
     det *= piv;
     if (piv == 0) return 0;
     const double inv = 1 / piv;
+#pragma GCC unroll 6
     for (int i = k + 1; i < 6; ++i) {
       const double l = a(i, k) * inv;
+#pragma GCC unroll 6
       for (int j = k + 1; j < 6; ++j) a(i, j) -= l * a(k, j);
       b[i] -= l * b[k];
     }
   }
+#pragma GCC unroll 6
   for (int k = 5; k >= 0; --k) {
     double v = b[k];
+#pragma GCC unroll 6
     for (int j = k + 1; j < 6; ++j) v -= a(k, j) * b[j];
     b[k] = v / a(k, k);
   }

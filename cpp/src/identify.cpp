@@ -187,7 +187,9 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
   for (const Effect& e : eff) {
     if (e.name == "transmission_error") {
       const double qj = m.q_deg[e.joint] * kDeg;
-      dq[e.joint] += p[0] * std::sin(qj) + p[1] * std::cos(qj) + p[2] * std::sin(2 * qj) + p[3] * std::cos(2 * qj);
+      double s1, c1;
+      fastmath::sincos(qj, s1, c1);
+      dq[e.joint] += p[0] * s1 + p[1] * c1 + p[2] * (2 * s1 * c1) + p[3] * (c1 * c1 - s1 * s1);
     } else if (e.name == "backlash") {
       if (m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
       dq[e.joint] += p[0] * m.dir[e.joint];
@@ -407,7 +409,7 @@ void PointModel::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& g
   gr[0].setIdentity();
   gt[0].setZero();
   for (int j = 0; j < layout_.dof; ++j) {
-    const Mat3 e = Eigen::AngleAxisd(q[j], w_[j]).toRotationMatrix();
+    const Mat3 e = axis_rotation(w_[j], q[j]);
     const Vec3 et = p_[j] - e * p_[j];
     gr[j + 1] = gr[j] * e;
     gt[j + 1] = gr[j] * et + gt[j];
@@ -616,7 +618,9 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
     const int c = layout_.effect_offset[e];
     if (ef.name == "transmission_error") {
       const double qj = q[ef.joint];
-      const double b[4] = {std::sin(qj), std::cos(qj), std::sin(2 * qj), std::cos(2 * qj)};
+      double s1, c1;
+      fastmath::sincos(qj, s1, c1);
+      const double b[4] = {s1, c1, 2 * s1 * c1, c1 * c1 - s1 * s1};  // sin, cos of q and 2q
       for (int k = 0; k < 4; ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
       if (ang)
         for (int k = 0; k < 4; ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];

@@ -1,5 +1,7 @@
 #include "kincal/ik.hpp"
 
+#include "kincal/kinematics.hpp"
+
 #include <Eigen/Cholesky>
 
 #include <algorithm>
@@ -11,17 +13,7 @@ namespace kincal {
 
 namespace {
 
-inline Mat3 rot(const Vec3& k, double t) {
-  // Rodrigues, k unit
-  double s, c;
-  fastmath::sincos(t, s, c);
-  const double v = 1 - c;
-  Mat3 r;
-  r << c + k[0] * k[0] * v, k[0] * k[1] * v - k[2] * s, k[0] * k[2] * v + k[1] * s,  //
-      k[1] * k[0] * v + k[2] * s, c + k[1] * k[1] * v, k[1] * k[2] * v - k[0] * s,    //
-      k[2] * k[0] * v - k[1] * s, k[2] * k[1] * v + k[0] * s, c + k[2] * k[2] * v;
-  return r;
-}
+inline Mat3 rot(const Vec3& k, double t) { return axis_rotation(k, t); }
 
 // Subproblems at tangency: values a hair outside [-1, 1] are one solution, beyond is none, unless
 // the nearest configuration is asked for.

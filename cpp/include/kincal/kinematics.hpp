@@ -3,9 +3,22 @@
 // Nothing here allocates: every buffer has a fixed maximum size.
 #pragma once
 
+#include "kincal/fastmath.hpp"
 #include "kincal/model.hpp"
 
 namespace kincal {
+
+/// Rotation by angle q (rad) about the unit axis k (Rodrigues), with the hot paths' sine and cosine.
+inline Mat3 axis_rotation(const Vec3& k, double q) {
+  double s, c;
+  fastmath::sincos(q, s, c);
+  const double v = 1 - c;
+  Mat3 r;
+  r << c + k[0] * k[0] * v, k[0] * k[1] * v - k[2] * s, k[0] * k[2] * v + k[1] * s,  //
+      k[1] * k[0] * v + k[2] * s, c + k[1] * k[1] * v, k[1] * k[2] * v - k[0] * s,    //
+      k[2] * k[0] * v - k[1] * s, k[2] * k[1] * v + k[0] * s, c + k[2] * k[2] * v;
+  return r;
+}
 
 /// Tool pose in the base frame (rigid model: no compliance).
 Eigen::Isometry3d fk(const Model& m, const VecQ& q);

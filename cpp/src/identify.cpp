@@ -474,9 +474,22 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
     J.col(col) += rb_ * dx;
     if (jac_rot) W.col(col) += rb_ * dw;
   };
+  // Every torque change below is linear in the motion (go, gv) of line i and (dom, dv) of the links
+  // beyond it; the vectors it is dotted with depend on the pose only and are formed once:
+  // B_j = g x wc_j, C_j = wc_j x (arm_j x g), A_j = C_j + arm_j x B_j.
+  std::array<Vec3, kMaxJoints> A, B, C, OB;
+  for (int j : layout_.loaded) {
+    B[j] = g.cross(wc[j]);
+    C[j] = wc[j].cross(arm[j].cross(g));
+    A[j] = C[j] + arm[j].cross(B[j]);
+    OB[j] = oc[j].cross(B[j]);
+  }
   for (int i = 0; i < n; ++i) {
     const Vec3 wraw = nominal_.axis(i) + x_[4 * i] * u_[i] + x_[4 * i + 1] * v_[i];
     const double nn = wraw.norm();
+    std::array<Vec3, kMaxJoints> SB;  // S_i x B_j for the joints up to i
+    for (int j : layout_.loaded)
+      if (j <= i) SB[j] = S[i].cross(B[j]);
     for (int c = 0; c < 4; ++c) {
       const Vec3& d = (c % 2 == 0) ? u_[i] : v_[i];
       Vec3 om, v;
@@ -494,13 +507,14 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
       std::array<double, kMaxJoints> dtau{};
       for (int j : layout_.loaded) {
         if (j > i) {
-          dtau[j] = dom.cross(wc[j]).dot(arm[j].cross(g)) + wc[j].dot(dom.cross(arm[j]).cross(g));
+          // dom x wc_j . (arm_j x g) + wc_j . ((dom x arm_j) x g)
+          dtau[j] = dom.dot(A[j]);
         } else if (j == i) {
-          const Vec3 darm = M[j] * dv + dom.cross(S[j]) - M[j] * (gv + go.cross(oc[j]));
-          dtau[j] = go.cross(wc[j]).dot(arm[j].cross(g)) + wc[j].dot(darm.cross(g));
+          // go x wc_j . (arm_j x g) + wc_j . (darm x g), darm = M_j dv + dom x S_j - M_j (gv + go x oc_j)
+          dtau[j] = go.dot(C[j]) + M[j] * (dv - gv).dot(B[j]) + dom.dot(SB[j]) - M[j] * go.dot(OB[j]);
         } else {
-          const Vec3 darm = M[i] * dv + dom.cross(S[i]);
-          dtau[j] = wc[j].dot(darm.cross(g));
+          // wc_j . (darm x g), darm = M_i dv + dom x S_i
+          dtau[j] = M[i] * dv.dot(B[j]) + dom.dot(SB[j]);
         }
       }
       apply(4 * i + c, dtau);

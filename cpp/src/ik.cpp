@@ -50,10 +50,6 @@ inline double wrap(double a) {  // to (-pi, pi]; the angles here are at most a f
   return a;
 }
 
-}  // namespace
-
-namespace {
-
 // An angle with its cosine and sine, taken from the atan2 arguments that define it: the rotations
 // of the IK are built from these, with no trigonometric call.
 struct Angle {
@@ -82,7 +78,8 @@ inline Vec3 rotv(const Vec3& k, double c, double s, const Vec3& v) {
   return c * v + s * k.cross(v) + ((1 - c) * k.dot(v)) * k;
 }
 
-// cosine of the half-angle of a subproblem, with the tolerance of safe_acos: false when none
+// the cosine of a subproblem's angle: a hair outside [-1, 1] is tangency (one solution), beyond is
+// none (false) unless the nearest configuration is asked for
 inline bool cos_of(double x, double& out, bool& tangent) {
   constexpr double tol = 1e-10;
   tangent = false;

@@ -28,6 +28,9 @@ void define_kinematics(py::module_& m) {
       "abc_to_rotation", [](const Eigen::Vector3d& abc) { return Eigen::Matrix3d(abc_to_rotation(abc)); },
       py::arg("abc_deg"), "Rotation matrix of KUKA ABC angles (deg): Rz(a) Ry(b) Rx(c)");
   m.def(
+      "rotation_to_abc", [](const Eigen::Matrix3d& r) { return Eigen::Vector3d(rotation_to_abc(r)); },
+      py::arg("rotation"), "KUKA ABC angles (deg) of a rotation matrix (the inverse of abc_to_rotation)");
+  m.def(
       "fk",
       [](const Robot& r, const Rows& q_deg, bool calibrated, bool instrument) {
         const Model& md = pick(r, calibrated);

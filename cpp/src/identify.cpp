@@ -201,10 +201,6 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
   }
 }
 
-}  // namespace
-
-namespace {
-
 /// The truth's tool frame (instrument frame) at a row with every effect acting, and the thermal
 /// scale of its lengths: the one place the simulator computes where the robot really is.
 Eigen::Isometry3d truth_tool(const Model& truth, const Measurement& row, const std::vector<EffectValue>& effects,

@@ -13,8 +13,6 @@ namespace kincal {
 
 namespace {
 
-inline Mat3 rot(const Vec3& k, double t) { return axis_rotation(k, t); }
-
 // Subproblems at tangency: values a hair outside [-1, 1] are one solution, beyond is none, unless
 // the nearest configuration is asked for.
 thread_local bool t_clamp = false;   // ik_all(..., nearest_if_unreachable) is running
@@ -24,8 +22,8 @@ thread_local bool t_clamped = false;  // a subproblem was clamped to tangency
 // difference): two Gauss-Newton steps with a pseudo-inverse restore the orientation to round-off.
 void polish_wrist(const Vec3& w4, const Vec3& w5, const Vec3& w6, const Mat3& target, double* q) {
   for (int it = 0; it < 2; ++it) {
-    const Mat3 r4 = rot(w4, q[0]), r45 = r4 * rot(w5, q[1]);
-    const Mat3 r = r45 * rot(w6, q[2]);
+    const Mat3 r4 = axis_rotation(w4, q[0]), r45 = r4 * axis_rotation(w5, q[1]);
+    const Mat3 r = r45 * axis_rotation(w6, q[2]);
     const Eigen::AngleAxisd e(target * r.transpose());
     const Vec3 err = e.axis() * e.angle();
     Mat3 j;
@@ -262,7 +260,7 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
         double q[6] = {a1.q, a2.q, a3.q, a4.q, a5.q, a6.q};
         const double wrist = w4.cross(rotv(w5, a5.c, a5.s, w6)).norm();  // sin of the angle between axes 4 and 6
         if (wrist < 1e-6) {
-          const Mat3 r456 = (rot(w1, a1.q) * rot(w2, a2.q) * rot(w3, a3.q)).transpose() * gr;
+          const Mat3 r456 = (axis_rotation(w1, a1.q) * axis_rotation(w2, a2.q) * axis_rotation(w3, a3.q)).transpose() * gr;
           polish_wrist(w4, w5, w6, r456, q + 3);
         }
         for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) / kDeg;

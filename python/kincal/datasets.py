@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _core
+
 UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
              "wrist_3_joint"]
 
@@ -44,7 +46,6 @@ def read_ipa(path: str | Path, orientation: bool = False) -> dict:
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{path}: row {bad + 2}: not a finite number")
     n = len(a)
-    abc = np.array([_abc_of_xyz_intrinsic(*np.radians(r)) for r in a[:, 10:13]])
     out = {
         "pose": np.arange(n, dtype=np.int32),
         "q_deg": np.degrees(a[:, :6]),
@@ -56,16 +57,14 @@ def read_ipa(path: str | Path, orientation: bool = False) -> dict:
         "temperature_c": a[:, 9].copy(),
     }
     if orientation:
-        out["abc"] = abc
+        out["abc"] = np.array([_abc_of_xyz_intrinsic(*np.radians(r)) for r in a[:, 10:13]])
     return out
 
 
-def _abc_of_xyz_intrinsic(rx: float, ry: float, rz: float) -> list:
+def _abc_of_xyz_intrinsic(rx: float, ry: float, rz: float) -> np.ndarray:
     """KUKA ABC (deg) of the rotation Rx(rx) Ry(ry) Rz(rz) (intrinsic XYZ Euler angles, rad)."""
-    cx, sx, cy, sy, cz, sz = np.cos(rx), np.sin(rx), np.cos(ry), np.sin(ry), np.cos(rz), np.sin(rz)
-    rxm = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    rym = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    rzm = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    r = rxm @ rym @ rzm
-    b = np.degrees(np.arctan2(-r[2, 0], np.hypot(r[0, 0], r[1, 0])))
-    return [float(np.degrees(np.arctan2(r[1, 0], r[0, 0]))), float(b), float(np.degrees(np.arctan2(r[2, 1], r[2, 2])))]
+    # intrinsic X, Y, Z is the product Rx Ry Rz; each factor is a KUKA rotation with one angle set
+    r = (_core.abc_to_rotation(np.array([0.0, 0.0, np.degrees(rx)]))
+         @ _core.abc_to_rotation(np.array([0.0, np.degrees(ry), 0.0]))
+         @ _core.abc_to_rotation(np.array([np.degrees(rz), 0.0, 0.0])))
+    return _core.rotation_to_abc(r)

@@ -206,3 +206,25 @@ def test_tool_targets_place_the_tcp(campaign, tmp_path):
     a = kincal.fk(model, q, frame="instrument")
     b = kincal.fk(truth, q, frame="instrument")
     assert np.max(np.linalg.norm(a[:, :3] - b[:, :3], axis=1)) < 0.1
+
+
+def test_ipa_orientations_read_as_abc():
+    """Real data: series B of ../shared/data/ipa-robot-accuracy. The probe's orientation columns
+    (intrinsic XYZ Euler angles in degrees) read as KUKA ABC angles give the same rotation as
+    scipy's Rotation.from_euler('XYZ') of the file's values, to 1e-12, on every row."""
+    from scipy.spatial.transform import Rotation
+
+    from conftest import SHARED
+    from kincal import datasets
+    path = SHARED / "data" / "ipa-robot-accuracy" / "Series_B/measurements_joint_configurations.csv"
+    if not path.exists():
+        pytest.skip("the shared UR10 data are not present")
+    d = datasets.read_ipa(path, orientation=True)
+    header = path.read_text().splitlines()[0].split(";")
+    rows = [ln.split(";") for ln in path.read_text().splitlines()[1:] if ln.strip()]
+    cols = [header.index(c) for c in ("measurement_rx", "measurement_ry", "measurement_rz")]
+    eul = np.array([[float(r[c].replace(",", ".")) for c in cols] for r in rows])
+    want = Rotation.from_euler("XYZ", eul, degrees=True).as_matrix()
+    got = np.array([_core.abc_to_rotation(a) for a in d["abc"]])
+    assert len(got) == len(want) > 100
+    assert np.max(np.abs(got - want)) < 1e-12

@@ -460,15 +460,21 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
     omo = gr[k] * om;
     vo = gr[k] * v + gt[k].cross(omo);
   };
-  // effect on the point of a torque change dtau (N mm) on every loaded joint
+  // effect on the point (instrument frame) of a torque change dtau (N mm) on every loaded joint:
+  // the sum of rb K_j jp_j dtau_j, those vectors formed once per pose
+  std::array<Vec3, kMaxJoints> kp, kw;
+  for (int j : layout_.loaded) {
+    kp[j] = rb_ * jp[j] * model.compliance(j);
+    if (jac_rot) kw[j] = rb_ * jw[j] * model.compliance(j);
+  }
   auto apply = [&](int col, const std::array<double, kMaxJoints>& dtau) {
     Vec3 dx = Vec3::Zero(), dw = Vec3::Zero();
     for (int j : layout_.loaded) {
-      dx += jp[j] * (model.compliance(j) * dtau[j]);
-      dw += jw[j] * (model.compliance(j) * dtau[j]);
+      dx += kp[j] * dtau[j];
+      if (jac_rot) dw += kw[j] * dtau[j];
     }
-    J.col(col) += rb_ * dx;
-    if (jac_rot) W.col(col) += rb_ * dw;
+    J.col(col) += dx;
+    if (jac_rot) W.col(col) += dw;
   };
   // Every torque change below is linear in the motion (go, gv) of line i and (dom, dv) of the links
   // beyond it; the vectors it is dotted with depend on the pose only and are formed once:

@@ -11,6 +11,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <random>
@@ -541,18 +542,17 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
   }
 }
 
-Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
-  const Model& model = model_for(m.payload_kg);
+void PointModel::row_frames(const Model& model, const Measurement& m, GravityState& gs,
+                            std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt,
+                            double& scale) const {
   const int n = layout_.dof;
-  const VecQ q = m.q_deg * kDeg;
-  VecQ qe = q;
-  GravityState gs;
+  VecQ qe = m.q_deg * kDeg;
   const bool torque = !layout_.loaded.empty();
   if (torque) {
     gravity_state(model, m, gs);
     for (int j = 0; j < n; ++j) qe[j] += model.compliance(j) * gs.tau[j];
   }
-  double scale = 1.0;
+  scale = 1.0;
   const bool effects = !layout_.effect_list.empty();
   if (effects) {
     VecQ dq = VecQ::Zero(n);
@@ -560,13 +560,55 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
     qe += dq;
   }
   // G_j = exp(xi_1 qe_1) ... exp(xi_j qe_j), G_0 = identity
-  std::array<Mat3, kMaxJoints + 1> gr;
-  std::array<Vec3, kMaxJoints + 1> gt;
   if (torque && !model.has_compliance() && !effects) {
     gr = gs.gr;
     gt = gs.gt;
   } else {
     chain_frames(qe, gr, gt);
+  }
+}
+
+void PointModel::set_frames_only(bool on, const MeasurementSet* data) {
+  frames_only_ = on;
+  flange_.clear();
+  flange_rows_ = nullptr;
+  if (!on || !data || data->rows.empty()) return;
+  const int n = layout_.dof;
+  flange_.resize(data->rows.size());
+  for (size_t i = 0; i < data->rows.size(); ++i) {
+    const Measurement& m = data->rows[i];
+    GravityState gs;
+    std::array<Mat3, kMaxJoints + 1> gr;
+    std::array<Vec3, kMaxJoints + 1> gt;
+    row_frames(model_for(m.payload_kg), m, gs, gr, gt, flange_[i].scale);
+    flange_[i].r = gr[n];
+    flange_[i].t = gt[n];
+  }
+  flange_rows_ = data->rows.data();
+}
+
+const PointModel::Flange* PointModel::cached_flange(const Measurement& m) const {
+  if (flange_.empty()) return nullptr;
+  const auto a = reinterpret_cast<std::uintptr_t>(&m), b = reinterpret_cast<std::uintptr_t>(flange_rows_);
+  if (a < b || (a - b) % sizeof(Measurement) != 0) return nullptr;
+  const size_t i = (a - b) / sizeof(Measurement);
+  return i < flange_.size() ? &flange_[i] : nullptr;
+}
+
+Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
+  const Model& model = model_for(m.payload_kg);
+  const int n = layout_.dof;
+  const VecQ q = m.q_deg * kDeg;
+  GravityState gs;
+  double scale;
+  std::array<Mat3, kMaxJoints + 1> gr;
+  std::array<Vec3, kMaxJoints + 1> gt;
+  if (const Flange* f = frames_only_ ? cached_flange(m) : nullptr) {
+    gr[n] = f->r;  // only the flange frame is read on the frames-only path
+    gt[n] = f->t;
+    scale = f->scale;
+  } else {
+    row_frames(model, m, gs, gr, gt, scale);
   }
   const Vec3 tkv(x_[layout_.targets + 3 * m.target], x_[layout_.targets + 3 * m.target + 1],
                  x_[layout_.targets + 3 * m.target + 2]);
@@ -994,7 +1036,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     AllRows all1(pm, data, x, frames, opt.orientation_weight);
     ceres::Problem p1(problem_options(all1));
     std::unique_ptr<ceres::LossFunction> loss1 = make_loss(opt);
-    pm.set_frames_only(true);  // only the base and target columns are needed here
+    pm.set_params(x);
+    pm.set_frames_only(true, &data);  // only the base and target columns are needed here
     solve(p1, all1, loss1.get(), opt, s1, false);
     pm.set_frames_only(false);
     res.nominal_x = x;

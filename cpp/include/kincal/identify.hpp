@@ -122,7 +122,9 @@ class PointModel {
   /// The current geometry as a model spec (base_in_instrument and tool included).
   ModelSpec spec() const;
   /// Jacobian columns of the base frame and targets only (the others left zero), for fitting the frames.
-  void set_frames_only(bool on) { frames_only_ = on; }
+  /// With the data, every row's flange frame is computed here once and reused while only the frames
+  /// move (set_params must not change the robot's own parameters until it is switched off).
+  void set_frames_only(bool on, const MeasurementSet* data = nullptr);
   /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.
   /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
   /// (instrument frame) per parameter.
@@ -137,6 +139,14 @@ class PointModel {
   std::vector<Vec3> u_, v_;
   std::vector<double> x_;
   bool frames_only_ = false;
+  struct Flange {
+    Mat3 r;
+    Vec3 t;
+    double scale;
+  };
+  std::vector<Flange> flange_;          ///< per row of flange_rows_, while frames_only_
+  const Measurement* flange_rows_ = nullptr;
+  const Flange* cached_flange(const Measurement& m) const;
   ModelSpec spec_;
   std::shared_ptr<const Model> current_;
   std::vector<std::pair<double, std::shared_ptr<const Model>>> payload_models_;
@@ -156,6 +166,9 @@ class PointModel {
     double mp = 0;
   };
   void gravity_state(const Model& model, const Measurement& m, GravityState& gs) const;
+  /// The joint frames G_0..G_n of row m with compliance and effects acting, and the thermal scale.
+  void row_frames(const Model& model, const Measurement& m, GravityState& gs, std::array<Mat3, kMaxJoints + 1>& gr,
+                  std::array<Vec3, kMaxJoints + 1>& gt, double& scale) const;
   void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
                         const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const;
 };

@@ -820,13 +820,11 @@ class AllRows : public ceres::EvaluationCallback {
         RS_(d.orientation ? 6 : 3), w_(weight), r_(RS_ * d.rows.size()), j_(RS_ * d.rows.size() * F_) {
     for (int i : free_) z_.push_back(x_[i]);
   }
-  void PrepareForEvaluation(bool jacobians, bool new_point) override {
-    if (new_point || !valid_) {
-      for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
-      pm_.set_params(x_);
-      valid_ = false;
-    }
-    if (valid_ && (!jacobians || have_j_)) return;
+  void PrepareForEvaluation(bool jacobians, bool /*new_point*/) override {
+    // rows already evaluated at this very point (Ceres's repeated calls, or the seed) are kept
+    if (valid_ && z_ == at_ && (!jacobians || have_j_)) return;
+    for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
+    pm_.set_params(x_);
     parallel_rows(d_.rows.size(), [&](size_t i) {
       thread_local std::vector<double> full;
       if (jacobians) full.resize(6 * static_cast<size_t>(P_));
@@ -837,6 +835,17 @@ class AllRows : public ceres::EvaluationCallback {
     });
     valid_ = true;
     have_j_ = jacobians;
+    at_ = z_;
+  }
+  /// Rows already evaluated at the start point (residuals r and the full Jacobian J of every
+  /// parameter, from full_jacobian at the same x): the first evaluation reuses them.
+  void seed(const Eigen::MatrixXd& J, const std::vector<double>& r) {
+    for (size_t i = 0; i < RS_ * d_.rows.size(); ++i) {
+      r_[i] = r[i];
+      for (int k = 0; k < F_; ++k) j_[i * F_ + k] = J(static_cast<Eigen::Index>(i), free_[k]);
+    }
+    valid_ = have_j_ = true;
+    at_ = z_;
   }
   void finish() {
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
@@ -856,7 +865,7 @@ class AllRows : public ceres::EvaluationCallback {
   std::vector<int> free_;
   int P_, F_, RS_;
   double w_;
-  std::vector<double> z_, r_, j_;
+  std::vector<double> z_, r_, j_, at_;  // at_: the point r_ (and j_ if have_j_) were evaluated at
   bool valid_ = false, have_j_ = false;
 };
 
@@ -928,16 +937,19 @@ int count_poses(const MeasurementSet& d) {
   return static_cast<int>(ids.size());
 }
 
-/// Full identification Jacobian (3 rows per measurement) at x.
-Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std::vector<double>& x, double weight) {
+/// Full identification Jacobian (3 or 6 rows per measurement) at x; the residuals too when asked.
+Eigen::MatrixXd full_jacobian(PointModel& pm, const MeasurementSet& d, const std::vector<double>& x, double weight,
+                              std::vector<double>* residuals = nullptr) {
   pm.set_params(x);
   const int P = pm.layout().size, RS = d.orientation ? 6 : 3;
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(RS * d.rows.size(), P);
+  if (residuals) residuals->assign(RS * d.rows.size(), 0.0);
   parallel_rows(d.rows.size(), [&](size_t i) {
     thread_local std::vector<double> full, r(6);
     full.resize(6 * static_cast<size_t>(P));
     row_residuals(pm, d.rows[i], weight, RS == 6, r.data(), full.data());
     std::copy_n(full.data(), RS * P, J.data() + RS * i * P);
+    if (residuals) std::copy_n(r.data(), RS, residuals->data() + RS * i);
   });
   return J;
 }
@@ -1055,6 +1067,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     res.nominal_rms_mm = std::sqrt(ss / data.rows.size());
   }
 
+  Eigen::MatrixXd start_jacobian;  // at the start of stage 2, also its first evaluation
+  std::vector<double> start_residuals;
   // --- identifiability: greedy selection of independent scaled columns in a preferred order, on
   // the data and on a generic campaign (random poses, the same targets): what the generic campaign
   // determines but the data do not means the data are too few or too alike ---
@@ -1137,7 +1151,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     std::vector<bool> gfixed = res.fixed;
     std::vector<std::string> greason = res.fixed_reason;
     select(full_jacobian(pm, generic, x, opt.orientation_weight), gfixed, greason);
-    select(full_jacobian(pm, data, x, opt.orientation_weight), res.fixed, res.fixed_reason);
+    start_jacobian = full_jacobian(pm, data, x, opt.orientation_weight, &start_residuals);
+    select(start_jacobian, res.fixed, res.fixed_reason);
     std::string missing;
     int n_missing = 0;
     // only what the data make exactly redundant counts (near the weak threshold the two may differ)
@@ -1161,6 +1176,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   ceres::Solver::Summary summary;
   std::unique_ptr<ceres::LossFunction> loss = make_loss(opt);
   AllRows all(pm, data, x, free_idx, opt.orientation_weight);
+  all.seed(start_jacobian, start_residuals);
   ceres::Problem problem(problem_options(all));
   solve(problem, all, loss.get(), opt, summary, true);
   res.iterations = static_cast<int>(summary.iterations.size()) - 1;

@@ -40,6 +40,34 @@ inline Vec6 deviation(const Eigen::Isometry3d& t, const Pose6& d, Vec3& abc) {
   return f;
 }
 
+// The rigid analytic path's deviation (eq. 6) with the cosines and sines of A and B that the ABC
+// rates need, read off the rotation (rotation_to_abc's formulas; its gimbal-lock branch is where
+// this path stops with OrientationSingular, so it is not needed here).
+struct AbcTrig {
+  double ca, sa, cb, sb;
+};
+inline Vec6 deviation_trig(const Eigen::Isometry3d& t, const Pose6& d, AbcTrig& tr) {
+  const Mat3& r = t.linear();
+  tr.cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
+  tr.sb = -r(2, 0);
+  Vec3 abc;
+  if (tr.cb < 1e-12) {
+    abc = rotation_to_abc(r);
+    tr.ca = 1;
+    tr.sa = 0;
+  } else {
+    const double inv = 1 / tr.cb;
+    tr.ca = r(0, 0) * inv;
+    tr.sa = r(1, 0) * inv;
+    abc << fastmath::atan2(r(1, 0), r(0, 0)), fastmath::atan2(tr.sb, tr.cb), fastmath::atan2(r(2, 1), r(2, 2));
+    abc *= 1 / kDeg;
+  }
+  Vec6 f;
+  f.head<3>() = t.translation() - d.xyz;
+  for (int i = 0; i < 3; ++i) f[3 + i] = wrap180(abc[i] - d.abc[i]);
+  return f;
+}
+
 inline VecQ to_rad(const Q6& q) { return q * kDeg; }
 
 // Solves a x = b in place (b becomes x) by Gaussian elimination with partial pivoting on the fixed
@@ -84,6 +112,57 @@ Vec6 pose_deviation(const Model& cal, const Q6& q_deg, const Pose6& desired) {
   return deviation(fk_compliant(cal, to_rad(q_deg)), desired, abc);
 }
 
+namespace {
+
+// The default path (analytic Jacobian, no compliance) in fixed sizes: the Jacobian follows from the
+// frames of the FK only when another step is needed, the ABC rates from the rotation itself.
+CompensationResult compensate_rigid(const Model& cal, const Pose6& desired, const Q6& q0_deg,
+                                    const CompensationOptions& opt) {
+  CompensationResult res;
+  Q6 q = q0_deg;
+  ChainFrames frames;
+  VecQ qr(6);
+  for (int it = 0;; ++it) {
+    qr = q * kDeg;
+    fk_frames(cal, qr, frames);
+    AbcTrig tr;
+    Vec6 f = deviation_trig(frames.tool, desired, tr);
+    const double f2 = f.squaredNorm();
+    auto finish = [&](CompStatus status) {
+      res.q_deg = q;
+      res.iterations = it;
+      res.residual = std::sqrt(f2);
+      res.position_error_mm = f.head<3>().norm();
+      res.orientation_error_deg = f.tail<3>().norm();
+      res.status = status;
+      return res;
+    };
+    if (f2 < opt.epsilon) return finish(CompStatus::Converged);
+    if (it >= opt.max_iterations) return finish(CompStatus::NotConverged);
+    if (std::abs(tr.cb) < 1e-9) return finish(CompStatus::OrientationSingular);
+    // angular velocity w = E(a, b, c) [a', b', c'] for R = Rz(a) Ry(b) Rx(c); rows of E^-1:
+    // [ca sb/cb, sa sb/cb, 1], [-sa, ca, 0], [ca/cb, sa/cb, 0]; columns per degree of q
+    const double icb = 1 / tr.cb;
+    const double e0 = tr.ca * tr.sb * icb, e1 = tr.sa * tr.sb * icb, e2 = tr.ca * icb, e3 = tr.sa * icb;
+    const Vec3 tip = frames.tool.translation();
+    Mat6 jf;
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      const Vec3& z = frames.z[j];
+      jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * kDeg;
+      jf(3, j) = e0 * z[0] + e1 * z[1] + z[2];
+      jf(4, j) = -tr.sa * z[0] + tr.ca * z[1];
+      jf(5, j) = e2 * z[0] + e3 * z[1];
+    }
+    Vec6 step = f;
+    const double det = solve6(jf, step);
+    if (!(det > 1e-18) || !std::isfinite(det) || !step.allFinite()) return finish(CompStatus::SingularJacobian);
+    q -= step;
+  }
+}
+
+}  // namespace
+
 CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& q0_deg, const CompensationOptions& opt) {
   CompensationResult res;
   res.q_deg = q0_deg;
@@ -91,6 +170,7 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
     res.status = CompStatus::NotSixJoints;
     return res;
   }
+  if (!opt.finite_difference && !cal.has_compliance()) return compensate_rigid(cal, desired, q0_deg, opt);
   Q6 q = q0_deg;
   Eigen::Isometry3d t;
   Jac jg;

@@ -248,9 +248,11 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
     q0 = s.sol[k].q_deg;
     approximate_start = s.sol[k].approximate;
     if (opt.compensate && opt.corrected_start && robot.identified()) {
-      // one fixed-point step: the nominal IK of the target corrected by the model difference at q0
+      // one fixed-point step: the nominal IK of the target corrected by the model difference at q0,
+      // e = FK_nom(q0)^-1 FK_cal(q0), where FK_nom(q0) is the target itself unless q0 only came near it
       const VecQ a = q0 * kDeg;
-      const Eigen::Isometry3d e = fk(nom, a).inverse() * fk_compliant(cal, a);
+      const Eigen::Isometry3d at_q0 = approximate_start ? fk(nom, a) : target;
+      const Eigen::Isometry3d e = at_q0.inverse() * fk_compliant(cal, a);
       const IkSolutions s2 = ik_all(nom, target * e.inverse(), q0.data(), false, true);
       const int k2 = ik_nearest(nom, s2, q0.data());
       if (k2 >= 0) q0 = s2.sol[k2].q_deg;

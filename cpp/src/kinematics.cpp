@@ -8,8 +8,8 @@ namespace kincal {
 
 namespace {
 
-// T <- T * Rz(q): mixes the first two columns of the rotation.
-inline void rotate_z(Mat3& r, double q) {
+// R <- R * Rz(q): mixes the first two columns of the rotation.
+[[gnu::always_inline]] inline void rotate_z(Mat3& r, double q) {
   double s, c;
   fastmath::sincos(q, s, c);
   const Vec3 x = r.col(0), y = r.col(1);
@@ -17,19 +17,39 @@ inline void rotate_z(Mat3& r, double q) {
   r.col(1) = c * y - s * x;
 }
 
-// Walks the chain; calls visit(j, R, t) with the frame right after joint j's rotation.
-template <class Visit>
-inline void walk(const Model& m, const VecQ& q, Mat3& r, Vec3& t, Visit&& visit) {
+// R <- R * Rx(alpha): mixes the last two columns.
+inline void rotate_x(Mat3& r, double ca, double sa) {
+  const Vec3 y = r.col(1), z = r.col(2);
+  r.col(1) = ca * y + sa * z;
+  r.col(2) = ca * z - sa * y;
+}
+
+// Walks the chain (Model::Link); calls visit(j, R, t) with the frame right after joint j's rotation.
+// N > 0: the joint count known at compile time (the loop unrolled), N = 0: m.dof().
+template <int N, class Visit>
+inline void walk_n(const Model& m, const double* q, Mat3& r, Vec3& t, Visit&& visit) {
   r = m.c0_r();
   t = m.c0_t();
-  const int n = m.dof();
+  const int n = N > 0 ? N : m.dof();
+#pragma GCC unroll 6
   for (int j = 0; j < n; ++j) {
-    rotate_z(r, q[j]);
-    visit(j, r, t);
     const Model::Link& l = m.link(j);
+    rotate_z(r, q[j] + l.offset);
+    visit(j, r, t);
     t += r * l.t;
-    r = r * l.r;
+    if (j + 1 < n)
+      rotate_x(r, l.ca, l.sa);
+    else
+      r = r * m.last_r();
   }
+}
+
+template <class Visit>
+inline void walk(const Model& m, const VecQ& q, Mat3& r, Vec3& t, Visit&& visit) {
+  if (m.dof() == 6)
+    walk_n<6>(m, q.data(), r, t, visit);
+  else
+    walk_n<0>(m, q.data(), r, t, visit);
 }
 
 }  // namespace

@@ -106,28 +106,50 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
     has_compliance_ = has_compliance_ || spec_.joints[j].compliance_deg_per_knm != 0;
   }
 
-  // Compiled evaluator: a local frame F_j along every axis; T(q) = C0 Rz(q1) C1 Rz(q2) ... Rz(qn) Cn.
+  // Compiled evaluator: a local frame F_j along every axis, T(q) = C0 Rz(q1) L1 Rz(q2) L2 ... Rz(qn) Ln
+  // with constant L_j = F_j^T F_{j+1} (L_n to the tool); then every link rotation but the last written
+  // as Rz(theta) Rx(alpha) Rz(phi) and the Rz merged into the joints: Rz(q_j) Trans(t_j) Rz(theta_j)
+  // = Rz(q_j + theta_j) Trans(Rz(-theta_j) t_j), and Rz(phi_j) Rz(q_{j+1}) = Rz(q_{j+1} + phi_j).
+  // The local frame of joint j becomes F_j Rz(theta_j), in which its link data are written.
   std::array<Mat3, kMaxJoints> fr;
   fr.fill(Mat3::Identity());
   for (int j = 0; j < n_; ++j) fr[j] = frame_along(w_[j]);
   c0_r_ = fr[0];
   c0_t_ = p_[0];
+  double carried = 0;  // phi of the previous link
   for (int j = 0; j < n_; ++j) {
     Link& l = links_[j];
-    if (j + 1 < n_) {
-      l.r = fr[j].transpose() * fr[j + 1];
-      l.t = fr[j].transpose() * (p_[j + 1] - p_[j]);
+    const bool last = j + 1 == n_;
+    const Mat3 lr = last ? Mat3(fr[j].transpose() * tool_.linear()) : Mat3(fr[j].transpose() * fr[j + 1]);
+    const Vec3 lt = fr[j].transpose() * ((last ? tool_.translation() : p_[j + 1]) - p_[j]);
+    double theta = 0, alpha = 0, phi = 0;
+    if (!last) {
+      // lr = Rz(theta) Rx(alpha) Rz(phi): the third column is (s_theta s_alpha, -c_theta s_alpha, c_alpha)
+      const double sa = std::hypot(lr(0, 2), lr(1, 2));
+      theta = sa > 0 ? std::atan2(lr(0, 2), -lr(1, 2)) : 0.0;
+      alpha = std::atan2(sa, lr(2, 2));
+      // phi from what is left, so that the product is lr to rounding even when alpha is tiny
+      const Mat3 rest = (Eigen::AngleAxisd(theta, Vec3::UnitZ()) * Eigen::AngleAxisd(alpha, Vec3::UnitX()))
+                            .toRotationMatrix()
+                            .transpose() *
+                        lr;
+      phi = std::atan2(rest(1, 0), rest(0, 0));
     } else {
-      l.r = fr[j].transpose() * tool_.linear();
-      l.t = fr[j].transpose() * (tool_.translation() - p_[j]);
+      last_r_ = lr;
     }
+    const Mat3 rz_back = Eigen::AngleAxisd(-theta, Vec3::UnitZ()).toRotationMatrix();
+    l.offset = carried + theta;
+    carried = phi;
+    l.ca = std::cos(alpha);
+    l.sa = std::sin(alpha);
+    l.t = rz_back * lt;
     const JointSpec& js = spec_.joints[j];
     l.m = js.mass_kg;
-    l.mc = js.mass_kg * (fr[j].transpose() * (js.com - p_[j]));
-    if (j + 1 == n_ && spec_.payload_kg > 0) {
+    l.mc = js.mass_kg * (rz_back * (fr[j].transpose() * (js.com - p_[j])));
+    if (last && spec_.payload_kg > 0) {
       const Vec3 pc = tool_ * spec_.payload_com;
       l.m += spec_.payload_kg;
-      l.mc += spec_.payload_kg * (fr[j].transpose() * (pc - p_[j]));
+      l.mc += spec_.payload_kg * (fr[j].transpose() * (pc - p_[j]));  // theta = 0 on the last joint
     }
   }
 

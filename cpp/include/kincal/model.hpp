@@ -107,15 +107,21 @@ class Model {
   bool within_limits_deg(const VecQ& q_deg, double tol_deg = 1e-9) const;
 
   // --- compiled evaluator data (read by kinematics.cpp) ---
+  /// T(q) = C0 * prod_j [Rz(q_j + offset_j) Trans(t_j) Rx(alpha_j)] with the last Rx replaced by the
+  /// general tool rotation: every constant link rotation split as Rz Rx Rz, the Rz parts merged into
+  /// the joint rotations (an exact rewriting of the chain, cheaper to evaluate than 3x3 products).
   struct Link {
-    Mat3 r;     ///< rotation of the constant transform after the joint
-    Vec3 t;     ///< translation of it
-    double m;   ///< mass carried by the joint's link (payload included on the last)
-    Vec3 mc;    ///< first moment m * com in the joint's local frame (kg mm)
+    double offset;   ///< added to the joint angle (rad)
+    double ca, sa;   ///< cos and sin of alpha, the rotation about x after the joint (not on the last)
+    Vec3 t;          ///< translation after the joint, in the joint's local frame (mm)
+    double m;        ///< mass carried by the joint's link (payload included on the last)
+    Vec3 mc;         ///< first moment m * com in the joint's local frame (kg mm)
   };
   const Mat3& c0_r() const { return c0_r_; }
   const Vec3& c0_t() const { return c0_t_; }
   const Link& link(int j) const { return links_[j]; }
+  /// rotation after the last joint (to the tool frame), local frame of the last joint
+  const Mat3& last_r() const { return last_r_; }
   const Vec3& gravity() const { return g_; }
   /// compliance in rad per N mm (internal unit)
   double compliance(int j) const { return k_[j]; }
@@ -133,6 +139,7 @@ class Model {
   Mat3 c0_r_;
   Vec3 c0_t_;
   std::array<Link, kMaxJoints> links_;
+  Mat3 last_r_;
   Vec3 g_;
 };
 

@@ -72,7 +72,9 @@ inline VecQ to_rad(const Q6& q) { return q * kDeg; }
 
 // Solves a x = b in place (b becomes x) by Gaussian elimination with partial pivoting on the fixed
 // 6 x 6 system, its loops unrolled by the compiler (Eigen's general LU loops at run time); returns |det a|.
-inline double solve6(Mat6 a, Vec6& b) {
+using Mat6r = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;  // row operations on contiguous memory
+
+inline double solve6(Mat6r a, Vec6& b) {
   double det = 1;
 #pragma GCC unroll 6
   for (int k = 0; k < 6; ++k) {
@@ -145,7 +147,7 @@ CompensationResult compensate_rigid(const Model& cal, const Pose6& desired, cons
     const double icb = 1 / tr.cb;
     const double e0 = tr.ca * tr.sb * icb, e1 = tr.sa * tr.sb * icb, e2 = tr.ca * icb, e3 = tr.sa * icb;
     const Vec3 tip = frames.tool.translation();
-    Mat6 jf;
+    Mat6r jf;
 #pragma GCC unroll 6
     for (int j = 0; j < 6; ++j) {
       const Vec3& z = frames.z[j];
@@ -175,7 +177,7 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
   Eigen::Isometry3d t;
   Jac jg;
   Vec3 abc;
-  Mat6 jf;
+  Mat6r jf;
   ChainFrames frames;
   const bool rigid = !cal.has_compliance();
   for (int it = 0;; ++it) {

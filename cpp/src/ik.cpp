@@ -101,8 +101,10 @@ inline Angle sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
   return from_xy(u.dot(v) - k.dot(u) * k.dot(v), k.dot(u.cross(v)));
 }
 
-// SP2: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v. Returns the count (0, 1 or 2).
-int sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, Angle t1[2], Angle t2[2]) {
+// SP2: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v. Returns the count (0, 1 or 2);
+// with first_only, only the first of two solutions is written (the caller knows the second).
+int sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, Angle t1[2], Angle t2[2],
+         bool first_only) {
   // c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|; c = a k1 + b k2 +- g n
   const double k12 = k1.dot(k2);
   const double den = k12 * k12 - 1;
@@ -127,7 +129,7 @@ int sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, Angle t1[
   const double y20 = k2.dot(up.cross(c0)), y21 = k2.dot(up.cross(n));
   const double x10 = beta * k2.dot(vp), x11 = n.dot(vp);
   const double y10 = beta * k1.dot(k2.cross(vp)), y11 = k1.dot(n.cross(vp));
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < (first_only ? 1 : count); ++i) {
     const double sg = i == 0 ? g : -g;
     t2[i] = from_xy(x20 + sg * x21, y20 + sg * y21);
     t1[i] = from_xy(x10 + sg * x11, y10 + sg * y11);
@@ -244,7 +246,15 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       const Vec3 v6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, v6_1));
       Angle t4[2], t5[2];
       t_clamped = clamped3;
-      const int n45 = sub2(w4, w5, w6, w6_456, t4, t5);
+      const bool flip = st.wrist_flip;
+      const int n45 = sub2(w4, w5, w6, w6_456, t4, t5, flip);
+      if (flip && n45 == 2) {  // the other wrist: (q4 + pi, -q5, q6 + pi)
+        t4[1] = Angle{t4[0].q + kPi, -t4[0].c, -t4[0].s};
+        t5[1] = negated(t5[0]);
+      }
+      Angle a6_first;  // q6 of the first wrist solution, when the second is its flip
+      if (flip && n45 == 2)
+        a6_first = sub1(w6, v6, rotv(w5, t5[0].c, -t5[0].s, rotv(w4, t4[0].c, -t4[0].s, v6_456)));
       int b45 = 0;
       if (greedy && n45 == 2) {
         auto dist = [&](int i) {
@@ -255,11 +265,14 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       for (int i45 = greedy ? b45 : 0; i45 < (greedy ? std::min(b45 + 1, n45) : n45); ++i45) {
         const Angle &a4 = t4[i45], &a5 = t5[i45];
         // q6 takes v6 to rot(w5, -q5) rot(w4, -q4) R456 v6
-        const Angle a6 = sub1(w6, v6, rotv(w5, a5.c, -a5.s, rotv(w4, a4.c, -a4.s, v6_456)));
+        const Angle a6 = !(flip && n45 == 2) ? sub1(w6, v6, rotv(w5, a5.c, -a5.s, rotv(w4, a4.c, -a4.s, v6_456)))
+                         : i45 == 0          ? a6_first
+                                             : Angle{a6_first.q + kPi, -a6_first.c, -a6_first.s};
         IkSolution& s = out.sol[out.count];
         double q[6] = {a1.q, a2.q, a3.q, a4.q, a5.q, a6.q};
-        const double wrist = w4.cross(rotv(w5, a5.c, a5.s, w6)).norm();  // sin of the angle between axes 4 and 6
-        if (wrist < 1e-6) {
+        // sin of the angle between axes 4 and 6 (|sin q5| for a wrist with the flip)
+        const double wrist = flip ? std::abs(a5.s) : w4.cross(rotv(w5, a5.c, a5.s, w6)).norm();
+        if (wrist < 1e-3) {  // within 0.06 deg of the singularity q5 has lost digits
           const Mat3 r456 = (axis_rotation(w1, a1.q) * axis_rotation(w2, a2.q) * axis_rotation(w3, a3.q)).transpose() * gr;
           polish_wrist(w4, w5, w6, r456, q + 3);
         }

@@ -193,6 +193,8 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
     } else {
       ik_.spherical_wrist_parallel_23 = true;
       ik_.wrist_center = c;
+      ik_.wrist_flip = std::abs(w_[3].dot(w_[4])) < 1e-12 && std::abs(w_[4].dot(w_[5])) < 1e-12 &&
+                       w_[3].cross(w_[5]).norm() < 1e-12;
     }
   }
 }

@@ -96,3 +96,19 @@ TEST(FastMath, SpecialValuesAsLibm) {
   EXPECT_EQ(fm::round_nearest(-3.5), -4.0);
   EXPECT_EQ(fm::round_nearest(-0.4), 0.0);
 }
+
+// The written-out tables are long-double libm rounded to double.
+TEST(FastMath, TablesAreLibmRounded) {
+  const long double pi = 3.14159265358979323846264338327950288L;
+  namespace d = fm::detail;
+  for (int j = 0; j <= 16; ++j)
+    EXPECT_EQ(d::kSinQuadrant[j], static_cast<double>(std::sin(j * pi / 32))) << "sin(" << j << " pi/32)";
+  for (int k = 0; k <= 16; ++k)
+    EXPECT_EQ(d::kAtanSixteenths[k], static_cast<double>(std::atan(k / 16.0L))) << "atan(" << k << "/16)";
+  // the whole turn by symmetry: equal to the rounded values, with exact zeros where long-double pi
+  // leaves about 1e-19
+  for (int j = 0; j < d::kSinSteps; ++j) {
+    EXPECT_NEAR(d::kTables.s[j], static_cast<double>(std::sin(j * pi / 32)), 1e-18) << j;
+    EXPECT_NEAR(d::kTables.c[j], static_cast<double>(std::cos(j * pi / 32)), 1e-18) << j;
+  }
+}

@@ -29,8 +29,10 @@ void check_round_trip(const Model& m, const Eigen::Matrix<double, 6, 1>& q, doub
   EXPECT_TRUE(found) << "the generating configuration is not among the " << s.count << " solutions";
 }
 
-// A random robot of the class: axes 2 and 3 parallel, axes 4, 5, 6 through one point, any offsets.
-ModelSpec random_robot(std::mt19937_64& rng) {
+// A random robot of the class: axes 2 and 3 parallel, axes 4, 5, 6 through one point, any offsets;
+// with orthogonal_wrist, axis 5 normal to axes 4 and 6 and these parallel (or opposite) at zero, the
+// wrist of industrial robots, whose second wrist solution the IK takes as the flip of the first.
+ModelSpec random_robot(std::mt19937_64& rng, bool orthogonal_wrist = false) {
   std::normal_distribution<double> nd(0, 1);
   auto rv = [&] { return Vec3(nd(rng), nd(rng), nd(rng)); };
   ModelSpec s;
@@ -38,7 +40,11 @@ ModelSpec random_robot(std::mt19937_64& rng) {
   Vec3 w1 = rv().normalized(), w2 = rv().normalized();
   const Vec3 wc = rv() * 600;
   const Vec3 pts[6] = {rv() * 300, rv() * 300, rv() * 500, wc, wc, wc};
-  const Vec3 axes[6] = {w1, w2, (nd(rng) > 0 ? 1 : -1) * w2, rv().normalized(), rv().normalized(), rv().normalized()};
+  Vec3 axes[6] = {w1, w2, (nd(rng) > 0 ? 1 : -1) * w2, rv().normalized(), rv().normalized(), rv().normalized()};
+  if (orthogonal_wrist) {
+    axes[4] = axes[3].cross(rv()).normalized();
+    axes[5] = (nd(rng) > 0 ? 1 : -1) * axes[3];
+  }
   for (int j = 0; j < 6; ++j) {
     JointSpec js;
     js.point = pts[j];
@@ -69,8 +75,10 @@ TEST(Ik, AnyOffsetsRoundTrip) {
   double wp = 0, wr = 0;
   int robots = 0;
   for (int r = 0; r < 200; ++r) {
-    const Model m(random_robot(rng));
+    const bool orthogonal = r % 2 == 1;  // half with the flip-symmetric wrist, half with any wrist
+    const Model m(random_robot(rng, orthogonal));
     ASSERT_TRUE(m.ik_structure().spherical_wrist_parallel_23) << m.ik_structure().reason;
+    ASSERT_EQ(m.ik_structure().wrist_flip, orthogonal);
     ++robots;
     for (int i = 0; i < 50; ++i) {
       Eigen::Matrix<double, 6, 1> q;
@@ -79,6 +87,7 @@ TEST(Ik, AnyOffsetsRoundTrip) {
     }
   }
   EXPECT_EQ(robots, 200);
+  std::printf("FK(IK(T)) - T on 200 random robots: %.2e mm, %.2e rad\n", wp, wr);
   EXPECT_LT(wp, 1e-9);
   EXPECT_LT(wr, 1e-9);
 }

@@ -2,7 +2,7 @@
 //
 // libm's sincos and atan2 were 35% of the time of kinematics and compensation. These are table +
 // short-polynomial versions, inlined: the argument is reduced to a small remainder around a table
-// point (tables filled once from long-double libm; only pi is written out), where a few terms of the
+// point (table values from long-double libm, checked by the test), where a few terms of the
 // Taylor series are exact to below 1e-20. Results are within 3 ulp of the true values (tests/cpp
 // test_fastmath.cpp checks 4 ulp on millions of arguments, and the special values);
 // arguments outside the fast range (|x| > 1e5 for sincos, zeros, infinities, NaN) go to libm.
@@ -18,29 +18,36 @@ constexpr double kPiHi = 3.141592653589793;        // M_PI, the double nearest p
 constexpr double kPiLo = 1.2246467991473532e-16;   // pi - kPiHi
 constexpr int kSinSteps = 64;                      // table step pi / 32 over one turn
 
+// sin(j pi / 32), j = 0..16, and atan(k / 16), k = 0..16: long-double libm rounded to double
+// (tests/cpp/test_fastmath.cpp recomputes them). Written out so that no call checks an initialisation.
+constexpr double kSinQuadrant[17] = {
+    0x0p+0, 0x1.917a6bc29b42cp-4, 0x1.8f8b83c69a60bp-3, 0x1.294062ed59f06p-2, 0x1.87de2a6aea963p-2,
+    0x1.e2b5d3806f63bp-2, 0x1.1c73b39ae68c8p-1, 0x1.44cf325091dd6p-1, 0x1.6a09e667f3bcdp-1,
+    0x1.8bc806b151741p-1, 0x1.a9b66290ea1a3p-1, 0x1.c38b2f180bdb1p-1, 0x1.d906bcf328d46p-1,
+    0x1.e9f4156c62ddap-1, 0x1.f6297cff75cbp-1, 0x1.fd88da3d12526p-1, 0x1p+0};
+constexpr double kAtanSixteenths[17] = {
+    0x0p+0, 0x1.ff55bb72cfdeap-5, 0x1.fd5ba9aac2f6ep-4, 0x1.7b97b4bce5b02p-3, 0x1.f5b75f92c80ddp-3,
+    0x1.362773707ebccp-2, 0x1.6f61941e4def1p-2, 0x1.a64eec3cc23fdp-2, 0x1.dac670561bb4fp-2,
+    0x1.0657e94db30dp-1, 0x1.1e00babdefeb4p-1, 0x1.345f01cce37bbp-1, 0x1.4978fa3269ee1p-1,
+    0x1.5d58987169b18p-1, 0x1.700a7c5784634p-1, 0x1.819d0b7158a4dp-1, 0x1.921fb54442d18p-1};
+
 struct Tables {
-  double s[kSinSteps], c[kSinSteps];  // sin, cos of j pi / 32
-  double at[17];                      // atan(k / 16)
-  Tables() {
-    // sin(j pi / 32) for the first quadrant in long double (the points true to ~1e-19), the rest by
-    // symmetry so that the zeros and ones are exact
-    const long double pi = 3.14159265358979323846264338327950288L;
-    double q[17];
-    for (int j = 0; j <= 16; ++j) q[j] = j == 0 ? 0.0 : (j == 16 ? 1.0 : static_cast<double>(std::sin(j * pi / 32)));
-    for (int j = 0; j < kSinSteps; ++j) {
-      const int m = j % 32;  // sin(j pi/32) = +-sin(m pi/32), the sign flips every half turn
-      const double v = m <= 16 ? q[m] : q[32 - m];
-      s[j] = j < 32 ? v : -v;
-    }
-    for (int j = 0; j < kSinSteps; ++j) c[j] = s[(j + 16) % kSinSteps];  // cos a = sin(a + pi/2)
-    for (int k = 0; k <= 16; ++k) at[k] = std::atan(k / 16.0);
-  }
+  double s[kSinSteps], c[kSinSteps];  // sin, cos of j pi / 32 over one turn
 };
 
-inline const Tables& tables() {
-  static const Tables t;
+// the whole turn from the first quadrant by symmetry, so that the zeros and ones are exact
+constexpr Tables make_tables() {
+  Tables t{};
+  for (int j = 0; j < kSinSteps; ++j) {
+    const int m = j % 32;  // sin(j pi/32) = +-sin(m pi/32), the sign flips every half turn
+    const double v = m <= 16 ? kSinQuadrant[m] : kSinQuadrant[32 - m];
+    t.s[j] = j < 32 ? v : -v;
+  }
+  for (int j = 0; j < kSinSteps; ++j) t.c[j] = t.s[(j + 16) % kSinSteps];  // cos a = sin(a + pi/2)
   return t;
 }
+
+inline constexpr Tables kTables = make_tables();
 
 }  // namespace detail
 
@@ -60,7 +67,7 @@ inline void sincos(double x, double& s, double& c) {
     c = std::cos(x);
     return;
   }
-  const Tables& t = tables();
+  const Tables& t = kTables;
   const double k = round_nearest(x * (32 / kPiHi));
   // x - k pi/32 in three parts (Cody-Waite): c1 has 24 significant bits, so k c1 is exact
   constexpr double step = kPiHi / 32;
@@ -91,7 +98,7 @@ inline double atan2(double y, double x) {
   const double u = (t - ck) / (1 + t * ck);  // atan t = atan ck + atan u, |u| <= 1/32
   const double u2 = u * u;
   const double au = u + u * u2 * (-1.0 / 3 + u2 * (1.0 / 5 + u2 * (-1.0 / 7 + u2 * (1.0 / 9 + u2 * (-1.0 / 11)))));
-  const double atk = tables().at[k];
+  const double atk = kAtanSixteenths[k];
   double a = atk + au;
   constexpr double pio2_lo = kPiLo / 2;
   if (ay > ax) a = (kPiHi / 2 - atk) + (pio2_lo - au);  // atan(y/x) = pi/2 - atan(x/y)

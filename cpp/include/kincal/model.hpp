@@ -83,6 +83,9 @@ struct IkStructure {
   bool spherical_wrist_parallel_23 = false;  ///< axes 4,5,6 meet, axes 2,3 parallel (KUKA class)
   std::string reason;                        ///< why not, when not
   Vec3 wrist_center = Vec3::Zero();
+  /// axis 5 normal to axes 4 and 6, which are parallel at zero: the second wrist solution of every
+  /// arm solution is (q4 + 180, -q5, q6 + 180) (KUKA, ABB, FANUC wrists)
+  bool wrist_flip = false;
 };
 
 class Model {

@@ -8,10 +8,8 @@ namespace kincal {
 
 namespace {
 
-// R <- R * Rz(q): mixes the first two columns of the rotation.
-[[gnu::always_inline]] inline void rotate_z(Mat3& r, double q) {
-  double s, c;
-  fastmath::sincos(q, s, c);
+// R <- R * Rz(q) for q of cosine c and sine s: mixes the first two columns of the rotation.
+inline void rotate_z(Mat3& r, double c, double s) {
   const Vec3 x = r.col(0), y = r.col(1);
   r.col(0) = c * x + s * y;
   r.col(1) = c * y - s * x;
@@ -31,10 +29,17 @@ inline void walk_n(const Model& m, const double* q, Mat3& r, Vec3& t, Visit&& vi
   r = m.c0_r();
   t = m.c0_t();
   const int n = N > 0 ? N : m.dof();
+  // the sines and cosines of all joints first, two at a time
+  double s[kMaxJoints + 1], c[kMaxJoints + 1];
+#pragma GCC unroll 3
+  for (int j = 0; j < n; j += 2) {
+    const double a = q[j] + m.link(j).offset, b = j + 1 < n ? q[j + 1] + m.link(j + 1).offset : 0.0;
+    fastmath::sincos2(a, b, s[j], c[j], s[j + 1], c[j + 1]);
+  }
 #pragma GCC unroll 6
   for (int j = 0; j < n; ++j) {
     const Model::Link& l = m.link(j);
-    rotate_z(r, q[j] + l.offset);
+    rotate_z(r, c[j], s[j]);
     visit(j, r, t);
     t += r * l.t;
     if (j + 1 < n)

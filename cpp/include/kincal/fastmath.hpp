@@ -59,6 +59,30 @@ inline double round_nearest(double v) {
 }
 
 
+namespace detail {
+
+// The argument reduction and the two short series of sincos, for a double or a pair of doubles
+// (the same operations lane by lane: the pair's results are bit-identical to two single calls).
+template <class T>
+inline void sincos_core(T x, T& k, T& sr, T& cr1) {
+  constexpr double magic = 6755399441055744.0;  // round_nearest
+  k = (x * (32 / kPiHi) + magic) - magic;
+  // x - k pi/32 in three parts (Cody-Waite): c1 has 24 significant bits, so k c1 is exact
+  constexpr double step = kPiHi / 32;
+  constexpr double c1 = static_cast<double>(static_cast<float>(step));
+  constexpr double c2 = step - c1;
+  constexpr double c3 = kPiLo / 32;
+  const T r = ((x - k * c1) - k * c2) - k * c3;
+  const T r2 = r * r;
+  // |r| <= pi/64: the next Taylor terms are below 1e-20
+  sr = r + r * r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880))));
+  cr1 = r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 + r2 * (-1.0 / 3628800)))));
+}
+
+inline int table_index(double k) { return static_cast<int>(static_cast<long long>(k) & (kSinSteps - 1)); }
+
+}  // namespace detail
+
 /// sin(x) and cos(x); within 2 ulp of the true values for |x| <= 1e5 (libm's own beyond).
 inline void sincos(double x, double& s, double& c) {
   using namespace detail;
@@ -67,23 +91,36 @@ inline void sincos(double x, double& s, double& c) {
     c = std::cos(x);
     return;
   }
-  const Tables& t = kTables;
-  const double k = round_nearest(x * (32 / kPiHi));
-  // x - k pi/32 in three parts (Cody-Waite): c1 has 24 significant bits, so k c1 is exact
-  constexpr double step = kPiHi / 32;
-  constexpr double c1 = static_cast<double>(static_cast<float>(step));
-  constexpr double c2 = step - c1;
-  constexpr double c3 = kPiLo / 32;
-  const double r = ((x - k * c1) - k * c2) - k * c3;
-  const double r2 = r * r;
-  // |r| <= pi/64: the next Taylor terms are below 1e-20
-  const double sr = r + r * r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880))));
-  const double cr1 = r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 + r2 * (-1.0 / 3628800)))));
-  const int j = static_cast<int>(static_cast<long long>(k) & (kSinSteps - 1));
-  const double sk = t.s[j], ck = t.c[j];
+  double k, sr, cr1;
+  sincos_core(x, k, sr, cr1);
+  const int j = table_index(k);
+  const double sk = kTables.s[j], ck = kTables.c[j];
   // sin(a + r) = sin a + (sin a (cos r - 1) + cos a sin r), and the same for cos: small corrections last
   s = sk + (sk * cr1 + ck * sr);
   c = ck + (ck * cr1 - sk * sr);
+}
+
+/// sincos of two arguments at once in the two lanes of an SSE2 register (GCC/Clang vector
+/// extensions): the same results as two sincos calls at about half the instructions.
+inline void sincos2(double x0, double x1, double& s0, double& c0, double& s1, double& c1) {
+  using namespace detail;
+  if (!(std::abs(x0) <= 1e5) || !(std::abs(x1) <= 1e5)) {
+    sincos(x0, s0, c0);
+    sincos(x1, s1, c1);
+    return;
+  }
+  typedef double v2d __attribute__((vector_size(16)));
+  const v2d x = {x0, x1};
+  v2d k, sr, cr1;
+  sincos_core(x, k, sr, cr1);
+  const int j0 = table_index(k[0]), j1 = table_index(k[1]);
+  const v2d sk = {kTables.s[j0], kTables.s[j1]}, ck = {kTables.c[j0], kTables.c[j1]};
+  const v2d s = sk + (sk * cr1 + ck * sr);
+  const v2d c = ck + (ck * cr1 - sk * sr);
+  s0 = s[0];
+  s1 = s[1];
+  c0 = c[0];
+  c1 = c[1];
 }
 
 /// atan2(y, x) within 3 ulp of the true value; zeros, infinities and NaN go to libm.

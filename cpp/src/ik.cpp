@@ -101,19 +101,20 @@ inline Angle sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
   return from_xy(u.dot(v) - k.dot(u) * k.dot(v), k.dot(u.cross(v)));
 }
 
-// SP2: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v. Returns the count (0, 1 or 2);
-// with first_only, only the first of two solutions is written (the caller knows the second).
-int sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, Angle t1[2], Angle t2[2],
-         bool first_only) {
-  // c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|; c = a k1 + b k2 +- g n
-  const double k12 = k1.dot(k2);
-  const double den = k12 * k12 - 1;
-  const double k2u = k2.dot(u), k1v = k1.dot(v);
-  const double alpha = (k12 * k2u - k1v) / den;
-  const double beta = (k12 * k1v - k2u) / den;
-  const Vec3 n = k1.cross(k2);
-  const double g2 = (u.squaredNorm() - alpha * alpha - beta * beta - 2 * alpha * beta * k12) / n.squaredNorm();
-  const double scale = std::max(1.0, u.squaredNorm());
+// SP2 of the wrist: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v for the model's
+// k1 = w4, k2 = w5, u = w6 (IkStructure::Constants), v given. Returns the count (0, 1 or 2); with
+// first_only, only the first of two solutions is written (the caller knows the second).
+// c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|; c = a k1 + b k2 +- g n.
+// Both subproblem-1 solutions are linear in +-g: theta2 takes u to c about k2, theta1 takes c to v
+// about k1; with up, vp the parts of u, v normal to k2, k1 and m = k1 x n, the projections reduce to
+// dot products of v with k1, k2, n and m (the terms with a vector twice in a triple product vanish).
+int sub2_wrist(const IkStructure::Constants& k, const Vec3& k1, const Vec3& k2, const Vec3& v, Angle t1[2],
+               Angle t2[2], bool first_only) {
+  const double k1v = k1.dot(v), k2v = k2.dot(v), nv = k.n.dot(v), mv = k.m.dot(v);
+  const double alpha = (k.k12 * k.k2u - k1v) / k.den;
+  const double beta = (k.k12 * k1v - k.k2u) / k.den;
+  const double g2 = (k.u2 - alpha * alpha - beta * beta - 2 * alpha * beta * k.k12) / k.n2;
+  const double scale = std::max(1.0, k.u2);
   if (!std::isfinite(g2)) return 0;
   if (g2 < -1e-10 * scale) {
     if (!t_clamp) return 0;
@@ -121,34 +122,26 @@ int sub2(const Vec3& k1, const Vec3& k2, const Vec3& u, const Vec3& v, Angle t1[
   }
   const double g = g2 > 0 ? std::sqrt(g2) : 0.0;
   const int count = g > 0 ? 2 : 1;
-  // both subproblem-1 solutions are linear in +-g: theta2 takes u to c about k2, theta1 takes c to v
-  // about k1 (the projections of c on the planes normal to k2 and k1 written out)
-  const Vec3 up = u - k2 * k2u, vp = v - k1 * k1v;
-  const Vec3 c0 = alpha * k1 + (beta - k2u) * k2;  // c - k2 (k2.c) without the n term
-  const double x20 = up.dot(c0), x21 = up.dot(n);
-  const double y20 = k2.dot(up.cross(c0)), y21 = k2.dot(up.cross(n));
-  const double x10 = beta * k2.dot(vp), x11 = n.dot(vp);
-  const double y10 = beta * k1.dot(k2.cross(vp)), y11 = k1.dot(n.cross(vp));
+  const double x20 = alpha * k.a1 + (beta - k.k2u) * k.a2, y20 = alpha * k.b1;
+  const double x10 = beta * (k2v - k.k12 * k1v), x11 = nv, y10 = beta * nv, y11 = mv;
   for (int i = 0; i < (first_only ? 1 : count); ++i) {
     const double sg = i == 0 ? g : -g;
-    t2[i] = from_xy(x20 + sg * x21, y20 + sg * y21);
+    t2[i] = from_xy(x20 + sg * k.x21, y20 + sg * k.y21);
     t1[i] = from_xy(x10 + sg * x11, y10 + sg * y11);
   }
   return count;
 }
 
-// SP3: theta with |rot(k, theta) u - v| = d. Returns the count (0, 1 or 2).
-int sub3(const Vec3& k, const Vec3& u, const Vec3& v, double d, Angle t[2]) {
-  const Vec3 up = u - k * k.dot(u), vp = v - k * k.dot(v);
-  const double dz = k.dot(u - v);
-  const double dp2 = d * d - dz * dz;
-  const double nu = up.norm(), nv = vp.norm();
+// SP3 of the elbow: q3 with |rot(w3, q3)(pw - p3) - (p2 - p3)| = d (IkStructure::Constants).
+// Returns the count (0, 1 or 2).
+int sub3_elbow(const IkStructure::Constants& k, double d, Angle t[2]) {
+  const double dp2 = d * d - k.elbow_dz * k.elbow_dz;
+  const double nu = k.elbow_nu, nv = k.elbow_nv;
   if (nu < 1e-12 || nv < 1e-12) return 0;
-  const Angle theta0 = from_xy(up.dot(vp), k.dot(up.cross(vp)));
   double ca;
   bool tangent;
   if (!cos_of((nu * nu + nv * nv - dp2) / (2 * nu * nv), ca, tangent)) return 0;
-  plus_minus(theta0, ca, t[1], t[0]);
+  plus_minus(Angle{k.elbow_q, k.elbow_c, k.elbow_s}, ca, t[1], t[0]);
   if (tangent) return 1;
   return 2;
 }
@@ -202,7 +195,8 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
   const Vec3 &p1 = m.point(0), &p2 = m.point(1), &p3 = m.point(2);
   // The wrist rotation R456 = (R1 R2 R3)^T G is needed only applied to w6 (for q4, q5) and to a
   // vector v normal to w6 (for q6): both are carried through the rotations as vectors.
-  const Vec3 v6 = w6.unitOrthogonal();
+  const IkStructure::Constants& kc = st.k;
+  const Vec3& v6 = kc.v6;
   const Vec3 gw6 = gr * w6, gv6 = gr * v6;
 
   // q1: rotations about axes 2 and 3 keep the component along w2, so w2 . rot(w1, -q1)(p - p1)
@@ -234,7 +228,7 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     const Vec3 w6_1 = rotv(w1, a1.c, -a1.s, gw6), v6_1 = rotv(w1, a1.c, -a1.s, gv6);
     Angle t3[2];
     t_clamped = clamped1;
-    const int n3 = sub3(w3, pw - p3, p2 - p3, (pp - p2).norm(), t3);
+    const int n3 = sub3_elbow(kc, (pp - p2).norm(), t3);
     const bool clamped3 = t_clamped;  // flags of this shoulder and elbow branch only
     const int b3 = nearer(t3, n3, 2);
     for (int i3 = greedy ? b3 : 0; i3 < (greedy ? std::min(b3 + 1, n3) : n3); ++i3) {
@@ -242,12 +236,19 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       const Vec3 x = rotv(w3, a3.c, a3.s, pw - p3) + p3;
       const Angle a2 = sub1(w2, x - p2, pp - p2);
       // R456 w6 and R456 v6: rotated back by -q2, then -q3
-      const Vec3 w6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, w6_1));
-      const Vec3 v6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, v6_1));
+      Vec3 w6_456, v6_456;
+      if (kc.sigma23 != 0) {  // w3 = sigma w2 exactly: one rotation about w2 by -(q2 + sigma q3)
+        const double c = a2.c * a3.c - kc.sigma23 * a2.s * a3.s, s = a2.s * a3.c + kc.sigma23 * a2.c * a3.s;
+        w6_456 = rotv(w2, c, -s, w6_1);
+        v6_456 = rotv(w2, c, -s, v6_1);
+      } else {
+        w6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, w6_1));
+        v6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, v6_1));
+      }
       Angle t4[2], t5[2];
       t_clamped = clamped3;
       const bool flip = st.wrist_flip;
-      const int n45 = sub2(w4, w5, w6, w6_456, t4, t5, flip);
+      const int n45 = sub2_wrist(kc, w4, w5, w6_456, t4, t5, flip);
       if (flip && n45 == 2) {  // the other wrist: (q4 + pi, -q5, q6 + pi)
         t4[1] = Angle{t4[0].q + kPi, -t4[0].c, -t4[0].s};
         t5[1] = negated(t5[0]);
@@ -297,8 +298,8 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       // the whole turn nearest the reference (|k| <= 2); when it falls outside the limits, the
       // nearest of the five that lie inside
       const double q = s.q_deg[j], ref = ref_deg ? ref_deg[j] : 0.0;
-      const double kn = fastmath::round_nearest((ref - q) / 360.0);
-      const double c = q + 360.0 * (kn > 2 ? 2 : (kn < -2 ? -2 : kn));
+      const double kn = std::min(2.0, std::max(-2.0, fastmath::round_nearest((ref - q) * (1.0 / 360))));
+      const double c = q + 360.0 * kn;
       if (c >= lo[j] && c <= hi[j]) {
         s.q_deg[j] = c;
         continue;

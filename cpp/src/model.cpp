@@ -195,6 +195,39 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
       ik_.wrist_center = c;
       ik_.wrist_flip = std::abs(w_[3].dot(w_[4])) < 1e-12 && std::abs(w_[4].dot(w_[5])) < 1e-12 &&
                        w_[3].cross(w_[5]).norm() < 1e-12;
+      IkStructure::Constants& k = ik_.k;
+      k.v6 = w_[5].unitOrthogonal();
+      k.sigma23 = w_[2] == w_[1] ? 1.0 : (w_[2] == -w_[1] ? -1.0 : 0.0);
+      {  // elbow: |rot(w3, q3) u - v| = d, u = pw - p3, v = p2 - p3; up, vp their parts normal to w3
+        const Vec3& ax = w_[2];
+        const Vec3 u = c - p_[2], v = p_[1] - p_[2];
+        const Vec3 up = u - ax * ax.dot(u), vp = v - ax * ax.dot(v);
+        k.elbow_dz = ax.dot(u - v);
+        k.elbow_nu = up.norm();
+        k.elbow_nv = vp.norm();
+        const double x = up.dot(vp), y = ax.dot(up.cross(vp)), h = std::sqrt(x * x + y * y);
+        if (h > 0) {
+          k.elbow_q = std::atan2(y, x);
+          k.elbow_c = x / h;
+          k.elbow_s = y / h;
+        }
+      }
+      {  // wrist: rot(k1, t1) rot(k2, t2) u = v with k1 = w4, k2 = w5, u = w6
+        const Vec3 &k1 = w_[3], &k2 = w_[4], &u = w_[5];
+        k.k12 = k1.dot(k2);
+        k.den = k.k12 * k.k12 - 1;
+        k.k2u = k2.dot(u);
+        k.n = k1.cross(k2);
+        k.m = k1.cross(k.n);
+        k.n2 = k.n.squaredNorm();
+        k.u2 = u.squaredNorm();
+        const Vec3 up = u - k2 * k.k2u;
+        k.a1 = up.dot(k1);
+        k.a2 = up.dot(k2);
+        k.b1 = k2.dot(up.cross(k1));
+        k.x21 = up.dot(k.n);
+        k.y21 = k2.dot(up.cross(k.n));
+      }
     }
   }
 }

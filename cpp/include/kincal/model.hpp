@@ -86,6 +86,18 @@ struct IkStructure {
   /// axis 5 normal to axes 4 and 6, which are parallel at zero: the second wrist solution of every
   /// arm solution is (q4 + 180, -q5, q6 + 180) (KUKA, ABB, FANUC wrists)
   bool wrist_flip = false;
+  /// Constants of the closed form (ik.cpp), fixed by the geometry: the elbow's subproblem 3 about
+  /// axis 3 (u = wrist centre - p3, v = p2 - p3: only the distance d changes) and the wrist's
+  /// subproblem 2 (k1 = axis 4, k2 = axis 5, u = axis 6: only v changes).
+  struct Constants {
+    Vec3 v6 = Vec3::UnitX();  ///< a unit vector normal to axis 6
+    double sigma23 = 0;       ///< +-1 when axis 3 is exactly (to the bit) +-axis 2, else 0
+    double elbow_q = 0, elbow_c = 1, elbow_s = 0;  ///< angle from u to v about axis 3 (projections)
+    double elbow_nu = 0, elbow_nv = 0, elbow_dz = 0;  ///< |u|, |v| normal to axis 3; (u - v) along it
+    Vec3 n = Vec3::Zero(), m = Vec3::Zero();  ///< k1 x k2, k1 x n
+    double k12 = 0, den = -1, k2u = 0, u2 = 1, n2 = 1;  ///< k1.k2, k12^2 - 1, k2.u, |u|^2, |n|^2
+    double a1 = 0, a2 = 0, b1 = 0, x21 = 0, y21 = 0;  ///< up.k1, up.k2, k2.(up x k1), up.n, k2.(up x n)
+  } k;
 };
 
 class Model {

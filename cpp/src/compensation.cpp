@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "kincal/fastmath.hpp"
+#include "kincal/solve6.hpp"
 
 namespace kincal {
 
@@ -70,43 +71,6 @@ inline Vec6 deviation_trig(const Eigen::Isometry3d& t, const Pose6& d, AbcTrig& 
 
 inline VecQ to_rad(const Q6& q) { return q * kDeg; }
 
-// Solves a x = b in place (b becomes x) by Gaussian elimination with partial pivoting on the fixed
-// 6 x 6 system, its loops unrolled by the compiler (Eigen's general LU loops at run time); returns |det a|.
-using Mat6r = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;  // row operations on contiguous memory
-
-inline double solve6(Mat6r a, Vec6& b) {
-  double det = 1;
-#pragma GCC unroll 6
-  for (int k = 0; k < 6; ++k) {
-    int p = k;
-    for (int i = k + 1; i < 6; ++i)
-      if (std::abs(a(i, k)) > std::abs(a(p, k))) p = i;
-    if (p != k) {
-      a.row(k).swap(a.row(p));
-      std::swap(b[k], b[p]);
-    }
-    const double piv = a(k, k);
-    det *= piv;
-    if (piv == 0) return 0;
-    const double inv = 1 / piv;
-#pragma GCC unroll 6
-    for (int i = k + 1; i < 6; ++i) {
-      const double l = a(i, k) * inv;
-#pragma GCC unroll 6
-      for (int j = k + 1; j < 6; ++j) a(i, j) -= l * a(k, j);
-      b[i] -= l * b[k];
-    }
-  }
-#pragma GCC unroll 6
-  for (int k = 5; k >= 0; --k) {
-    double v = b[k];
-#pragma GCC unroll 6
-    for (int j = k + 1; j < 6; ++j) v -= a(k, j) * b[j];
-    b[k] = v / a(k, k);
-  }
-  return std::abs(det);
-}
-
 }  // namespace
 
 Vec6 pose_deviation(const Model& cal, const Q6& q_deg, const Pose6& desired) {
@@ -116,19 +80,80 @@ Vec6 pose_deviation(const Model& cal, const Q6& q_deg, const Pose6& desired) {
 
 namespace {
 
-// The default path (analytic Jacobian, no compliance) in fixed sizes: the Jacobian follows from the
-// frames of the FK only when another step is needed, the ABC rates from the rotation itself.
-CompensationResult compensate_rigid(const Model& cal, const Pose6& desired, const Q6& q0_deg,
-                                    const CompensationOptions& opt) {
+// F (eq. 6) and its analytic Jacobian at one q, in fixed sizes: the Jacobian follows from the frames
+// of the FK only when it is asked for, the ABC rates from the rotation itself. With compliance the
+// chain is evaluated at the deflected angles q + K tau(q) and the Jacobian chained with
+// d(q + K tau)/dq = I + K dtau/dq.
+struct DeviationEvaluator {
+  const Model& cal;
+  const Pose6& desired;
+  const bool compliant;
+  ChainFrames frames;
+  VecQ qr = VecQ(6), tau = VecQ(6);
+  MatQ dtau = MatQ(6, 6);
+  AbcTrig tr{};
+
+  DeviationEvaluator(const Model& m, const Pose6& d) : cal(m), desired(d), compliant(m.has_compliance()) {}
+
+  Vec6 deviation_at(const Q6& q_deg) {
+    qr = q_deg * kDeg;
+    if (compliant) {
+      gravity_torque(cal, qr, tau, &dtau);
+      for (int j = 0; j < 6; ++j) qr[j] += cal.compliance(j) * tau[j];
+    }
+    fk_frames(cal, qr, frames);
+    return deviation_trig(frames.tool, desired, tr);
+  }
+
+  bool orientation_singular() const { return std::abs(tr.cb) < 1e-9; }
+
+  // Solves jf step = f for the step (f becomes it); returns |det jf|. The position rows are first
+  // moved from the tool point to the wrist (joint 5's origin): v_wrist = v_tool + d x w with
+  // d = tool - wrist and w = E (A', B', C'), a row operation of determinant 1 on jf and f alike,
+  // after which the arm's position block alone is singular only where the arm is (solve_blocks).
+  double solve(Mat6r& jf, Vec6& f) const {
+    const Vec3 d = frames.tool.translation() - frames.o[4];
+    Mat3 e;  // angular velocity per ABC rate
+    e << 0, -tr.sa, tr.ca * tr.cb, 0, tr.ca, tr.sa * tr.cb, 1, 0, -tr.sb;
+    Mat3 dx;
+    dx << 0, -d[2], d[1], d[2], 0, -d[0], -d[1], d[0], 0;
+    const Mat3 m = kDeg * dx * e;  // mm per degree of A, B, C
+    jf.topRows<3>() += m * jf.bottomRows<3>();
+    f.head<3>() += m * f.tail<3>();
+    return solve_blocks(jf, f);
+  }
+
+  // dF/dq at the last deviation_at: rows mm and degrees, columns per degree of q
+  void jacobian(Mat6r& jf) const {
+    // angular velocity w = E(a, b, c) [a', b', c'] for R = Rz(a) Ry(b) Rx(c); rows of E^-1:
+    // [ca sb/cb, sa sb/cb, 1], [-sa, ca, 0], [ca/cb, sa/cb, 0]
+    const double icb = 1 / tr.cb;
+    const double e0 = tr.ca * tr.sb * icb, e1 = tr.sa * tr.sb * icb, e2 = tr.ca * icb, e3 = tr.sa * icb;
+    const Vec3 tip = frames.tool.translation();
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      const Vec3& z = frames.z[j];
+      jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * kDeg;
+      jf(3, j) = e0 * z[0] + e1 * z[1] + z[2];
+      jf(4, j) = -tr.sa * z[0] + tr.ca * z[1];
+      jf(5, j) = e2 * z[0] + e3 * z[1];
+    }
+    if (compliant) {
+      Mat6 dq = Mat6::Identity();
+      for (int j = 0; j < 6; ++j) dq.row(j) += cal.compliance(j) * dtau.row(j).head<6>();
+      jf = (jf * dq).eval();
+    }
+  }
+};
+
+CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Q6& q0_deg,
+                                       const CompensationOptions& opt) {
   CompensationResult res;
   Q6 q = q0_deg;
-  ChainFrames frames;
-  VecQ qr(6);
+  DeviationEvaluator ev(cal, desired);
+  Mat6r jf;
   for (int it = 0;; ++it) {
-    qr = q * kDeg;
-    fk_frames(cal, qr, frames);
-    AbcTrig tr;
-    Vec6 f = deviation_trig(frames.tool, desired, tr);
+    const Vec6 f = ev.deviation_at(q);
     const double f2 = f.squaredNorm();
     auto finish = [&](CompStatus status) {
       res.q_deg = q;
@@ -141,29 +166,25 @@ CompensationResult compensate_rigid(const Model& cal, const Pose6& desired, cons
     };
     if (f2 < opt.epsilon) return finish(CompStatus::Converged);
     if (it >= opt.max_iterations) return finish(CompStatus::NotConverged);
-    if (std::abs(tr.cb) < 1e-9) return finish(CompStatus::OrientationSingular);
-    // angular velocity w = E(a, b, c) [a', b', c'] for R = Rz(a) Ry(b) Rx(c); rows of E^-1:
-    // [ca sb/cb, sa sb/cb, 1], [-sa, ca, 0], [ca/cb, sa/cb, 0]; columns per degree of q
-    const double icb = 1 / tr.cb;
-    const double e0 = tr.ca * tr.sb * icb, e1 = tr.sa * tr.sb * icb, e2 = tr.ca * icb, e3 = tr.sa * icb;
-    const Vec3 tip = frames.tool.translation();
-    Mat6r jf;
-#pragma GCC unroll 6
-    for (int j = 0; j < 6; ++j) {
-      const Vec3& z = frames.z[j];
-      jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * kDeg;
-      jf(3, j) = e0 * z[0] + e1 * z[1] + z[2];
-      jf(4, j) = -tr.sa * z[0] + tr.ca * z[1];
-      jf(5, j) = e2 * z[0] + e3 * z[1];
-    }
+    if (ev.orientation_singular()) return finish(CompStatus::OrientationSingular);
+    ev.jacobian(jf);
     Vec6 step = f;
-    const double det = solve6(jf, step);
+    const double det = ev.solve(jf, step);
     if (!(det > 1e-18) || !std::isfinite(det) || !step.allFinite()) return finish(CompStatus::SingularJacobian);
     q -= step;
   }
 }
 
 }  // namespace
+
+Mat6 pose_deviation_jacobian(const Model& cal, const Q6& q_deg, const Pose6& desired) {
+  if (cal.dof() != 6) throw std::invalid_argument("pose_deviation_jacobian needs a 6-joint robot");
+  DeviationEvaluator ev(cal, desired);
+  ev.deviation_at(q_deg);
+  Mat6r jf;
+  ev.jacobian(jf);
+  return jf;
+}
 
 CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& q0_deg, const CompensationOptions& opt) {
   CompensationResult res;
@@ -172,25 +193,13 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
     res.status = CompStatus::NotSixJoints;
     return res;
   }
-  if (!opt.finite_difference && !cal.has_compliance()) return compensate_rigid(cal, desired, q0_deg, opt);
+  if (!opt.finite_difference) return compensate_analytic(cal, desired, q0_deg, opt);
+  // the paper's iteration with its finite-difference Jacobian (eq. 7)
   Q6 q = q0_deg;
-  Eigen::Isometry3d t;
-  Jac jg;
   Vec3 abc;
   Mat6r jf;
-  ChainFrames frames;
-  const bool rigid = !cal.has_compliance();
   for (int it = 0;; ++it) {
-    Vec6 f;
-    if (opt.finite_difference) {
-      f = deviation(fk_compliant(cal, to_rad(q)), desired, abc);
-    } else if (rigid) {
-      fk_frames(cal, to_rad(q), frames);  // the Jacobian follows from the frames only if needed
-      f = deviation(frames.tool, desired, abc);
-    } else {
-      fk_jacobian_compliant(cal, to_rad(q), t, jg);
-      f = deviation(t, desired, abc);
-    }
+    Vec6 f = deviation(fk_compliant(cal, to_rad(q)), desired, abc);
     res.q_deg = q;
     res.iterations = it;
     res.residual = f.norm();
@@ -204,30 +213,13 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
       res.status = CompStatus::NotConverged;
       return res;
     }
-    if (opt.finite_difference) {
-      // eq. 7: column i = (F(q + delta e_i) - F(q)) / delta
-      for (int i = 0; i < 6; ++i) {
-        Q6 qi = q;
-        qi[i] += opt.delta;
-        Vec3 abci;
-        Vec6 fi = deviation(fk_compliant(cal, to_rad(qi)), desired, abci);
-        jf.col(i) = (fi - f) / opt.delta;
-      }
-    } else {
-      if (rigid) jacobian_from(frames, jg);
-      double sa, ca, sb, cb;
-      fastmath::sincos(abc[0] * kDeg, sa, ca);
-      fastmath::sincos(abc[1] * kDeg, sb, cb);
-      if (std::abs(cb) < 1e-9) {
-        res.status = CompStatus::OrientationSingular;
-        return res;
-      }
-      // angular velocity w = E(a, b, c) [a', b', c'] for R = Rz(a) Ry(b) Rx(c)
-      Mat3 einv;  // inverse of [[0, -sa, ca cb], [0, ca, sa cb], [1, 0, -sb]]
-      einv << ca * sb / cb, sa * sb / cb, 1, -sa, ca, 0, ca / cb, sa / cb, 0;
-      // columns per degree of q; rows mm and degrees
-      jf.topRows<3>() = jg.topRows<3>() * kDeg;
-      jf.bottomRows<3>() = einv * jg.bottomRows<3>();
+    // eq. 7: column i = (F(q + delta e_i) - F(q)) / delta
+    for (int i = 0; i < 6; ++i) {
+      Q6 qi = q;
+      qi[i] += opt.delta;
+      Vec3 abci;
+      Vec6 fi = deviation(fk_compliant(cal, to_rad(qi)), desired, abci);
+      jf.col(i) = (fi - f) / opt.delta;
     }
     const double det = solve6(jf, f);
     if (!(det > 1e-18) || !std::isfinite(det) || !f.allFinite()) {

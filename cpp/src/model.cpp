@@ -15,9 +15,15 @@ namespace kincal {
 using json = nlohmann::json;
 
 Mat3 abc_to_rotation(const Vec3& abc) {
-  return (Eigen::AngleAxisd(abc[0] * kDeg, Vec3::UnitZ()) * Eigen::AngleAxisd(abc[1] * kDeg, Vec3::UnitY()) *
-          Eigen::AngleAxisd(abc[2] * kDeg, Vec3::UnitX()))
-      .toRotationMatrix();
+  // Rz(a) Ry(b) Rx(c) written out
+  double sa, ca, sb, cb, sc, cc;
+  fastmath::sincos2(abc[0] * kDeg, abc[1] * kDeg, sa, ca, sb, cb);
+  fastmath::sincos(abc[2] * kDeg, sc, cc);
+  Mat3 r;
+  r << ca * cb, ca * sb * sc - sa * cc, ca * sb * cc + sa * sc,  //
+      sa * cb, sa * sb * sc + ca * cc, sa * sb * cc - ca * sc,    //
+      -sb, cb * sc, cb * cc;
+  return r;
 }
 
 Vec3 rotation_to_abc(const Mat3& r) {

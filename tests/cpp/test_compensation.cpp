@@ -1,5 +1,8 @@
 #include "kincal/compensation.hpp"
 #include "kincal/io.hpp"
+#include "kincal/solve6.hpp"
+
+#include <Eigen/LU>
 
 #include "test_util.hpp"
 
@@ -106,4 +109,66 @@ TEST(Compensation, FiniteDifferenceAndAnalyticAgree) {
   ASSERT_EQ(rf.status, CompStatus::Converged);
   EXPECT_LT((ra.q_deg - rf.q_deg).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_GT((ra.q_deg - q).norm(), 0.01);  // the calibrated model does need a correction
+}
+
+// The default compensation's analytic Jacobian of F (eq. 6) against central differences of F, on
+// random configurations of a kr500 with geometric errors, without and with joint compliance.
+TEST(Compensation, AnalyticJacobianMatchesFiniteDifferences) {
+  std::mt19937_64 rng(32);
+  double worst = 0;
+  for (double compliance : {0.0, 0.003}) {
+    const Model cal(perturbed_spec(kr500_spec(), 7, 1.0, 0.05, compliance));
+    for (int i = 0; i < 200; ++i) {
+      const Q6 q = test::random_q(cal, rng, 1.0);
+      Q6 qt = q;
+      qt[0] += 3;  // a desired pose near, not at, the current one
+      const Pose6 desired = iso_to_pose(fk_compliant(cal, VecQ(qt * kDeg)));
+      if (std::abs(desired.abc[1]) > 80) continue;  // ABC rates near their singularity
+      const Mat6 j = pose_deviation_jacobian(cal, q, desired);
+      const double h = 1e-5;  // degrees
+      for (int k = 0; k < 6; ++k) {
+        Q6 qp = q, qm = q;
+        qp[k] += h;
+        qm[k] -= h;
+        const Vec6 col = (pose_deviation(cal, qp, desired) - pose_deviation(cal, qm, desired)) / (2 * h);
+        worst = std::max(worst, (col - j.col(k)).cwiseAbs().maxCoeff() / std::max(1.0, col.cwiseAbs().maxCoeff()));
+      }
+    }
+  }
+  std::printf("analytic vs central differences: worst relative difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+// The block solve of Newton's step against Eigen's fully pivoted LU on random systems (arm rows in
+// mm-sized units, wrist rows in unit-sized ones): well-conditioned blocks, an arm block that is
+// singular while the system is not (the pivoted fallback), and a singular system.
+TEST(Compensation, BlockSolveMatchesPivotedLu) {
+  std::mt19937_64 rng(33);
+  std::normal_distribution<double> nd;
+  double worst = 0;
+  int fallbacks = 0;
+  for (int i = 0; i < 3000; ++i) {
+    Mat6r j;
+    for (int k = 0; k < 36; ++k) j.data()[k] = nd(rng) * (k < 18 ? 50 : 1);
+    if (i % 3 == 1) {  // arm block singular: its third column a copy of its first
+      j.block<3, 1>(0, 2) = j.block<3, 1>(0, 0);
+      ++fallbacks;
+    }
+    Vec6 b;
+    for (int k = 0; k < 6; ++k) b[k] = nd(rng);
+    const Eigen::FullPivLU<Mat6> lu{Mat6(j)};
+    if (lu.rcond() < 1e-8) continue;
+    const Vec6 truth = lu.solve(b);
+    Vec6 x = b;
+    const double det = solve_blocks(j, x);
+    worst = std::max(worst, (x - truth).norm() / truth.norm());
+    EXPECT_NEAR(det, std::abs(lu.determinant()), 1e-9 * std::abs(lu.determinant()));
+  }
+  std::printf("block solve vs pivoted LU: worst relative difference %.2e (%d with a singular arm block)\n", worst,
+              fallbacks);
+  EXPECT_LT(worst, 1e-9);
+  Mat6r singular = Mat6r::Identity();
+  singular.row(4) = singular.row(1);
+  Vec6 b = Vec6::Ones();
+  EXPECT_LT(solve_blocks(singular, b), 1e-12);
 }

@@ -32,6 +32,10 @@ struct CompensationResult {
 /// The pose deviation F (eq. 6) of the calibrated model at q_deg from the desired pose (xyz, abc).
 Vec6 pose_deviation(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired);
 
+/// The analytic Jacobian of pose_deviation with respect to q_deg, as the default compensation uses
+/// it: rows mm and degrees, columns per degree (the ABC rates singular at B = +-90 deg).
+Mat6 pose_deviation_jacobian(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired);
+
 /// Newton compensation from the start q0_deg (normally the nominal IK solution).
 CompensationResult compensate(const Model& cal, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& q0_deg,
                               const CompensationOptions& opt = {});

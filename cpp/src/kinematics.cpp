@@ -126,14 +126,17 @@ void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
   // torque about axis z_j of the weight: z_j . (arm_j x g)  [kg mm m/s^2 = N mm]
   for (int j = 0; j < n; ++j) tau[j] = z[j].dot(arm[j].cross(g));
   if (dtau) {
-    dtau->resize(n, n);
+    // i <= j: the whole sub-chain rotates about z_i, d tau_j / d q_i = g . (z_i x (z_j x arm_j));
+    // i > j: only the part beyond joint i moves, g . (z_j x (z_i x arm_i)). Both are u_k . h_l with
+    // u_k = z_k x arm_k, h_l = g x z_l, k = max(i, j), l = min(i, j).
+    std::array<Vec3, kMaxJoints> u, h;
     for (int j = 0; j < n; ++j) {
-      const Vec3 zj_arm = z[j].cross(arm[j]);
-      for (int i = 0; i < n; ++i) {
-        // i <= j: the whole sub-chain rotates about z_i; i > j: only the part beyond joint i moves.
-        (*dtau)(j, i) = (i <= j) ? g.dot(z[i].cross(zj_arm)) : g.dot(z[j].cross(z[i].cross(arm[i])));
-      }
+      u[j] = z[j].cross(arm[j]);
+      h[j] = g.cross(z[j]);
     }
+    dtau->resize(n, n);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) (*dtau)(j, i) = i <= j ? u[j].dot(h[i]) : u[i].dot(h[j]);
   }
 }
 

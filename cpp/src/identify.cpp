@@ -1089,7 +1089,10 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     // the span of the chosen ones is N_ii - N_iS N_SS^-1 N_Si (an incremental Cholesky factor)
     auto select = [&](const Eigen::MatrixXd& J, std::vector<bool>& fixed, std::vector<std::string>& reason) {
       Eigen::VectorXd nrm = J.colwise().norm().transpose();
-      Eigen::MatrixXd N = J.transpose() * J;
+      // the normal matrix from one triangle (half the work of the product), then mirrored
+      Eigen::MatrixXd N = Eigen::MatrixXd::Zero(P, P);
+      N.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+      N.triangularView<Eigen::StrictlyUpper>() = N.transpose();
       for (int a = 0; a < P; ++a)
         for (int b = 0; b < P; ++b) N(a, b) /= (nrm[a] > 0 ? nrm[a] : 1.0) * (nrm[b] > 0 ? nrm[b] : 1.0);
       std::vector<int> chosen;
@@ -1211,7 +1214,10 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
       Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
     }
     // singular values from the eigenvalues of the (small) normal matrix
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Jf.transpose() * Jf, Eigen::EigenvaluesOnly);
+    // (the solver reads the lower triangle only: rankUpdate fills just that)
+    Eigen::MatrixXd nf = Eigen::MatrixXd::Zero(Jf.cols(), Jf.cols());
+    nf.selfadjointView<Eigen::Lower>().rankUpdate(Jf.transpose());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(nf, Eigen::EigenvaluesOnly);
     const Eigen::VectorXd s = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
     res.condition_number = s.maxCoeff() / s.minCoeff();
     double logsum = 0;

@@ -41,9 +41,9 @@ inline Vec6 deviation(const Eigen::Isometry3d& t, const Pose6& d, Vec3& abc) {
   return f;
 }
 
-// The rigid analytic path's deviation (eq. 6) with the cosines and sines of A and B that the ABC
-// rates need, read off the rotation (rotation_to_abc's formulas; its gimbal-lock branch is where
-// this path stops with OrientationSingular, so it is not needed here).
+// The analytic path's deviation (eq. 6) with the cosines and sines of A and B that the ABC rates
+// need, read off the rotation with rotation_to_abc's formulas (at gimbal lock, cb < 1e-12, the
+// angles are rotation_to_abc's own and the path stops with OrientationSingular before any step).
 struct AbcTrig {
   double ca, sa, cb, sb;
 };

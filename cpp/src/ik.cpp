@@ -111,9 +111,9 @@ inline Angle sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
 int sub2_wrist(const IkStructure::Constants& k, const Vec3& k1, const Vec3& k2, const Vec3& v, Angle t1[2],
                Angle t2[2], bool first_only) {
   const double k1v = k1.dot(v), k2v = k2.dot(v), nv = k.n.dot(v), mv = k.m.dot(v);
-  const double alpha = (k.k12 * k.k2u - k1v) / k.den;
-  const double beta = (k.k12 * k1v - k.k2u) / k.den;
-  const double g2 = (k.u2 - alpha * alpha - beta * beta - 2 * alpha * beta * k.k12) / k.n2;
+  const double alpha = (k.k12 * k.k2u - k1v) * k.inv_den;
+  const double beta = (k.k12 * k1v - k.k2u) * k.inv_den;
+  const double g2 = (k.u2 - alpha * alpha - beta * beta - 2 * alpha * beta * k.k12) * k.inv_n2;
   const double scale = std::max(1.0, k.u2);
   if (!std::isfinite(g2)) return 0;
   if (g2 < -1e-10 * scale) {
@@ -140,7 +140,7 @@ int sub3_elbow(const IkStructure::Constants& k, double d, Angle t[2]) {
   if (nu < 1e-12 || nv < 1e-12) return 0;
   double ca;
   bool tangent;
-  if (!cos_of((nu * nu + nv * nv - dp2) / (2 * nu * nv), ca, tangent)) return 0;
+  if (!cos_of((nu * nu + nv * nv - dp2) * k.elbow_inv_2nunv, ca, tangent)) return 0;
   plus_minus(Angle{k.elbow_q, k.elbow_c, k.elbow_s}, ca, t[1], t[0]);
   if (tangent) return 1;
   return 2;
@@ -154,10 +154,11 @@ int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2]) {
   const double C = d - h.dot(k) * k.dot(u);
   const double r = std::sqrt(A * A + B * B);  // mm-sized terms: no overflow
   if (r < 1e-12) return 0;
-  const Angle phi{fastmath::atan2(B, A), A / r, B / r};
+  const double inv_r = 1 / r;
+  const Angle phi{fastmath::atan2(B, A), A * inv_r, B * inv_r};
   double ca;
   bool tangent;
-  if (!cos_of(C / r, ca, tangent)) return 0;
+  if (!cos_of(C * inv_r, ca, tangent)) return 0;
   plus_minus(phi, ca, t[0], t[1]);
   if (tangent) return 1;
   return 2;
@@ -277,7 +278,7 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
           const Mat3 r456 = (axis_rotation(w1, a1.q) * axis_rotation(w2, a2.q) * axis_rotation(w3, a3.q)).transpose() * gr;
           polish_wrist(w4, w5, w6, r456, q + 3);
         }
-        for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) / kDeg;
+        for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) * (180 / kPi);
         s.wrist_singular = wrist < 1e-7;
         s.shoulder_singular = shoulder;
         s.approximate = t_clamped;

@@ -211,6 +211,7 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
         k.elbow_dz = ax.dot(u - v);
         k.elbow_nu = up.norm();
         k.elbow_nv = vp.norm();
+        k.elbow_inv_2nunv = 1 / (2 * k.elbow_nu * k.elbow_nv);
         const double x = up.dot(vp), y = ax.dot(up.cross(vp)), h = std::sqrt(x * x + y * y);
         if (h > 0) {
           k.elbow_q = std::atan2(y, x);
@@ -221,11 +222,11 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
       {  // wrist: rot(k1, t1) rot(k2, t2) u = v with k1 = w4, k2 = w5, u = w6
         const Vec3 &k1 = w_[3], &k2 = w_[4], &u = w_[5];
         k.k12 = k1.dot(k2);
-        k.den = k.k12 * k.k12 - 1;
+        k.inv_den = 1 / (k.k12 * k.k12 - 1);
         k.k2u = k2.dot(u);
         k.n = k1.cross(k2);
         k.m = k1.cross(k.n);
-        k.n2 = k.n.squaredNorm();
+        k.inv_n2 = 1 / k.n.squaredNorm();
         k.u2 = u.squaredNorm();
         const Vec3 up = u - k2 * k.k2u;
         k.a1 = up.dot(k1);

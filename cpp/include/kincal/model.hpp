@@ -94,8 +94,9 @@ struct IkStructure {
     double sigma23 = 0;       ///< +-1 when axis 3 is exactly (to the bit) +-axis 2, else 0
     double elbow_q = 0, elbow_c = 1, elbow_s = 0;  ///< angle from u to v about axis 3 (projections)
     double elbow_nu = 0, elbow_nv = 0, elbow_dz = 0;  ///< |u|, |v| normal to axis 3; (u - v) along it
+    double elbow_inv_2nunv = 0;                         ///< 1 / (2 |u| |v|)
     Vec3 n = Vec3::Zero(), m = Vec3::Zero();  ///< k1 x k2, k1 x n
-    double k12 = 0, den = -1, k2u = 0, u2 = 1, n2 = 1;  ///< k1.k2, k12^2 - 1, k2.u, |u|^2, |n|^2
+    double k12 = 0, inv_den = -1, k2u = 0, u2 = 1, inv_n2 = 1;  ///< k1.k2, 1/(k12^2 - 1), k2.u, |u|^2, 1/|n|^2
     double a1 = 0, a2 = 0, b1 = 0, x21 = 0, y21 = 0;  ///< up.k1, up.k2, k2.(up x k1), up.n, k2.(up x n)
   } k;
 };

@@ -793,6 +793,14 @@ int row_residuals(const PointModel& pm, const Measurement& m, double weight, boo
 namespace {
 
 /// Run f(i) for i in [0, n) on all cores (rows are independent; PointModel::predict is const).
+/// J^T J with only its lower triangle filled (half the work of the product; what a self-adjoint
+/// solver reads).
+Eigen::MatrixXd normal_matrix_lower(const Eigen::MatrixXd& j) {
+  Eigen::MatrixXd n = Eigen::MatrixXd::Zero(j.cols(), j.cols());
+  n.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose());
+  return n;
+}
+
 template <class F>
 void parallel_rows(size_t n, F&& f) {
   const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), n / 256 + 1);
@@ -1089,9 +1097,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     // the span of the chosen ones is N_ii - N_iS N_SS^-1 N_Si (an incremental Cholesky factor)
     auto select = [&](const Eigen::MatrixXd& J, std::vector<bool>& fixed, std::vector<std::string>& reason) {
       Eigen::VectorXd nrm = J.colwise().norm().transpose();
-      // the normal matrix from one triangle (half the work of the product), then mirrored
-      Eigen::MatrixXd N = Eigen::MatrixXd::Zero(P, P);
-      N.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+      Eigen::MatrixXd N = normal_matrix_lower(J);
       N.triangularView<Eigen::StrictlyUpper>() = N.transpose();
       for (int a = 0; a < P; ++a)
         for (int b = 0; b < P; ++b) N(a, b) /= (nrm[a] > 0 ? nrm[a] : 1.0) * (nrm[b] > 0 ? nrm[b] : 1.0);
@@ -1214,10 +1220,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
       Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
     }
     // singular values from the eigenvalues of the (small) normal matrix
-    // (the solver reads the lower triangle only: rankUpdate fills just that)
-    Eigen::MatrixXd nf = Eigen::MatrixXd::Zero(Jf.cols(), Jf.cols());
-    nf.selfadjointView<Eigen::Lower>().rankUpdate(Jf.transpose());
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(nf, Eigen::EigenvaluesOnly);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal_matrix_lower(Jf), Eigen::EigenvaluesOnly);
     const Eigen::VectorXd s = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
     res.condition_number = s.maxCoeff() / s.minCoeff();
     double logsum = 0;

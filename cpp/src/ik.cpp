@@ -166,6 +166,45 @@ int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2]) {
 
 }  // namespace
 
+void fill_ik_constants(IkStructure& st, const Vec3* w, const Vec3* p) {
+  const Vec3& c = st.wrist_center;
+  st.wrist_flip = std::abs(w[3].dot(w[4])) < 1e-12 && std::abs(w[4].dot(w[5])) < 1e-12 && w[3].cross(w[5]).norm() < 1e-12;
+  IkStructure::Constants& k = st.k;
+  k.v6 = w[5].unitOrthogonal();
+  k.sigma23 = w[2] == w[1] ? 1.0 : (w[2] == -w[1] ? -1.0 : 0.0);
+  {  // elbow (sub3_elbow): |rot(w3, q3) u - v| = d, u = pw - p3, v = p2 - p3; up, vp their parts normal to w3
+    const Vec3& ax = w[2];
+    const Vec3 u = c - p[2], v = p[1] - p[2];
+    const Vec3 up = u - ax * ax.dot(u), vp = v - ax * ax.dot(v);
+    k.elbow_dz = ax.dot(u - v);
+    k.elbow_nu = up.norm();
+    k.elbow_nv = vp.norm();
+    k.elbow_inv_2nunv = 1 / (2 * k.elbow_nu * k.elbow_nv);
+    const double x = up.dot(vp), y = ax.dot(up.cross(vp)), h = std::sqrt(x * x + y * y);
+    if (h > 0) {
+      k.elbow_q = std::atan2(y, x);
+      k.elbow_c = x / h;
+      k.elbow_s = y / h;
+    }
+  }
+  {  // wrist (sub2_wrist): rot(k1, t1) rot(k2, t2) u = v with k1 = w4, k2 = w5, u = w6
+    const Vec3 &k1 = w[3], &k2 = w[4], &u = w[5];
+    k.k12 = k1.dot(k2);
+    k.inv_den = 1 / (k.k12 * k.k12 - 1);
+    k.k2u = k2.dot(u);
+    k.n = k1.cross(k2);
+    k.m = k1.cross(k.n);
+    k.inv_n2 = 1 / k.n.squaredNorm();
+    k.u2 = u.squaredNorm();
+    const Vec3 up = u - k2 * k.k2u;
+    k.a1 = up.dot(k1);
+    k.a2 = up.dot(k2);
+    k.b1 = k2.dot(up.cross(k1));
+    k.x21 = up.dot(k.n);
+    k.y21 = k2.dot(up.cross(k.n));
+  }
+}
+
 IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg,
                    bool nearest_if_unreachable, bool nearest_branch) {
   const bool greedy = nearest_branch && ref_deg != nullptr;

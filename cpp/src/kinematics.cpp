@@ -140,12 +140,21 @@ void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
   }
 }
 
-VecQ deflected(const Model& m, const VecQ& q) {
-  if (!m.has_compliance()) return q;
+VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd) {
+  const int n = m.dof();
+  if (!m.has_compliance()) {
+    if (dqd) *dqd = MatQ::Identity(n, n);
+    return q;
+  }
   VecQ tau;
-  gravity_torque(m, q, tau);
+  MatQ dtau;
+  gravity_torque(m, q, tau, dqd ? &dtau : nullptr);
   VecQ out = q;
-  for (int j = 0; j < m.dof(); ++j) out[j] += m.compliance(j) * tau[j];
+  for (int j = 0; j < n; ++j) out[j] += m.compliance(j) * tau[j];
+  if (dqd) {  // d(q + K tau)/dq = I + K dtau/dq
+    *dqd = MatQ::Identity(n, n);
+    for (int j = 0; j < n; ++j) dqd->row(j) += m.compliance(j) * dtau.row(j);
+  }
   return out;
 }
 
@@ -156,18 +165,11 @@ void fk_jacobian_compliant(const Model& m, const VecQ& q, Eigen::Isometry3d& too
     fk_jacobian(m, q, tool, jac);
     return;
   }
-  const int n = m.dof();
-  VecQ tau;
-  MatQ dtau;
-  gravity_torque(m, q, tau, &dtau);
-  VecQ qd = q;
-  for (int j = 0; j < n; ++j) qd[j] += m.compliance(j) * tau[j];
+  MatQ dqd;
+  const VecQ qd = deflected(m, q, &dqd);
   Jac j0;
   fk_jacobian(m, qd, tool, j0);
-  // d q_eff / d q = I + K dtau/dq
-  MatQ dq = MatQ::Identity(n, n);
-  for (int j = 0; j < n; ++j) dq.row(j) += m.compliance(j) * dtau.row(j);
-  jac.noalias() = j0 * dq;
+  jac.noalias() = j0 * dqd;
 }
 
 }  // namespace kincal

@@ -1,6 +1,7 @@
 #include "kincal/model.hpp"
 
 #include "kincal/fastmath.hpp"
+#include "kincal/ik.hpp"
 
 #include <kdl/chain.hpp>
 #include <kdl/frames.hpp>
@@ -26,20 +27,7 @@ Mat3 abc_to_rotation(const Vec3& abc) {
   return r;
 }
 
-Vec3 rotation_to_abc(const Mat3& r) {
-  // the entries of a rotation are at most 1: a plain square root is safe (and much faster than hypot)
-  const double cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
-  const double b = fastmath::atan2(-r(2, 0), cb);
-  double a, c;
-  if (cb < 1e-12) {  // gimbal lock: put everything in a
-    c = 0;
-    a = fastmath::atan2(-r(0, 1), r(1, 1));
-  } else {
-    a = fastmath::atan2(r(1, 0), r(0, 0));
-    c = fastmath::atan2(r(2, 1), r(2, 2));
-  }
-  return Vec3(a, b, c) / kDeg;
-}
+Vec3 rotation_to_abc(const Mat3& r) { return rotation_to_abc_rad(r) / kDeg; }
 
 Eigen::Isometry3d pose_to_iso(const Pose6& p) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
@@ -199,42 +187,7 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
     } else {
       ik_.spherical_wrist_parallel_23 = true;
       ik_.wrist_center = c;
-      ik_.wrist_flip = std::abs(w_[3].dot(w_[4])) < 1e-12 && std::abs(w_[4].dot(w_[5])) < 1e-12 &&
-                       w_[3].cross(w_[5]).norm() < 1e-12;
-      IkStructure::Constants& k = ik_.k;
-      k.v6 = w_[5].unitOrthogonal();
-      k.sigma23 = w_[2] == w_[1] ? 1.0 : (w_[2] == -w_[1] ? -1.0 : 0.0);
-      {  // elbow: |rot(w3, q3) u - v| = d, u = pw - p3, v = p2 - p3; up, vp their parts normal to w3
-        const Vec3& ax = w_[2];
-        const Vec3 u = c - p_[2], v = p_[1] - p_[2];
-        const Vec3 up = u - ax * ax.dot(u), vp = v - ax * ax.dot(v);
-        k.elbow_dz = ax.dot(u - v);
-        k.elbow_nu = up.norm();
-        k.elbow_nv = vp.norm();
-        k.elbow_inv_2nunv = 1 / (2 * k.elbow_nu * k.elbow_nv);
-        const double x = up.dot(vp), y = ax.dot(up.cross(vp)), h = std::sqrt(x * x + y * y);
-        if (h > 0) {
-          k.elbow_q = std::atan2(y, x);
-          k.elbow_c = x / h;
-          k.elbow_s = y / h;
-        }
-      }
-      {  // wrist: rot(k1, t1) rot(k2, t2) u = v with k1 = w4, k2 = w5, u = w6
-        const Vec3 &k1 = w_[3], &k2 = w_[4], &u = w_[5];
-        k.k12 = k1.dot(k2);
-        k.inv_den = 1 / (k.k12 * k.k12 - 1);
-        k.k2u = k2.dot(u);
-        k.n = k1.cross(k2);
-        k.m = k1.cross(k.n);
-        k.inv_n2 = 1 / k.n.squaredNorm();
-        k.u2 = u.squaredNorm();
-        const Vec3 up = u - k2 * k.k2u;
-        k.a1 = up.dot(k1);
-        k.a2 = up.dot(k2);
-        k.b1 = k2.dot(up.cross(k1));
-        k.x21 = up.dot(k.n);
-        k.y21 = k2.dot(up.cross(k.n));
-      }
+      fill_ik_constants(ik_, w_.data(), p_.data());
     }
   }
 }

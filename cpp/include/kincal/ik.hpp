@@ -26,6 +26,10 @@ struct IkSolutions {
   std::array<IkSolution, 8> sol;
 };
 
+/// Fills the closed form's geometry constants of st (wrist_flip, Constants) for a 6R model of the
+/// class (st.wrist_center set), from its unit axes w and axis points p (the Model does this).
+void fill_ik_constants(IkStructure& st, const Vec3* w, const Vec3* p);
+
 /// All closed-form solutions of the nominal model for the tool pose T (base frame, mm).
 /// Each angle is shifted by multiples of 360 deg to the value nearest ref_deg (or 0) that lies
 /// within the joint limits, when one does. Never NaN.

@@ -43,8 +43,9 @@ void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& ja
 /// Gravity torque on every joint (N mm) and, when dtau is not null, its derivative dtau/dq.
 void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau = nullptr);
 
-/// The joint angles after deflection under gravity: q + K tau(q).
-VecQ deflected(const Model& m, const VecQ& q);
+/// The joint angles after deflection under gravity: q + K tau(q); with dqd, also their derivative
+/// d(q + K tau)/dq = I + K dtau/dq (the identity for a model without compliance).
+VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd = nullptr);
 
 /// Tool pose with joint compliance (equals fk() for a model without compliance).
 Eigen::Isometry3d fk_compliant(const Model& m, const VecQ& q);

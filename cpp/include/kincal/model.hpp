@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "kincal/fastmath.hpp"
+
 namespace KDL {
 class Chain;
 }
@@ -46,6 +48,14 @@ struct Pose6 {
 Mat3 abc_to_rotation(const Vec3& abc_deg);
 /// ABC angles in degrees of a rotation (b in [-90, 90]).
 Vec3 rotation_to_abc(const Mat3& r);
+/// The same in radians, inlined for the hot paths (at gimbal lock everything goes into a).
+inline Vec3 rotation_to_abc_rad(const Mat3& r) {
+  // the entries of a rotation are at most 1: a plain square root is safe (and much faster than hypot)
+  const double cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
+  const double b = fastmath::atan2(-r(2, 0), cb);
+  if (cb < 1e-12) return Vec3(fastmath::atan2(-r(0, 1), r(1, 1)), b, 0.0);
+  return Vec3(fastmath::atan2(r(1, 0), r(0, 0)), b, fastmath::atan2(r(2, 1), r(2, 2)));
+}
 Eigen::Isometry3d pose_to_iso(const Pose6& p);
 Pose6 iso_to_pose(const Eigen::Isometry3d& t);
 

@@ -8,6 +8,7 @@
 
 namespace py = pybind11;
 
+void define_effects(py::module_& m);
 void define_model(py::module_& m);
 void define_kinematics(py::module_& m);
 void define_programs(py::module_& m);

@@ -1,10 +1,13 @@
 #include "common.hpp"
 
 #include "kincal/ik.hpp"
+#include "kincal/io.hpp"
 #include "kincal/kinematics.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
+
+#include <optional>
 
 using namespace kincal;
 
@@ -21,6 +24,23 @@ void check_q(const Model& m, const Rows& q) {
   if (!q.allFinite()) throw InputError("joint angles contain NaN or infinite values");
 }
 
+// The effects' context of row i: its directions (when given) and temperature (when given).
+EffectContext context_of(const Model& m, const std::optional<Rows>& dir, const std::optional<Eigen::VectorXd>& temp,
+                         Eigen::Index i) {
+  EffectContext c;
+  if (dir) c.dir = dir->row(i).transpose();
+  if (temp) c.temperature_c = (*temp)[i];
+  check_context(m, c, "row " + std::to_string(i) + ": ");
+  return c;
+}
+
+void check_context_arrays(const Model& m, const Rows& q, const std::optional<Rows>& dir,
+                          const std::optional<Eigen::VectorXd>& temp) {
+  if (dir && (dir->rows() != q.rows() || dir->cols() != m.dof()))
+    throw InputError("dir needs one row of " + std::to_string(m.dof()) + " signs per configuration");
+  if (temp && temp->size() != q.rows()) throw InputError("temperature_c needs one value per configuration");
+}
+
 }  // namespace
 
 void define_kinematics(py::module_& m) {
@@ -32,13 +52,15 @@ void define_kinematics(py::module_& m) {
       py::arg("rotation"), "KUKA ABC angles (deg) of a rotation matrix (the inverse of abc_to_rotation)");
   m.def(
       "fk",
-      [](const Robot& r, const Rows& q_deg, bool calibrated, bool instrument) {
+      [](const Robot& r, const Rows& q_deg, bool calibrated, bool instrument, const std::optional<Rows>& dir,
+         const std::optional<Eigen::VectorXd>& temperature_c) {
         const Model& md = pick(r, calibrated);
         check_q(md, q_deg);
+        check_context_arrays(md, q_deg, dir, temperature_c);
         Rows out(q_deg.rows(), 6);
         for (Eigen::Index i = 0; i < q_deg.rows(); ++i) {
           const VecQ q = q_deg.row(i).transpose() * kDeg;
-          Eigen::Isometry3d t = fk_compliant(md, q);
+          Eigen::Isometry3d t = fk_model(md, q, context_of(md, dir, temperature_c, i));
           if (instrument) t = md.base_in_instrument() * t;
           const Pose6 p = iso_to_pose(t);
           out.row(i) << p.xyz.transpose(), p.abc.transpose();
@@ -46,7 +68,23 @@ void define_kinematics(py::module_& m) {
         return out;
       },
       py::arg("robot"), py::arg("q_deg"), py::arg("calibrated") = true, py::arg("instrument") = false,
-      "Tool poses x,y,z,a,b,c (mm, deg) for joint angles in degrees (N x dof)");
+      py::arg("dir") = py::none(), py::arg("temperature_c") = py::none(),
+      "Tool poses x,y,z,a,b,c (mm, deg) for joint angles in degrees (N x dof), every effect of the model\n"
+      "acting: dir (N x dof signs, backlash) and temperature_c (N, thermal expansion) when it needs them");
+  m.def(
+      "motion_directions",
+      [](const Rows& q_deg, const std::vector<double>& initial) {
+        if (q_deg.cols() != 6) throw InputError("motion_directions: joint programs of 6 joints");
+        std::vector<Eigen::Matrix<double, 6, 1>> q(q_deg.rows());
+        for (Eigen::Index i = 0; i < q_deg.rows(); ++i) q[i] = q_deg.row(i).transpose();
+        const auto d = motion_directions(q, initial);
+        Rows out(q_deg.rows(), 6);
+        for (Eigen::Index i = 0; i < q_deg.rows(); ++i) out.row(i) = d[i].transpose();
+        return out;
+      },
+      py::arg("q_deg"), py::arg("initial") = std::vector<double>{},
+      "Each joint's direction of motion into each pose of a joint program (sign of its change, held while\n"
+      "it stands still; the first pose's from initial, or the direction of the first motion)");
   m.def(
       "fk_matrix",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
@@ -58,15 +96,21 @@ void define_kinematics(py::module_& m) {
       py::arg("robot"), py::arg("q_deg"), py::arg("calibrated") = true);
   m.def(
       "jacobian",
-      [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
+      [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated, const std::optional<Eigen::VectorXd>& dir,
+         std::optional<double> temperature_c) {
         const Model& md = pick(r, calibrated);
         check_q(md, q_deg.transpose());
+        EffectContext c;
+        if (dir) c.dir = *dir;
+        if (temperature_c) c.temperature_c = *temperature_c;
+        check_context(md, c, "");
         Eigen::Isometry3d t;
         Jac j;
-        fk_jacobian_compliant(md, VecQ(q_deg * kDeg), t, j);
+        fk_jacobian_model(md, VecQ(q_deg * kDeg), c, t, j);
         return Eigen::MatrixXd(j);
       },
-      py::arg("robot"), py::arg("q_deg"), py::arg("calibrated") = true,
+      py::arg("robot"), py::arg("q_deg"), py::arg("calibrated") = true, py::arg("dir") = py::none(),
+      py::arg("temperature_c") = py::none(),
       "6 x dof geometric Jacobian at the tool point (mm/rad over rad/rad), base frame");
   m.def(
       "gravity_torque",

@@ -1,5 +1,6 @@
 #include "common.hpp"
 
+#include "kincal/identify.hpp"
 #include "kincal/model.hpp"
 
 #include <array>
@@ -27,6 +28,28 @@ void define_model(py::module_& m) {
                                for (const auto& j : r.nominal->spec().joints) l.emplace_back(j.lower_deg, j.upper_deg);
                                return l;
                              })
+      .def_property_readonly(
+          "effects",
+          [](const Robot& r) {
+            py::list l;
+            for (const auto& ev : r.calibrated->spec().effects) l.append(py::make_tuple(ev.effect, ev.p));
+            return l;
+          },
+          "the calibrated model's effects besides compliance: (Effect, values in core units)")
+      .def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated->spec().t_ref_c; })
+      .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated->needs_dir(); },
+                             "backlash: the direction of motion into each pose is needed")
+      .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated->needs_temperature(); },
+                             "thermal expansion: the temperature is needed")
+      .def(
+          "with_effects",
+          [](const Robot& r, const std::vector<std::pair<Effect, std::vector<double>>>& effects, double t_ref) {
+            std::vector<EffectValue> ev;
+            for (const auto& [e, p] : effects) ev.push_back(EffectValue{e, p});
+            return Robot{r.nominal, std::make_shared<Model>(with_effects(r.calibrated->spec(), ev, t_ref))};
+          },
+          py::arg("effects"), py::arg("t_ref") = 20.0,
+          "The robot with effects (Effect, values in core units) added to its calibrated model")
       .def(
           "with_calibrated",
           [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance,

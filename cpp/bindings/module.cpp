@@ -5,6 +5,7 @@
 PYBIND11_MODULE(_core, m) {
   m.doc() = "kincal C++ core (private: use the kincal package)";
   py::register_exception<kincal::InputError>(m, "InputError", PyExc_ValueError);
+  define_effects(m);
   define_model(m);
   define_kinematics(m);
   define_programs(m);

@@ -4,6 +4,8 @@
 #include "kincal/feed.hpp"
 #include "kincal/io.hpp"
 
+#include <optional>
+
 using namespace kincal;
 
 namespace {
@@ -11,7 +13,8 @@ namespace {
 using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 ProgramOptions options(bool compensate, bool instrument, bool fd, double delta, double epsilon, int max_iter,
-                       bool corrected_start) {
+                       bool corrected_start, const std::string& residual, std::optional<double> temperature_c,
+                       const std::vector<double>& initial_direction, bool keep_branch) {
   ProgramOptions o;
   o.compensate = compensate;
   o.instrument_frame = instrument;
@@ -20,6 +23,13 @@ ProgramOptions options(bool compensate, bool instrument, bool fd, double delta, 
   o.comp.delta = delta;
   o.comp.epsilon = epsilon;
   o.comp.max_iterations = max_iter;
+  if (residual == "abc")
+    o.comp.residual = Residual::Abc;
+  else if (residual != "rotation_vector")
+    throw InputError("residual must be 'rotation_vector' or 'abc', not '" + residual + "'");
+  if (temperature_c) o.temperature_c = *temperature_c;
+  o.initial_direction = initial_direction;
+  o.keep_branch = keep_branch;
   return o;
 }
 
@@ -30,6 +40,10 @@ py::dict result_dict(const ProgramResult& r) {
   d["q_deg"] = q;
   d["iterations"] = r.iterations;
   d["residual"] = r.residual;
+  Rows dir(static_cast<Eigen::Index>(r.dir.size()), 6);
+  for (size_t i = 0; i < r.dir.size(); ++i) dir.row(static_cast<Eigen::Index>(i)) = r.dir[i].transpose();
+  d["dir"] = dir;
+  d["warnings"] = r.warnings;
   return d;
 }
 
@@ -38,14 +52,24 @@ py::dict result_dict(const ProgramResult& r) {
 #define KINCAL_COMP_ARGS                                                                                  \
   py::arg("compensate") = true, py::arg("instrument") = false, py::arg("finite_difference") = false,     \
       py::arg("delta") = 1e-8, py::arg("epsilon") = 1e-15, py::arg("max_iterations") = 20,               \
-      py::arg("corrected_start") = true
+      py::arg("corrected_start") = true, py::arg("residual") = "rotation_vector",                        \
+      py::arg("temperature_c") = py::none(), py::arg("initial_direction") = std::vector<double>{},        \
+      py::arg("keep_branch") = false
+#define KINCAL_COMP_PARAMS                                                                                \
+  bool comp, bool instr, bool fd, double delta, double eps, int it, bool cs, const std::string &residual, \
+      std::optional<double> temp, const std::vector<double>&initial, bool keep
+#define KINCAL_COMP_OPTIONS options(comp, instr, fd, delta, eps, it, cs, residual, temp, initial, keep)
 
 void define_programs(py::module_& m) {
   m.def(
       "compensate_poses",
-      [](const Robot& r, const Rows& poses, bool comp, bool instr, bool fd, double delta, double eps, int it,
-         bool cs) {
+      [](const Robot& r, const Rows& poses, KINCAL_COMP_PARAMS, const std::optional<Eigen::VectorXd>& temps) {
         if (poses.cols() != 6) throw InputError("poses need 6 columns x,y,z,a,b,c");
+        std::vector<double> tv;
+        if (temps) {
+          if (temps->size() != poses.rows()) throw InputError("temperatures_c needs one value per pose");
+          tv.assign(temps->data(), temps->data() + temps->size());
+        }
         std::vector<Pose6> p;
         std::vector<std::string> where;
         for (Eigen::Index i = 0; i < poses.rows(); ++i) {
@@ -53,18 +77,20 @@ void define_programs(py::module_& m) {
           p.push_back(Pose6{poses.row(i).head<3>().transpose(), poses.row(i).tail<3>().transpose()});
           where.push_back("pose " + std::to_string(i));
         }
-        py::gil_scoped_release release;
-        const ProgramResult res = compensate_poses(r, p, where, options(comp, instr, fd, delta, eps, it, cs));
-        py::gil_scoped_acquire acquire;
+        const ProgramOptions o = KINCAL_COMP_OPTIONS;
+        ProgramResult res;
+        {
+          py::gil_scoped_release release;
+          res = compensate_poses(r, p, where, o, tv);
+        }
         return result_dict(res);
       },
-      py::arg("robot"), py::arg("poses"), KINCAL_COMP_ARGS,
+      py::arg("robot"), py::arg("poses"), KINCAL_COMP_ARGS, py::arg("temperatures_c") = py::none(),
       "IK + Newton compensation of every pose (N x 6), branch kept continuous");
   m.def(
       "compensate_program",
-      [](const Robot& r, const std::string& in, const std::string& out, bool comp, bool instr, bool fd, double delta,
-         double eps, int it, bool cs) {
-        return result_dict(compensate_program_file(r, in, out, options(comp, instr, fd, delta, eps, it, cs)));
+      [](const Robot& r, const std::string& in, const std::string& out, KINCAL_COMP_PARAMS) {
+        return result_dict(compensate_program_file(r, in, out, KINCAL_COMP_OPTIONS));
       },
       py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS,
       "Compensates a pose program file (CSV or G-code) into a joint program file, atomically");
@@ -134,14 +160,16 @@ void define_programs(py::module_& m) {
       py::arg("path"), py::arg("names"), "numeric columns of a CSV (finite numbers; errors name file:line)");
   m.def(
       "stream_lines",
-      [](const Robot& r, const std::vector<std::string>& lines, bool instr) {
-        StreamCompensator sc(r, options(true, instr, false, 1e-8, 1e-15, 20, true));
+      [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,
+         const std::vector<double>& initial, const std::string& residual) {
+        StreamCompensator sc(r, options(true, instr, false, 1e-8, 1e-15, 20, true, residual, temp, initial, false));
         std::vector<std::string> out;
         char buf[8192];
         for (const auto& l : lines) out.emplace_back(buf, sc.process(l.data(), l.size(), buf, sizeof buf));
         return out;
       },
-      py::arg("robot"), py::arg("lines"), py::arg("instrument") = false,
+      py::arg("robot"), py::arg("lines"), py::arg("instrument") = false, py::arg("temperature_c") = py::none(),
+      py::arg("initial_direction") = std::vector<double>{}, py::arg("residual") = "rotation_vector",
       "The streaming corrector on a list of lines (as kincal-compensate --stream)");
   m.def(
       "run_benchmarks",

@@ -45,6 +45,51 @@ inline Vec6 deviation(const Eigen::Isometry3d& t, const Pose6& d) {
   return deviation_from(t.translation(), rotation_to_abc(t.linear()), d);
 }
 
+// The rotation vector of a rotation (rad), accurate near the identity, where Newton works.
+inline Vec3 rotation_vector(const Mat3& r) {
+  const Vec3 v(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1));  // 2 sin(theta) axis
+  const double c = 0.5 * (r(0, 0) + r(1, 1) + r(2, 2) - 1), s2 = v.norm();
+  if (c < -0.9) {  // near half a turn: the antisymmetric part loses the axis
+    const Eigen::AngleAxisd aa(r);
+    return aa.angle() * aa.axis();
+  }
+  const double th = fastmath::atan2(0.5 * s2, c);
+  const double f = th < 1e-4 ? 0.5 + th * th / 12 : th / s2;  // theta / (2 sin theta)
+  return f * v;
+}
+
+inline Mat3 skew3(const Vec3& v) {
+  Mat3 k;
+  k << 0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0;
+  return k;
+}
+
+// The left Jacobian of SO(3) and its inverse at phi: Exp(phi + d) = Exp(Jl d) Exp(phi), so an
+// angular velocity w (base frame) of R_model changes phi = log(R_model R_d^T) by Jl^-1 w.
+inline void left_jacobians(const Vec3& phi, Mat3& jl, Mat3& jl_inv) {
+  const double t2 = phi.squaredNorm(), t = std::sqrt(t2);
+  const Mat3 k = skew3(phi), k2 = k * k;
+  double a, b, c;
+  if (t < 1e-4) {
+    a = 0.5 - t2 / 24, b = 1.0 / 6 - t2 / 120, c = 1.0 / 12 + t2 / 720;
+  } else {
+    double st, ct;
+    fastmath::sincos(t, st, ct);
+    a = (1 - ct) / t2, b = (t - st) / (t2 * t), c = 1 / t2 - (1 + ct) / (2 * t * st);
+  }
+  jl = Mat3::Identity() + a * k + b * k2;
+  jl_inv = Mat3::Identity() - 0.5 * k + c * k2;
+}
+
+// F of the chosen residual from a pose of the model
+inline Vec6 deviation_of(const Eigen::Isometry3d& t, const Pose6& d, Residual residual) {
+  if (residual == Residual::Abc) return deviation(t, d);
+  Vec6 f;
+  f.head<3>() = t.translation() - d.xyz;
+  f.tail<3>() = rotation_vector(t.linear() * abc_to_rotation(d.abc).transpose()) * (1 / kDeg);
+  return f;
+}
+
 // The sines and cosines of A and B of a rotation (the ABC rates need them), read off the matrix;
 // at gimbal lock (cb = 0) A is taken as 0, and Newton stops there with OrientationSingular.
 struct AbcTrig {
@@ -66,79 +111,106 @@ inline VecQ to_rad(const Q6& q) { return q * kDeg; }
 
 }  // namespace
 
-Vec6 pose_deviation(const Model& cal, const Q6& q_deg, const Pose6& desired) {
-  return deviation(fk_compliant(cal, to_rad(q_deg)), desired);
+Vec6 pose_deviation(const Model& cal, const Q6& q_deg, const Pose6& desired, Residual residual,
+                    const EffectContext& ctx) {
+  return deviation_of(fk_model(cal, to_rad(q_deg), ctx), desired, residual);
 }
 
 namespace {
 
-// F (eq. 6) and its analytic Jacobian at one q, in fixed sizes: the Jacobian follows from the frames
-// of the FK only when it is asked for, the ABC rates from the rotation itself. With compliance the
-// chain is evaluated at the deflected angles q + K tau(q) and the Jacobian chained with
-// d(q + K tau)/dq = I + K dtau/dq.
+// F and its analytic Jacobian at one q, in fixed sizes: the Jacobian follows from the frames of the
+// FK only when it is asked for, the orientation rates from the rotation itself. With compliance,
+// transmission error or backlash the chain is evaluated at the joints' actual angles and the
+// Jacobian chained with their derivative d(q + dq(q))/dq; thermal expansion scales the positions.
 struct DeviationEvaluator {
   const Model& cal;
   const Pose6& desired;
-  const bool compliant;
+  const EffectContext& ctx;
+  const bool abc;      // the paper's ABC residual, else the rotation vector
+  const bool effects;  // joint-angle effects (compliance, transmission error, backlash)
+  const double scale;  // thermal expansion
+  Mat3 rd_t;           // R_desired^T (rotation vector)
   ChainFrames frames;
-  MatQ dqd;  // d(q + K tau)/dq, with compliance
+  MatQ dqd;  // d(actual joint angles)/dq, with effects
   AbcTrig tr;
+  Vec3 phi;  // rotation vector of R_model R_desired^T (rad)
 
-  DeviationEvaluator(const Model& m, const Pose6& d) : cal(m), desired(d), compliant(m.has_compliance()) {}
+  DeviationEvaluator(const Model& m, const Pose6& d, const EffectContext& c, Residual r)
+      : cal(m),
+        desired(d),
+        ctx(c),
+        abc(r == Residual::Abc),
+        effects(m.has_compliance() || m.has_joint_effects()),
+        scale(length_scale(m, c)) {
+    if (!abc) rd_t = abc_to_rotation(d.abc).transpose();
+  }
 
   Vec6 deviation_at(const Q6& q_deg) {
     const VecQ qr = q_deg * kDeg;
-    fk_frames(cal, compliant ? deflected(cal, qr, &dqd) : qr, frames);
-    tr = abc_trig(frames.tool.linear());
-    // rotation_to_abc's angles, its division by the degree as a multiplication on this path
-    return deviation_from(frames.tool.translation(), rotation_to_abc_rad(frames.tool.linear()) * (1 / kDeg), desired);
+    fk_frames(cal, effects ? joint_angles(cal, qr, ctx, &dqd) : qr, frames);
+    const Vec3 pos = scale * frames.tool.translation();
+    if (abc) {
+      tr = abc_trig(frames.tool.linear());
+      // rotation_to_abc's angles, its division by the degree as a multiplication on this path
+      return deviation_from(pos, rotation_to_abc_rad(frames.tool.linear()) * (1 / kDeg), desired);
+    }
+    phi = rotation_vector(frames.tool.linear() * rd_t);
+    Vec6 f;
+    f.head<3>() = pos - desired.xyz;
+    f.tail<3>() = phi * (1 / kDeg);
+    return f;
   }
 
-  bool orientation_singular() const { return std::abs(tr.cb) < 1e-9; }
+  bool orientation_singular() const { return abc && std::abs(tr.cb) < 1e-9; }
+
+  // angular velocity per unit of the orientation rows' rates (E), and its inverse
+  void rates(Mat3& e, Mat3& e_inv) const {
+    if (!abc) {
+      left_jacobians(phi, e, e_inv);
+      return;
+    }
+    // for R = Rz(a) Ry(b) Rx(c): E = [[0, -sa, ca cb], [0, ca, sa cb], [1, 0, -sb]],
+    // E^-1 = [[ca sb/cb, sa sb/cb, 1], [-sa, ca, 0], [ca/cb, sa/cb, 0]]
+    e << 0, -tr.sa, tr.ca * tr.cb, 0, tr.ca, tr.sa * tr.cb, 1, 0, -tr.sb;
+    const double icb = 1 / tr.cb;
+    e_inv << tr.ca * tr.sb * icb, tr.sa * tr.sb * icb, 1, -tr.sa, tr.ca, 0, tr.ca * icb, tr.sa * icb, 0;
+  }
+
+  // dF/dq at the last deviation_at (rows mm and degrees, columns per degree of q), and E for solve
+  void jacobian(Mat6r& jf, Mat3& e) const {
+    Mat3 e_inv;
+    rates(e, e_inv);
+    const Vec3 tip = frames.tool.translation();
+    const double ks = kDeg * scale;
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      const Vec3& z = frames.z[j];
+      jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * ks;
+      jf.col(j).tail<3>() = e_inv * z;
+    }
+    if (effects) jf = (jf * dqd.topLeftCorner<6, 6>()).eval();
+  }
 
   // Solves jf step = f for the step (f becomes it); returns |det jf|. The position rows are first
   // moved from the tool point to the wrist (joint 5's origin): v_wrist = v_tool + d x w with
-  // d = tool - wrist and w = E (A', B', C'), a row operation of determinant 1 on jf and f alike,
-  // after which the arm's position block alone is singular only where the arm is (solve_blocks).
-  double solve(Mat6r& jf, Vec6& f) const {
+  // d = tool - wrist and w = E (orientation rates), a row operation of determinant 1 on jf and f
+  // alike, after which the arm's position block alone is singular only where the arm is.
+  double solve(Mat6r& jf, Vec6& f, const Mat3& e) const {
     const Vec3 d = frames.tool.translation() - frames.o[4];
-    Mat3 e;  // angular velocity per ABC rate
-    e << 0, -tr.sa, tr.ca * tr.cb, 0, tr.ca, tr.sa * tr.cb, 1, 0, -tr.sb;
-    Mat3 dx;
-    dx << 0, -d[2], d[1], d[2], 0, -d[0], -d[1], d[0], 0;
-    const Mat3 m = kDeg * dx * e;  // mm per degree of A, B, C
+    const Mat3 m = (kDeg * scale) * skew3(d) * e;  // mm per degree of the orientation rates
     jf.topRows<3>() += m * jf.bottomRows<3>();
     f.head<3>() += m * f.tail<3>();
     return solve_blocks(jf, f);
   }
-
-  // dF/dq at the last deviation_at: rows mm and degrees, columns per degree of q: the geometric
-  // Jacobian of the frames (jacobian_from's columns, written here in fixed size: through
-  // jacobian_from's 6 x N matrix the compensation took 40 ns longer), its angular rows mapped to
-  // the ABC rates by E^-1 = [[ca sb/cb, sa sb/cb, 1], [-sa, ca, 0], [ca/cb, sa/cb, 0]] for
-  // R = Rz(a) Ry(b) Rx(c)
-  void jacobian(Mat6r& jf) const {
-    const double icb = 1 / tr.cb;
-    const double e0 = tr.ca * tr.sb * icb, e1 = tr.sa * tr.sb * icb, e2 = tr.ca * icb, e3 = tr.sa * icb;
-    const Vec3 tip = frames.tool.translation();
-#pragma GCC unroll 6
-    for (int j = 0; j < 6; ++j) {
-      const Vec3& z = frames.z[j];
-      jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * kDeg;
-      jf(3, j) = e0 * z[0] + e1 * z[1] + z[2];
-      jf(4, j) = -tr.sa * z[0] + tr.ca * z[1];
-      jf(5, j) = e2 * z[0] + e3 * z[1];
-    }
-    if (compliant) jf = (jf * dqd.topLeftCorner<6, 6>()).eval();
-  }
 };
 
 CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Q6& q0_deg,
-                                       const CompensationOptions& opt) {
+                                       const CompensationOptions& opt, const EffectContext& ctx) {
   CompensationResult res;
   Q6 q = q0_deg;
-  DeviationEvaluator ev(cal, desired);
+  DeviationEvaluator ev(cal, desired, ctx, opt.residual);
   Mat6r jf;
+  Mat3 e;
   for (int it = 0;; ++it) {
     const Vec6 f = ev.deviation_at(q);
     const double f2 = f.squaredNorm();
@@ -154,9 +226,9 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     if (f2 < opt.epsilon) return finish(CompStatus::Converged);
     if (it >= opt.max_iterations) return finish(CompStatus::NotConverged);
     if (ev.orientation_singular()) return finish(CompStatus::OrientationSingular);
-    ev.jacobian(jf);
+    ev.jacobian(jf, e);
     Vec6 step = f;
-    const double det = ev.solve(jf, step);
+    const double det = ev.solve(jf, step, e);
     if (!(det > 1e-18) || !std::isfinite(det) || !step.allFinite()) return finish(CompStatus::SingularJacobian);
     q -= step;
   }
@@ -164,28 +236,33 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
 
 }  // namespace
 
-Mat6 pose_deviation_jacobian(const Model& cal, const Q6& q_deg, const Pose6& desired) {
+Mat6 pose_deviation_jacobian(const Model& cal, const Q6& q_deg, const Pose6& desired, Residual residual,
+                             const EffectContext& ctx) {
   if (cal.dof() != 6) throw std::invalid_argument("pose_deviation_jacobian needs a 6-joint robot");
-  DeviationEvaluator ev(cal, desired);
+  check_context(cal, ctx, "");
+  DeviationEvaluator ev(cal, desired, ctx, residual);
   ev.deviation_at(q_deg);
   Mat6r jf;
-  ev.jacobian(jf);
+  Mat3 e;
+  ev.jacobian(jf, e);
   return jf;
 }
 
-CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& q0_deg, const CompensationOptions& opt) {
+CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& q0_deg, const CompensationOptions& opt,
+                              const EffectContext& ctx) {
   CompensationResult res;
   res.q_deg = q0_deg;
   if (cal.dof() != 6) {
     res.status = CompStatus::NotSixJoints;
     return res;
   }
-  if (!opt.finite_difference) return compensate_analytic(cal, desired, q0_deg, opt);
+  if (cal.needs_dir() || cal.needs_temperature()) check_context(cal, ctx, "");
+  if (!opt.finite_difference) return compensate_analytic(cal, desired, q0_deg, opt, ctx);
   // the paper's iteration with its finite-difference Jacobian (eq. 7)
   Q6 q = q0_deg;
   Mat6r jf;
   for (int it = 0;; ++it) {
-    Vec6 f = deviation(fk_compliant(cal, to_rad(q)), desired);
+    Vec6 f = deviation_of(fk_model(cal, to_rad(q), ctx), desired, opt.residual);
     res.q_deg = q;
     res.iterations = it;
     res.residual = f.norm();
@@ -203,7 +280,7 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
     for (int i = 0; i < 6; ++i) {
       Q6 qi = q;
       qi[i] += opt.delta;
-      Vec6 fi = deviation(fk_compliant(cal, to_rad(qi)), desired);
+      Vec6 fi = deviation_of(fk_model(cal, to_rad(qi), ctx), desired, opt.residual);
       jf.col(i) = (fi - f) / opt.delta;
     }
     const double det = solve6(jf, f);
@@ -239,13 +316,13 @@ Q6 wrap_near(const Model& m, const Q6& q, const Q6& ref) {
 namespace {
 
 /// Damped least squares from q (deg) toward the desired pose; true when it gets within 1e-6 mm/rad.
-bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q) {
+bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q, const EffectContext& ctx) {
   Eigen::Isometry3d t;
   Jac jg;
   double lambda = 1e-2;
   const double w = 1000.0;  // mm per rad of orientation error
   auto error = [&](const Q6& qq, Vec6& e) {
-    const Eigen::Isometry3d tt = fk_compliant(m, to_rad(qq));
+    const Eigen::Isometry3d tt = fk_model(m, to_rad(qq), ctx);
     const Eigen::AngleAxisd aa(tt.linear() * target.linear().transpose());
     e.head<3>() = tt.translation() - target.translation();
     e.tail<3>() = w * aa.angle() * aa.axis();
@@ -254,7 +331,7 @@ bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q) {
   Vec6 e;
   double err = error(q, e);
   for (int it = 0; it < 300 && err > 1e-6; ++it) {
-    fk_jacobian_compliant(m, to_rad(q), t, jg);
+    fk_jacobian_model(m, to_rad(q), ctx, t, jg);
     Mat6 j;
     j.topRows<3>() = jg.topRows<3>();
     j.bottomRows<3>() = w * jg.bottomRows<3>();
@@ -288,7 +365,7 @@ bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q) {
 }  // namespace
 
 bool numeric_ik(const Model& m, const Pose6& desired, const Q6& ref, Q6& q_out, const CompensationOptions& opt,
-                int starts) {
+                int starts, const EffectContext& ctx) {
   const Eigen::Isometry3d target = pose_to_iso(desired);
   std::vector<Q6> seeds = {ref};
   if (m.spec().home_deg.size() == 6) seeds.push_back(Eigen::Map<const Q6>(m.spec().home_deg.data()));
@@ -305,8 +382,8 @@ bool numeric_ik(const Model& m, const Pose6& desired, const Q6& ref, Q6& q_out, 
   double best = 0;
   for (size_t k = 0; k < seeds.size(); ++k) {
     Q6 q = seeds[k];
-    if (!dls(m, target, q)) continue;
-    const CompensationResult r = compensate(m, desired, q, opt);
+    if (!dls(m, target, q, ctx)) continue;
+    const CompensationResult r = compensate(m, desired, q, opt, ctx);
     if (r.status != CompStatus::Converged) continue;
     const Q6 qq = wrap_near(m, r.q_deg, ref);
     if (!m.within_limits_deg(qq)) continue;

@@ -169,75 +169,56 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
 // ---------------------------------------------------------------------------------------------
 // Simulation: every effect of the truth in one place
 // ---------------------------------------------------------------------------------------------
-int Effect::size() const {
-  if (name == "transmission_error") return 4;
-  if (name == "backlash" || name == "thermal_expansion") return 1;
-  throw InputError("unknown effect '" + name + "' (transmission_error, backlash, thermal_expansion)");
-}
-
-std::string Effect::label() const {
-  return joint >= 0 ? name + "(joint " + std::to_string(joint + 1) + ")" : name;
-}
-
 namespace {
 
 /// Joint-angle offsets (rad) of the effects at a row, and the thermal scale factor.
 void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measurement& m, double t_ref, VecQ& dq,
                     double& scale) {
   scale = 1.0;
+  double b[128];
   for (const Effect& e : eff) {
-    if (e.name == "transmission_error") {
-      const double qj = m.q_deg[e.joint] * kDeg;
-      double s1, c1;
-      fastmath::sincos(qj, s1, c1);
-      dq[e.joint] += p[0] * s1 + p[1] * c1 + p[2] * (2 * s1 * c1) + p[3] * (c1 * c1 - s1 * s1);
-    } else if (e.name == "backlash") {
-      if (m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
-      dq[e.joint] += p[0] * m.dir[e.joint];
-    } else if (e.name == "thermal_expansion") {
+    if (e.name == "thermal_expansion") {
       if (std::isnan(m.temperature_c)) throw InputError("thermal_expansion needs the temperature_c column");
       scale *= 1.0 + p[0] * (m.temperature_c - t_ref);
+    } else {
+      if (e.name == "backlash" && m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
+      joint_basis(e, m.q_deg[e.joint] * kDeg, e.name == "backlash" ? m.dir[e.joint] : 0.0, b);
+      for (int k = 0; k < e.size(); ++k) dq[e.joint] += p[k] * b[k];
     }
     p += e.size();
   }
 }
 
-/// The truth's tool frame (instrument frame) at a row with every effect acting, and the thermal
-/// scale of its lengths: the one place the simulator computes where the robot really is.
-Eigen::Isometry3d truth_tool(const Model& truth, const Measurement& row, const std::vector<EffectValue>& effects,
-                             double t_ref, double& scale) {
-  std::vector<Effect> eff;
-  std::vector<double> p;
-  for (const auto& ev : effects) {
-    if (static_cast<int>(ev.p.size()) != ev.effect.size()) throw InputError(ev.effect.label() + ": wrong parameter count");
-    eff.push_back(ev.effect);
-    p.insert(p.end(), ev.p.begin(), ev.p.end());
-  }
-  const VecQ q = row.q_deg * kDeg;
-  VecQ dq = VecQ::Zero(q.size());
-  scale = 1.0;
-  effect_offsets(eff, p.data(), row, t_ref, dq, scale);
-  return fk(truth, deflected(truth, q) + dq);
+/// The context of a row for the model's effects (its dir and temperature).
+EffectContext row_context(const Measurement& row) {
+  EffectContext c;
+  c.dir = row.dir;
+  c.temperature_c = row.temperature_c;
+  return c;
 }
 
 }  // namespace
 
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target,
-                    const std::vector<EffectValue>& effects, double t_ref) {
-  double scale;
-  const Eigen::Isometry3d tool = truth_tool(truth, row, effects, t_ref, scale);
-  return truth.base_in_instrument() * (scale * (tool * target));
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target) {
+  const EffectContext ctx = row_context(row);
+  const Eigen::Isometry3d tool = fk(truth, joint_angles(truth, row.q_deg * kDeg, ctx));
+  // thermal expansion: every length of the robot, the target's offset included, scales
+  return truth.base_in_instrument() * (length_scale(truth, ctx) * (tool * target));
 }
 
-Vec3 simulate_point(const Model& truth, const VecQ& q_deg, const Vec3& target) {
-  const VecQ q = q_deg * kDeg;
-  // joint compliance under gravity (truth masses and payload); later effects plug in here
-  const Eigen::Isometry3d tool = fk_compliant(truth, q);
-  return truth.base_in_instrument() * (tool * target);
+ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref) {
+  ModelSpec s = truth;
+  if (effects.empty()) return s;
+  bool thermal = false;
+  for (const auto& e : s.effects) thermal = thermal || e.effect.name == "thermal_expansion";
+  if (!thermal) s.t_ref_c = t_ref;
+  for (const auto& e : effects) s.effects.push_back(e);
+  return s;
 }
 
-MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
+MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
   if (opt.poses < 1) throw InputError("simulate: the number of poses must be positive");
+  const Model truth(with_effects(truth_in.spec(), opt.effects, opt.t_ref));
   if (opt.targets.empty()) throw InputError("simulate: at least one target");
   MeasurementSet m;
   m.source = "simulated";
@@ -266,12 +247,11 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt) {
       row.dir = dir;
       row.temperature_c = temp;
       row.target = t;
-      row.xyz = simulate_point(truth, row, opt.targets[t], opt.effects, opt.t_ref);
+      row.xyz = simulate_point(truth, row, opt.targets[t]);
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
       if (opt.orientation_noise_deg >= 0) {
         // the measured tool frame (a 6-D probe): truth orientation, then a small random rotation
-        double scale;
-        const Mat3 r = truth.base_in_instrument().linear() * truth_tool(truth, row, opt.effects, opt.t_ref, scale).linear();
+        const Mat3 r = truth.base_in_instrument().linear() * fk_model(truth, row.q_deg * kDeg, row_context(row)).linear();
         const Vec3 e = Vec3(nd(rng), nd(rng), nd(rng)) * opt.orientation_noise_deg * kDeg;
         row.has_abc = true;
         row.abc = rotation_to_abc(so3_exp(e) * r);
@@ -299,8 +279,9 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
   effects = targets + 3 * n_targets;
   size = effects;
   for (const Effect& e : effect_list) {
-    if (e.name != "thermal_expansion" && (e.joint < 0 || e.joint >= dof))
-      throw InputError(e.name + ": joint " + std::to_string(e.joint + 1) + " is not one of 1.." + std::to_string(dof));
+    check_effect(e, dof, "");
+    if (e.name == "joint_compliance")
+      throw InputError("joint_compliance is identified through IdentifyOptions::compliance, not as an extra effect");
     effect_offset.push_back(size);
     size += e.size();
   }
@@ -318,12 +299,8 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
     for (const char* s : {".x", ".y", ".z"}) names.push_back("target" + std::to_string(t) + s), units.push_back("mm");
   for (const Effect& e : effect_list) {
     const std::string p = e.joint >= 0 ? "joint" + std::to_string(e.joint + 1) + "." : "";
-    if (e.name == "transmission_error")
-      for (const char* s : {"te_sin1", "te_cos1", "te_sin2", "te_cos2"}) names.push_back(p + s), units.push_back("rad");
-    else if (e.name == "backlash")
-      names.push_back(p + "backlash"), units.push_back("rad");
-    else
-      names.push_back("thermal_expansion"), units.push_back("1/degC");
+    for (const auto& n : e.parameter_names()) names.push_back(p + n);
+    for (const auto& u : e.units()) units.push_back(u);
   }
 }
 
@@ -346,6 +323,7 @@ PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Ef
 void PointModel::set_params(const std::vector<double>& x) {
   x_ = x;
   spec_ = nominal_.spec();
+  spec_.effects.clear();  // the layout's effects act through x, never twice through the model
   const int n = layout_.dof;
   for (int j = 0; j < n; ++j) {
     const double* a = &x[4 * j];
@@ -674,17 +652,12 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
-    if (ef.name == "transmission_error") {
-      const double qj = q[ef.joint];
-      double s1, c1;
-      fastmath::sincos(qj, s1, c1);
-      const double b[4] = {s1, c1, 2 * s1 * c1, c1 * c1 - s1 * s1};  // sin, cos of q and 2q
-      for (int k = 0; k < 4; ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
+    if (ef.name != "thermal_expansion") {  // joint-angle effects: dq_j = p . basis
+      double b[128];
+      joint_basis(ef, q[ef.joint], ef.name == "backlash" ? m.dir[ef.joint] : 0.0, b);
+      for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
       if (ang)
-        for (int k = 0; k < 4; ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
-    } else if (ef.name == "backlash") {
-      J.col(c) = rb_ * jp[ef.joint] * m.dir[ef.joint];
-      if (ang) W.col(c) = rb_ * jw[ef.joint] * m.dir[ef.joint];
+        for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
     } else {
       J.col(c) = rb_ * xr * (m.temperature_c - layout_.t_ref);
     }
@@ -724,11 +697,6 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
 }
 
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data) {
-  return point_errors(model, targets, data, {}, 20.0);
-}
-
-std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
-                                 const std::vector<EffectValue>& effects, double t_ref) {
   std::vector<double> e;
   e.reserve(data.rows.size());
   std::map<double, std::shared_ptr<const Model>> variants;
@@ -744,7 +712,7 @@ std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& ta
       m = v.get();
     }
     const Vec3 t = r.target < static_cast<int>(targets.size()) ? targets[r.target] : Vec3::Zero();
-    e.push_back((simulate_point(*m, r, t, effects, t_ref) - r.xyz).norm());
+    e.push_back((simulate_point(*m, r, t) - r.xyz).norm());
   }
   return e;
 }
@@ -969,13 +937,21 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     if (r.q_deg.size() != nominal.dof())
       throw InputError(data.source + ":" + std::to_string(r.line) + ": " + std::to_string(r.q_deg.size()) +
                        " joint angles but the robot has " + std::to_string(nominal.dof()));
-  double t_ref = 20.0;
+  // the extra effects: those asked for, then those the starting model carries (held at their values)
+  std::vector<Effect> effects = opt.effects;
+  const auto same = [](const Effect& a, const Effect& b) { return a.name == b.name && a.joint == b.joint; };
+  for (const EffectValue& ev : nominal.spec().effects) {
+    bool asked = false;
+    for (const Effect& e : effects) asked = asked || same(e, ev.effect);
+    if (!asked) effects.push_back(ev.effect);
+  }
+  double t_ref = nominal.spec().t_ref_c;
   bool thermal = false;
-  for (const Effect& e : opt.effects) {
-    e.size();  // a known name
+  for (const Effect& e : effects) {
+    check_effect(e, nominal.dof(), "");
     if (e.name == "thermal_expansion") thermal = true;
   }
-  if (thermal) {
+  if (thermal && nominal.thermal_alpha() == 0) {
     double sum = 0;
     for (const auto& r : data.rows) {
       if (std::isnan(r.temperature_c))
@@ -984,21 +960,36 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     }
     t_ref = sum / data.rows.size();
   }
-  for (const Effect& e : opt.effects)
+  if (thermal)
+    for (const auto& r : data.rows)
+      if (std::isnan(r.temperature_c))
+        throw InputError(data.source + ":" + std::to_string(r.line) + ": thermal_expansion needs the temperature_c column");
+  for (const Effect& e : effects)
     if (e.name == "backlash")
       for (const auto& r : data.rows)
         if (r.dir.size() != nominal.dof())
           throw InputError(data.source + ":" + std::to_string(r.line) + ": backlash needs the dir1..dir" +
                            std::to_string(nominal.dof()) + " columns");
-  IdentifyResult res(ParamLayout(nominal, data.n_targets, opt.effects, t_ref));
+  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref));
   const ParamLayout& L = res.layout;
   const int P = L.size;
-  PointModel pm(nominal, data.n_targets, opt.effects, t_ref);
+  PointModel pm(nominal, data.n_targets, effects, t_ref);
   pm.prepare_payloads(data);
   res.start = pm.start(data);
-  std::vector<double> x = res.start;
   res.fixed.assign(P, false);
   res.fixed_reason.assign(P, "");
+  // effects the starting model carries start from its values; those not asked for are held there
+  for (size_t e = 0; e < L.effect_list.size(); ++e)
+    for (const EffectValue& ev : nominal.spec().effects)
+      if (same(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size()) {
+        const bool asked = e < opt.effects.size();
+        for (size_t k = 0; k < ev.p.size(); ++k) {
+          const size_t i = static_cast<size_t>(L.effect_offset[e]) + k;
+          res.start[i] = ev.p[k];
+          if (!asked) res.fixed[i] = true, res.fixed_reason[i] = "carried by the starting model (not asked for)";
+        }
+      }
+  std::vector<double> x = res.start;
   std::vector<int> targets_used(data.n_targets, 0);
   for (const auto& r : data.rows) targets_used[r.target] = 1;
   for (int t = 0; t < data.n_targets; ++t)
@@ -1202,9 +1193,11 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   for (size_t e = 0; e < L.effect_list.size(); ++e)
     res.effects.push_back({L.effect_list[e], std::vector<double>(x.begin() + L.effect_offset[e],
                                                                  x.begin() + L.effect_offset[e] + L.effect_list[e].size())});
+  res.calibrated.effects = res.effects;  // the model carries every identified effect
+  res.calibrated.t_ref_c = t_ref;
   {
     const Model cal(res.calibrated);
-    const std::vector<double> e = point_errors(cal, res.targets, data, res.effects, t_ref);
+    const std::vector<double> e = point_errors(cal, res.targets, data);
     double ss = 0;
     for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
     res.rms_mm = std::sqrt(ss / e.size());

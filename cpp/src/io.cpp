@@ -2,6 +2,8 @@
 
 #include "kincal/kinematics.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -215,70 +217,140 @@ Q6 home_of(const Model& m) {
 
 }  // namespace
 
-// Nominal IK start (nearest ref) and Newton compensation of one pose. Returns false with the
-// cause in err; allocates nothing on success.
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose_in, const Q6& ref, Q6& q_out,
-                int& iterations, double& residual, std::string& err) {
+namespace {
+
+// The limit a compensated solution violates, as a message; empty when inside the limits.
+std::string limit_violation(const Model& m, const Q6& q) {
+  if (m.within_limits_deg(q)) return {};
+  for (int j = 0; j < 6; ++j) {
+    const auto& js = m.spec().joints[j];
+    if (q[j] < js.lower_deg - 1e-9 || q[j] > js.upper_deg + 1e-9) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "compensated q%d = %.4f deg is outside its limits [%g, %g]", j + 1, q[j],
+                    js.lower_deg, js.upper_deg);
+      return buf;
+    }
+  }
+  return "outside the joint limits";
+}
+
+// Newton on the calibrated model from one nominal IK solution q0 (corrected once, by default).
+// Returns false with the cause in err.
+bool compensate_from(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Eigen::Isometry3d& target,
+                     Q6 q0, bool approximate_start, const EffectContext& ctx, Q6& q_out, int& iterations,
+                     double& residual, std::string& err) {
   const Model& nom = *robot.nominal;
   const Model& cal = *robot.calibrated;
+  if (opt.corrected_start && robot.identified()) {
+    // one fixed-point step: the nominal IK of the target corrected by the model difference at q0,
+    // e = FK_nom(q0)^-1 FK_cal(q0), where FK_nom(q0) is the target itself unless q0 only came near it
+    const VecQ a = q0 * kDeg;
+    const Eigen::Isometry3d at_q0 = approximate_start ? fk(nom, a) : target;
+    const Eigen::Isometry3d e = at_q0.inverse() * fk_model(cal, a, ctx);
+    const IkSolutions s2 = ik_all(nom, target * e.inverse(), q0.data(), false, true);
+    const int k2 = ik_nearest(nom, s2, q0.data());
+    if (k2 >= 0) q0 = s2.sol[k2].q_deg;
+  }
+  const CompensationResult r = compensate(cal, pose, q0, opt.comp, ctx);
+  if (r.status != CompStatus::Converged) {
+    if (approximate_start) {
+      err = "pose out of reach of the robot (beyond the nominal reach, and the model does not reach it either)";
+      return false;
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " (after %d iterations, |F| = %.3g)", r.iterations, r.residual);
+    err = std::string("compensation failed: ") + to_string(r.status) + buf;
+    return false;
+  }
+  err = limit_violation(cal, r.q_deg);
+  if (!err.empty()) return false;
+  q_out = r.q_deg;
+  iterations = r.iterations;
+  residual = r.residual;
+  return true;
+}
+
+}  // namespace
+
+bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Q6& ref, Q6& q_out,
+                int& iterations, double& residual, std::string& err) {
+  bool changed;
+  return solve_pose(robot, opt, pose, ref, EffectContext(), q_out, iterations, residual, changed, err);
+}
+
+// Nominal IK start (nearest ref) and Newton compensation of one pose; the other branches, nearest
+// first, when the nearest one's compensated solution is not inside the limits. Returns false with
+// the cause in err; allocates nothing when the nearest branch succeeds.
+bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose_in, const Q6& ref,
+                const EffectContext& ctx, Q6& q_out, int& iterations, double& residual, bool& branch_changed,
+                std::string& err) {
+  const Model& nom = *robot.nominal;
+  const Model& cal = *robot.calibrated;
+  branch_changed = false;
+  iterations = 0;
+  residual = 0;
   if (nom.dof() != 6) {
     err = "programs need a 6-joint robot";
     return false;
   }
   Pose6 pose = pose_in;
   if (opt.instrument_frame) pose = iso_to_pose(cal.base_in_instrument().inverse() * pose_to_iso(pose_in));
-  Q6 q0 = ref;
-  bool approximate_start = false;
   if (nom.ik_structure().spherical_wrist_parallel_23) {
     const Eigen::Isometry3d target = pose_to_iso(pose);
     // the branch nearest the reference first; all branches when it is out of limits
     IkSolutions s = ik_all(nom, target, ref.data(), false, true);
-    if (s.status != IkStatus::Ok || !s.sol[0].within_limits) s = ik_all(nom, target, ref.data());
+    bool all = false;
+    if (s.status != IkStatus::Ok || !s.sol[0].within_limits) s = ik_all(nom, target, ref.data()), all = true;
     // a calibrated robot may reach a little beyond the nominal one: start from the nearest
-    if (s.status != IkStatus::Ok && opt.compensate) s = ik_all(nom, target, ref.data(), true);
+    if (s.status != IkStatus::Ok && opt.compensate) s = ik_all(nom, target, ref.data(), true), all = true;
     if (s.status != IkStatus::Ok) {
       err = "pose out of reach of the robot (no inverse-kinematics solution)";
       return false;
     }
     const int k = ik_nearest(nom, s, ref.data());
-    if (k < 0) {
-      err = "no inverse-kinematics solution within the joint limits";
-      return false;
+    if (!opt.compensate) {
+      if (k < 0) {
+        err = "no inverse-kinematics solution within the joint limits";
+        return false;
+      }
+      q_out = s.sol[k].q_deg;
+      return true;
     }
-    q0 = s.sol[k].q_deg;
-    approximate_start = s.sol[k].approximate;
-    if (opt.compensate && opt.corrected_start && robot.identified()) {
-      // one fixed-point step: the nominal IK of the target corrected by the model difference at q0,
-      // e = FK_nom(q0)^-1 FK_cal(q0), where FK_nom(q0) is the target itself unless q0 only came near it
-      const VecQ a = q0 * kDeg;
-      const Eigen::Isometry3d at_q0 = approximate_start ? fk(nom, a) : target;
-      const Eigen::Isometry3d e = at_q0.inverse() * fk_compliant(cal, a);
-      const IkSolutions s2 = ik_all(nom, target * e.inverse(), q0.data(), false, true);
-      const int k2 = ik_nearest(nom, s2, q0.data());
-      if (k2 >= 0) q0 = s2.sol[k2].q_deg;
+    if (k >= 0 && compensate_from(robot, opt, pose, target, s.sol[k].q_deg, s.sol[k].approximate, ctx, q_out,
+                                  iterations, residual, err))
+      return true;
+    // the nearest branch does not give a compensated solution inside the limits: the others, nearest
+    // first (a nominal solution a little outside the limits may come inside once compensated)
+    const std::string first_err = k >= 0 ? err : "no inverse-kinematics solution within the joint limits";
+    const Q6 tried = k >= 0 ? s.sol[k].q_deg : Q6::Constant(1e300);
+    if (!all) s = ik_all(nom, target, ref.data(), false, false);
+    std::array<int, 8> order;
+    std::array<double, 8> dist;
+    for (int i = 0; i < s.count; ++i) order[i] = i, dist[i] = (s.sol[i].q_deg - ref).cwiseAbs().maxCoeff();
+    for (int i = 1; i < s.count; ++i)  // insertion sort by distance (at most 8)
+      for (int j = i; j > 0 && dist[order[j]] < dist[order[j - 1]]; --j) std::swap(order[j], order[j - 1]);
+    for (int i = 0; i < s.count; ++i) {
+      const IkSolution& c = s.sol[order[i]];
+      if ((c.q_deg - tried).cwiseAbs().maxCoeff() < 1e-9) continue;  // the nearest branch, tried first
+      if (compensate_from(robot, opt, pose, target, c.q_deg, c.approximate, ctx, q_out, iterations, residual, err)) {
+        branch_changed = true;
+        return true;
+      }
     }
-  }
-  iterations = 0;
-  residual = 0;
-  if (!opt.compensate && nom.ik_structure().spherical_wrist_parallel_23) {
-    q_out = q0;
-    return true;
+    err = first_err + (s.count > 1 ? "; no other branch reaches the pose inside the limits" : "");
+    return false;
   }
   // nominal robots without closed-form IK, and every calibrated robot: Newton on the model
   const Model& target_model = opt.compensate ? cal : nom;
-  CompensationResult r = compensate(target_model, pose, q0, opt.comp);
-  if (!nom.ik_structure().spherical_wrist_parallel_23) {
+  const EffectContext none;
+  const EffectContext& c = opt.compensate ? ctx : none;
+  CompensationResult r = compensate(target_model, pose, ref, opt.comp, c);
+  if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
+  if (r.status != CompStatus::Converged || !target_model.within_limits_deg(r.q_deg)) {
+    // no closed form to start from: a numerical IK from the reference, home and seeded starts
+    Q6 qn;
+    if (numeric_ik(target_model, pose, ref, qn, opt.comp, 48, c)) r = compensate(target_model, pose, qn, opt.comp, c);
     if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
-    if (r.status != CompStatus::Converged || !target_model.within_limits_deg(r.q_deg)) {
-      // no closed form to start from: a numerical IK from the reference, home and seeded starts
-      Q6 qn;
-      if (numeric_ik(target_model, pose, ref, qn, opt.comp)) r = compensate(target_model, pose, qn, opt.comp);
-      if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
-    }
-  }
-  if (r.status != CompStatus::Converged && approximate_start) {
-    err = "pose out of reach of the robot (beyond the nominal reach, and the model does not reach it either)";
-    return false;
   }
   if (r.status != CompStatus::Converged) {
     char buf[160];
@@ -286,18 +358,8 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
     err = std::string("compensation failed: ") + to_string(r.status) + buf;
     return false;
   }
-  if (!target_model.within_limits_deg(r.q_deg)) {
-    for (int j = 0; j < 6; ++j) {
-      const auto& js = target_model.spec().joints[j];
-      if (r.q_deg[j] < js.lower_deg - 1e-9 || r.q_deg[j] > js.upper_deg + 1e-9) {
-        char buf[200];
-        std::snprintf(buf, sizeof buf, "compensated q%d = %.4f deg is outside its limits [%g, %g]", j + 1, r.q_deg[j],
-                      js.lower_deg, js.upper_deg);
-        err = buf;
-        return false;
-      }
-    }
-  }
+  err = limit_violation(target_model, r.q_deg);
+  if (!err.empty()) return false;
   q_out = r.q_deg;
   iterations = r.iterations;
   residual = r.residual;
@@ -392,12 +454,14 @@ PoseProgram parse_pose_program(const std::string& text, const std::string& sourc
     int col[6];
     const char* names[6] = {"x", "y", "z", "a", "b", "c"};
     for (int k = 0; k < 6; ++k) col[k] = t.require(names[k]);
+    const int tc = t.find("temperature_c");
     for (size_t r = 0; r < t.cells.size(); ++r) {
       Pose6 pose;
       for (int k = 0; k < 3; ++k) pose.xyz[k] = t.number(r, col[k]);
       for (int k = 0; k < 3; ++k) pose.abc[k] = t.number(r, col[3 + k]);
       p.poses.push_back(pose);
       p.pose_line.push_back(t.line[r]);
+      if (tc >= 0) p.temperature_c.push_back(t.number(r, tc));
     }
     if (p.poses.empty()) throw InputError(source + ": the program has no poses");
     return p;
@@ -506,25 +570,126 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   }
 }
 
-ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& poses,
-                               const std::vector<std::string>& where_of, const ProgramOptions& opt) {
-  ProgramResult res;
-  Q6 ref = home_of(*robot.nominal);
-  std::string err;
-  for (size_t i = 0; i < poses.size(); ++i) {
-    Q6 q;
-    int it;
-    double r;
-    if (!solve_pose(robot, opt, poses[i], ref, q, it, r, err))
-      throw InputError((i < where_of.size() ? where_of[i] : "pose " + std::to_string(i)) + ": " + err);
-    res.q_deg.push_back(q);
-    res.iterations.push_back(it);
-    res.residual.push_back(r);
-    res.max_iterations = std::max(res.max_iterations, it);
-    res.max_residual = std::max(res.max_residual, r);
-    ref = q;
+std::vector<Q6> motion_directions(const std::vector<Q6>& q, const std::vector<double>& initial) {
+  Q6 d = Q6::Ones();
+  if (initial.size() == 6) {
+    d = Eigen::Map<const Q6>(initial.data());
+  } else if (initial.size() == 1) {
+    d.setConstant(initial[0]);
+  } else {  // the direction of each joint's first motion
+    for (int j = 0; j < 6; ++j)
+      for (size_t i = 1; i < q.size(); ++i) {
+        const double delta = q[i][j] - q[i - 1][j];
+        if (std::abs(delta) > kStillDeg) {
+          d[j] = delta > 0 ? 1.0 : -1.0;
+          break;
+        }
+      }
   }
-  return res;
+  std::vector<Q6> out(q.size());
+  for (size_t i = 0; i < q.size(); ++i) {
+    for (int j = 0; j < 6 && i > 0; ++j) {
+      const double delta = q[i][j] - q[i - 1][j];
+      if (std::abs(delta) > kStillDeg) d[j] = delta > 0 ? 1.0 : -1.0;
+    }
+    out[i] = d;
+  }
+  return out;
+}
+
+namespace {
+
+Q6 initial_direction(const std::vector<double>& v) {
+  if (v.size() == 1) return Q6::Constant(v[0]);
+  if (v.size() != 6) throw InputError("--initial-direction needs one sign for every joint, or one for all");
+  for (double x : v)
+    if (x != 1.0 && x != -1.0) throw InputError("--initial-direction: the directions must be +1 or -1");
+  return Eigen::Map<const Q6>(v.data());
+}
+
+// One pose of a program in order: solved with the directions the joints have (held from the
+// previous pose), then, with backlash, again with the directions of its own motion when that motion
+// turns a joint around. ctx.dir holds the directions into the pose on return; prev the pose.
+bool program_step(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, bool first, Q6& prev,
+                  EffectContext& ctx, Q6& q, int& it, double& r, bool& changed, std::string& err) {
+  if (!solve_pose(robot, opt, pose, prev, ctx, q, it, r, changed, err)) return false;
+  if (!first && opt.compensate && robot.calibrated->needs_dir()) {
+    VecQ turned = ctx.dir;
+    bool any = false;
+    for (int j = 0; j < 6; ++j) {
+      const double delta = q[j] - prev[j];
+      if (std::abs(delta) > kStillDeg && (delta > 0 ? 1.0 : -1.0) != ctx.dir[j]) turned[j] = -ctx.dir[j], any = true;
+    }
+    if (any) {
+      EffectContext c2 = ctx;
+      c2.dir = turned;
+      Q6 q2;
+      int it2;
+      double r2;
+      bool changed2;
+      if (!solve_pose(robot, opt, pose, prev, c2, q2, it2, r2, changed2, err)) return false;
+      q = q2, it = it2, r = r2, changed = changed || changed2;
+      // the directions the commanded motion really has (a move inside the backlash keeps its sign)
+      for (int j = 0; j < 6; ++j) {
+        const double delta = q[j] - prev[j];
+        if (std::abs(delta) > kStillDeg) ctx.dir[j] = delta > 0 ? 1.0 : -1.0;
+      }
+    }
+  }
+  prev = q;
+  return true;
+}
+
+}  // namespace
+
+ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& poses,
+                               const std::vector<std::string>& where_of, const ProgramOptions& opt,
+                               const std::vector<double>& temperature_c) {
+  const Model& cal = *robot.calibrated;
+  auto where_i = [&](size_t i) { return i < where_of.size() ? where_of[i] : "pose " + std::to_string(i); };
+  const bool needs_dir = opt.compensate && cal.needs_dir();
+  const bool needs_t = opt.compensate && cal.needs_temperature();
+  std::vector<double> temps(poses.size(), opt.temperature_c);
+  for (size_t i = 0; i < temperature_c.size() && i < poses.size(); ++i)
+    if (std::isfinite(temperature_c[i])) temps[i] = temperature_c[i];
+  if (needs_t)
+    for (size_t i = 0; i < poses.size(); ++i)
+      if (!std::isfinite(temps[i]))
+        throw InputError(where_i(i) + ": the model has thermal expansion: give the temperature (--temperature C, or "
+                                      "a temperature_c column)");
+  auto run = [&](const Q6& dir0) {
+    ProgramResult res;
+    Q6 prev = home_of(*robot.nominal);
+    EffectContext ctx;
+    if (needs_dir) ctx.dir = dir0;
+    std::string err;
+    for (size_t i = 0; i < poses.size(); ++i) {
+      Q6 q;
+      int it;
+      double r;
+      bool changed;
+      ctx.temperature_c = temps[i];
+      if (!program_step(robot, opt, poses[i], i == 0, prev, ctx, q, it, r, changed, err))
+        throw InputError(where_i(i) + ": " + err);
+      if (changed && i > 0) {
+        const std::string w = where_i(i) + ": branch changed: on the branch nearest the previous pose, " + err;
+        if (opt.keep_branch) throw InputError(w + " (--keep-branch)");
+        res.warnings.push_back(w);
+      }
+      res.q_deg.push_back(q);
+      res.dir.push_back(needs_dir ? Q6(ctx.dir) : Q6::Zero());
+      res.iterations.push_back(it);
+      res.residual.push_back(r);
+      res.max_iterations = std::max(res.max_iterations, it);
+      res.max_residual = std::max(res.max_residual, r);
+    }
+    return res;
+  };
+  if (!needs_dir) return run(Q6::Ones());
+  if (!opt.initial_direction.empty()) return run(initial_direction(opt.initial_direction));
+  // the direction of the first motion: from a first pass that assumes +1, then the program again
+  const ProgramResult first = run(Q6::Ones());
+  return run(motion_directions(first.q_deg, {})[0]);
 }
 
 std::string format_joint_program(const PoseProgram& in, const ProgramResult& res, bool csv) {
@@ -565,7 +730,7 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
   std::vector<std::string> where_of;
   where_of.reserve(prog.poses.size());
   for (int l : prog.pose_line) where_of.push_back(where(in_path, l));
-  const ProgramResult res = compensate_poses(robot, prog.poses, where_of, opt);
+  const ProgramResult res = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
   write_file_atomic(out_path, format_joint_program(prog, res, is_csv_path(out_path)));
   return res;
 }
@@ -575,21 +740,38 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
 // ---------------------------------------------------------------------------------------------
 StreamCompensator::StreamCompensator(Robot robot, ProgramOptions opt) : robot_(std::move(robot)), opt_(opt) {
   prev_ = home_of(*robot_.nominal);
+  if (opt_.compensate && robot_.calibrated->needs_dir()) {
+    if (opt_.initial_direction.empty())
+      throw InputError("the model has backlash and a stream cannot look ahead to the first motion: give each "
+                       "joint's direction into the first pose (--initial-direction)");
+    ctx_.dir = initial_direction(opt_.initial_direction);
+  }
+  warning_.reserve(512);
 }
 
-Q6 StreamCompensator::solve(const Pose6& p) {
+Q6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
   Q6 q;
   int it;
   double r;
+  bool changed;
   std::string err;
-  if (!solve_pose(robot_, opt_, p, prev_, q, it, r, err))
+  ctx_.temperature_c = std::isfinite(temperature_c) ? temperature_c : opt_.temperature_c;
+  if (opt_.compensate && robot_.calibrated->needs_temperature() && !std::isfinite(ctx_.temperature_c))
+    fail_at("stdin", line_no_, "the model has thermal expansion: give the temperature (--temperature C, or a "
+                               "temperature_c column)");
+  if (!program_step(robot_, opt_, p, first_, prev_, ctx_, q, it, r, changed, err))
     throw InputError(std::string("stdin:") + std::to_string(line_no_) + ": " + err);
-  prev_ = q;
+  if (changed && !first_) {
+    if (opt_.keep_branch) fail_at("stdin", line_no_, "branch changed: on the branch nearest the previous pose, " + err);
+    warning_ = "stdin:" + std::to_string(line_no_) + ": branch changed: on the branch nearest the previous pose, " + err;
+  }
+  first_ = false;
   return q;
 }
 
 size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap) {
   ++line_no_;
+  warning_.clear();
   while (n > 0 && (s[n - 1] == '\r' || s[n - 1] == '\n')) --n;
   // CSV when the line has commas and no pose letters in it
   bool has_comma = false, has_letter = false;
@@ -613,6 +795,7 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
         while (fe > fb && std::isspace(static_cast<unsigned char>(fe[-1]))) --fe;
         for (int k = 0; k < 6; ++k)
           if (fe - fb == 1 && *fb == names[k][0]) csv_cols_[k] = col, found |= 1 << k;
+        if (fe - fb == 13 && std::strncmp(fb, "temperature_c", 13) == 0) csv_temperature_col_ = col;
         f = c + 1;
       }
       if (found != 63) fail_at("stdin", line_no_, "CSV header needs the columns x,y,z,a,b,c");
@@ -623,13 +806,14 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
       return sizeof hdr - 1;
     }
     Pose6 p;
-    double vals[6];
+    double vals[7];
+    vals[6] = std::numeric_limits<double>::quiet_NaN();
     int got = 0, col = 0;
     for (const char* f = b; f <= e; ++col) {
       const char* c = f;
       while (c < e && *c != ',') ++c;
-      for (int k = 0; k < 6; ++k) {
-        if (csv_cols_[k] != col) continue;
+      for (int k = 0; k < 7; ++k) {
+        if (k < 6 ? csv_cols_[k] != col : csv_temperature_col_ != col) continue;
         const char* fb = f;
         const char* fe = c;
         while (fb < fe && std::isspace(static_cast<unsigned char>(*fb))) ++fb;
@@ -637,15 +821,15 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
         bool nonfinite;
         if (!parse_double(fb, fe, vals[k], nonfinite))
           fail_at("stdin", line_no_,
-                  std::string("column ") + "xyzabc"[k] + ": '" + std::string(fb, fe) + "' is not a " +
-                      (nonfinite ? "finite number" : "number"));
-        ++got;
+                  std::string("column ") + (k < 6 ? std::string(1, "xyzabc"[k]) : std::string("temperature_c")) +
+                      ": '" + std::string(fb, fe) + "' is not a " + (nonfinite ? "finite number" : "number"));
+        got += k < 6;
       }
       f = c + 1;
     }
     if (got != 6) fail_at("stdin", line_no_, "a CSV pose line needs x,y,z,a,b,c");
     for (int k = 0; k < 3; ++k) p.xyz[k] = vals[k], p.abc[k] = vals[3 + k];
-    return format_joints(out, cap, solve(p), true);
+    return format_joints(out, cap, solve(p, vals[6]), true);
   }
   // G-code
   WordSpan spans[16];
@@ -662,7 +846,7 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
   for (int k = 0; k < 6; ++k)
     if (!modal_set_[k])
       fail_at("stdin", line_no_, std::string("pose word ") + kPoseLetters[k] + " not set yet on the first motion line");
-  const Q6 q = solve(modal_);
+  const Q6 q = solve(modal_, std::numeric_limits<double>::quiet_NaN());
   char cut[4096];
   size_t insert_at;
   const size_t cn = cut_spans(s, n, spans, cnt, cut, sizeof cut, insert_at, "stdin", line_no_);

@@ -158,6 +158,58 @@ VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd) {
   return out;
 }
 
+void check_context(const Model& m, const EffectContext& ctx, const std::string& who) {
+  if (m.needs_dir() && ctx.dir.size() != m.dof()) {
+    std::string joints;
+    for (const EffectValue& e : m.joint_effects())
+      if (e.effect.name == "backlash") joints += (joints.empty() ? "" : ", ") + std::to_string(e.effect.joint + 1);
+    throw InputError(who + "the model has backlash on joint(s) " + joints +
+                     ": the direction of motion into each pose is needed (dir1..dir" + std::to_string(m.dof()) +
+                     ")");
+  }
+  if (m.needs_dir())
+    for (int j = 0; j < m.dof(); ++j)
+      if (ctx.dir[j] != 1.0 && ctx.dir[j] != -1.0)
+        throw InputError(who + "dir" + std::to_string(j + 1) + " must be +1 or -1");
+  if (m.needs_temperature() && !std::isfinite(ctx.temperature_c))
+    throw InputError(who + "the model has thermal expansion: the temperature is needed (temperature_c)");
+}
+
+VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ* dqd) {
+  VecQ out = deflected(m, q, dqd);
+  if (!m.has_joint_effects()) return out;
+  double b[128], db[128];
+  for (const EffectValue& ev : m.joint_effects()) {
+    const int j = ev.effect.joint;
+    joint_basis(ev.effect, q[j], ev.effect.name == "backlash" ? ctx.dir[j] : 0.0, b, dqd ? db : nullptr);
+    double d = 0, dd = 0;
+    for (size_t k = 0; k < ev.p.size(); ++k) {
+      d += ev.p[k] * b[k];
+      if (dqd) dd += ev.p[k] * db[k];
+    }
+    out[j] += d;
+    if (dqd) (*dqd)(j, j) += dd;
+  }
+  return out;
+}
+
+Eigen::Isometry3d fk_model(const Model& m, const VecQ& q, const EffectContext& ctx) {
+  Eigen::Isometry3d t = fk(m, joint_angles(m, q, ctx));
+  t.translation() *= length_scale(m, ctx);
+  return t;
+}
+
+void fk_jacobian_model(const Model& m, const VecQ& q, const EffectContext& ctx, Eigen::Isometry3d& tool, Jac& jac) {
+  MatQ dqd;
+  const VecQ qd = joint_angles(m, q, ctx, &dqd);
+  Jac j0;
+  fk_jacobian(m, qd, tool, j0);
+  jac.noalias() = j0 * dqd;
+  const double s = length_scale(m, ctx);
+  tool.translation() *= s;
+  jac.topRows<3>() *= s;
+}
+
 Eigen::Isometry3d fk_compliant(const Model& m, const VecQ& q) { return fk(m, deflected(m, q)); }
 
 void fk_jacobian_compliant(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& jac) {

@@ -65,6 +65,34 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
   if (n_ < 1 || n_ > kMaxJoints)
     throw InputError(who + "a serial chain needs 1 to " + std::to_string(kMaxJoints) + " revolute joints, got " +
                      std::to_string(n_));
+  // Effects: joint_compliance entries set the joints' compliance; the others are checked and kept
+  {
+    std::vector<EffectValue> rest;
+    for (const EffectValue& ev : spec_.effects) {
+      check_effect(ev.effect, n_, who);
+      if (static_cast<int>(ev.p.size()) != ev.effect.size())
+        throw InputError(who + ev.effect.label() + ": " + std::to_string(ev.p.size()) + " values for " +
+                         std::to_string(ev.effect.size()) + " parameters");
+      for (double v : ev.p)
+        if (!std::isfinite(v)) throw InputError(who + ev.effect.label() + ": a value is NaN or infinite");
+      for (const EffectValue& o : rest)
+        if (o.effect.name == ev.effect.name && o.effect.joint == ev.effect.joint)
+          throw InputError(who + ev.effect.label() + " is given twice");
+      if (ev.effect.name == "joint_compliance") {
+        spec_.joints[ev.effect.joint].compliance_deg_per_knm = ev.p[0];
+        continue;
+      }
+      rest.push_back(ev);
+      if (ev.effect.name == "thermal_expansion") {
+        thermal_alpha_ = ev.p[0];
+      } else {
+        joint_effects_.push_back(ev);
+        needs_dir_ = needs_dir_ || ev.effect.name == "backlash";
+      }
+    }
+    spec_.effects = rest;
+    if (!std::isfinite(spec_.t_ref_c)) throw InputError(who + "the reference temperature is NaN or infinite");
+  }
   for (int j = 0; j < n_; ++j) {
     const JointSpec& js = spec_.joints[j];
     const std::string jn = who + "joint " + std::to_string(j + 1) + ": ";
@@ -326,6 +354,29 @@ namespace {
 json v3(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
 json pose_json(const Pose6& p) { return json{{"xyz_mm", v3(p.xyz)}, {"abc_deg", v3(p.abc)}}; }
 
+json effect_json(const Effect& e, const std::vector<double>& p) {
+  json params = json::array();
+  const auto names = e.parameter_names();
+  const auto units = e.file_units();
+  const auto scale = e.file_scale();
+  for (size_t k = 0; k < p.size(); ++k)
+    params.push_back(json{{"name", names[k]}, {"value", p[k] * scale[k]}, {"unit", units[k]}});
+  json o{{"effect", e.name}, {"joint", e.joint >= 0 ? json(e.joint + 1) : json(nullptr)}, {"parameters", params}};
+  if (e.name == "transmission_error") o["harmonics"] = e.harmonics;
+  return o;
+}
+
+/// Version 2: every effect of the model, compliance included (effect, joint from 1, parameters with
+/// units of the file: degrees, not radians)
+json effects_json(const ModelSpec& s) {
+  json out = json::array();
+  for (size_t j = 0; j < s.joints.size(); ++j)
+    if (s.joints[j].compliance_deg_per_knm != 0)
+      out.push_back(effect_json(Effect{"joint_compliance", static_cast<int>(j), {}}, {s.joints[j].compliance_deg_per_knm}));
+  for (const EffectValue& ev : s.effects) out.push_back(effect_json(ev.effect, ev.p));
+  return out;
+}
+
 json spec_json(const ModelSpec& s) {
   json joints = json::array();
   for (const JointSpec& j : s.joints) {
@@ -346,7 +397,9 @@ json spec_json(const ModelSpec& s) {
               {"payload", json{{"mass_kg", s.payload_kg}, {"com_mm", v3(s.payload_com)}}},
               {"gravity_m_s2", v3(s.gravity)},
               {"base_in_instrument", pose_json(s.base_in_instrument)},
-              {"home_deg", s.home_deg}};
+              {"home_deg", s.home_deg},
+              {"effects", effects_json(s)},
+              {"t_ref_c", s.t_ref_c}};
 }
 
 struct Reader {
@@ -416,7 +469,57 @@ struct Reader {
       if (!h.is_number()) fail(where + ".home_deg", "needs numbers");
       s.home_deg.push_back(h.get<double>());
     }
+    if (o.contains("t_ref_c")) s.t_ref_c = num(o, "t_ref_c", where);
+    if (o.contains("effects")) {
+      const json& effs = o["effects"];
+      if (!effs.is_array()) fail(where + ".effects", "needs a list");
+      for (size_t i = 0; i < effs.size(); ++i) s.effects.push_back(effect(effs[i], where + ".effects[" + std::to_string(i) + "]"));
+    }
     return s;
+  }
+  EffectValue effect(const json& eo, const std::string& w) const {
+    EffectValue ev;
+    const json& name = at(eo, "effect", w);
+    if (!name.is_string()) fail(w + ".effect", "not a string");
+    ev.effect.name = name.get<std::string>();
+    try {
+      effect_kind(ev.effect.name);
+    } catch (const InputError& e) {
+      fail(w + ".effect", e.what());
+    }
+    const json& joint = at(eo, "joint", w);
+    if (joint.is_null()) {
+      ev.effect.joint = -1;
+    } else if (joint.is_number_integer()) {
+      ev.effect.joint = joint.get<int>() - 1;
+    } else {
+      fail(w + ".joint", "needs a joint number (from 1) or null");
+    }
+    if (eo.contains("harmonics")) {
+      const json& h = eo["harmonics"];
+      if (!h.is_array()) fail(w + ".harmonics", "needs a list of orders");
+      ev.effect.harmonics.clear();
+      for (const json& k : h) {
+        if (!k.is_number_integer()) fail(w + ".harmonics", "needs integer orders");
+        ev.effect.harmonics.push_back(k.get<int>());
+      }
+    }
+    const json& params = at(eo, "parameters", w);
+    if (!params.is_array()) fail(w + ".parameters", "needs a list");
+    const auto names = ev.effect.parameter_names();
+    const auto units = ev.effect.file_units();
+    const auto scale = ev.effect.file_scale();
+    if (params.size() != names.size())
+      fail(w + ".parameters", std::to_string(params.size()) + " values for " + std::to_string(names.size()) + " parameters");
+    for (size_t k = 0; k < params.size(); ++k) {
+      const std::string pw = w + ".parameters[" + std::to_string(k) + "]";
+      const json& n = at(params[k], "name", pw);
+      if (!n.is_string() || n.get<std::string>() != names[k]) fail(pw + ".name", "expected '" + names[k] + "'");
+      const json& u = at(params[k], "unit", pw);
+      if (!u.is_string() || u.get<std::string>() != units[k]) fail(pw + ".unit", "expected '" + units[k] + "'");
+      ev.p.push_back(num(params[k], "value", pw) / scale[k]);
+    }
+    return ev;
   }
 };
 
@@ -425,7 +528,7 @@ struct Reader {
 std::string spec_to_json(const ModelSpec& spec) { return spec_json(spec).dump(2); }
 
 std::string robot_to_json(const Robot& robot) {
-  json o{{"format", "kincal-model"}, {"version", 1}, {"nominal", spec_json(robot.nominal->spec())}};
+  json o{{"format", "kincal-model"}, {"version", 2}, {"nominal", spec_json(robot.nominal->spec())}};
   if (robot.identified()) o["calibrated"] = spec_json(robot.calibrated->spec());
   return o.dump(2) + "\n";
 }
@@ -452,9 +555,10 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
   Reader r{source};
   if (!o.is_object() || !o.contains("format") || o["format"] != "kincal-model")
     throw InputError(source + ": not a kincal model (\"format\": \"kincal-model\" missing)");
-  if (!o.contains("version") || !o["version"].is_number_integer() || o["version"].get<int>() != 1)
+  if (!o.contains("version") || !o["version"].is_number_integer() || o["version"].get<int>() < 1 ||
+      o["version"].get<int>() > 2)
     throw InputError(source + ": model version " + (o.contains("version") ? o["version"].dump() : "missing") +
-                     " is not supported (this kincal reads version 1)");
+                     " is not supported (this kincal reads versions 1 and 2)");
   Robot robot;
   try {
     robot.nominal = std::make_shared<Model>(r.spec(r.at(o, "nominal", "model"), "nominal"));

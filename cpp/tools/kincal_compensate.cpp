@@ -21,6 +21,7 @@
 #include <fstream>
 #include <sstream>
 #include <iostream>
+#include <optional>
 #include <string>
 
 namespace {
@@ -97,13 +98,33 @@ int run_fivebar(const std::string& fit_path, const std::string& matrix_path, con
   return 0;
 }
 
+/// "+1", "-1" or six comma-separated signs; empty: none given
+std::vector<double> parse_directions(const std::string& text) {
+  std::vector<double> out;
+  if (text.empty()) return out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    char* end;
+    const double v = std::strtod(item.c_str(), &end);
+    if (end == item.c_str() || *end != '\0' || (v != 1.0 && v != -1.0))
+      throw kincal::InputError("--initial-direction: '" + item + "' is not +1 or -1");
+    out.push_back(v);
+  }
+  if (out.size() != 1 && out.size() != 6)
+    throw kincal::InputError("--initial-direction needs one sign for all joints or six (q1..q6)");
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"kincal-compensate: Newton compensation of pose programs into joint programs"};
   std::string model, program, out, frame = "base";
-  bool stream = false, fd = false, nominal = false;
+  bool stream = false, fd = false, nominal = false, keep_branch = false;
   double eps = 1e-15, delta = 1e-8;
+  std::optional<double> temperature;
+  std::string initial_direction, residual = "rotation_vector";
   int max_iter = 20;
   std::string fivebar, matrix;
   app.add_option("--model", model, "built-in robot name or model JSON");
@@ -118,6 +139,13 @@ int main(int argc, char** argv) {
   app.add_option("--epsilon", eps, "stop when |F|^2 < epsilon (eq. 9)");
   app.add_option("--delta", delta, "finite-difference step, degrees (eq. 7)");
   app.add_option("--max-iterations", max_iter, "Newton iteration limit");
+  app.add_option("--residual", residual, "orientation residual of Newton: rotation_vector (default) or abc (eq. 6)")
+      ->check(CLI::IsMember({"rotation_vector", "abc"}));
+  app.add_option("--temperature", temperature, "thermal expansion: the temperature (deg C) unless a temperature_c column");
+  app.add_option("--initial-direction", initial_direction,
+                 "backlash: each joint's direction into the first pose, +1 or -1 (one for all, or q1..q6 comma "
+                 "separated; default: the direction of the first motion; needed with --stream)");
+  app.add_flag("--keep-branch", keep_branch, "a branch change inside the program is an error, not a warning");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -130,6 +158,10 @@ int main(int argc, char** argv) {
     opt.comp.epsilon = eps;
     opt.comp.delta = delta;
     opt.comp.max_iterations = max_iter;
+    if (residual == "abc") opt.comp.residual = kincal::Residual::Abc;
+    if (temperature) opt.temperature_c = *temperature;
+    opt.keep_branch = keep_branch;
+    opt.initial_direction = parse_directions(initial_direction);
     const kincal::Robot robot = kincal::load_robot(model);
     if (opt.instrument_frame && !robot.identified())
       throw kincal::InputError(model + ": --frame instrument needs an identified model (kincal identify)");
@@ -143,11 +175,13 @@ int main(int argc, char** argv) {
         outbuf[n] = '\n';
         std::fwrite(outbuf, 1, n + 1, stdout);
         std::fflush(stdout);
+        if (!sc.warning().empty()) std::fprintf(stderr, "kincal-compensate: warning: %s\n", sc.warning().c_str());
       }
       return 0;
     }
     if (program.empty() || out.empty()) throw kincal::InputError("--program and --out are needed (or --stream)");
     const auto res = kincal::compensate_program_file(robot, program, out, opt);
+    for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());
     std::fprintf(stderr, "%s: %zu poses, at most %d iterations, largest residual %.3g\n", out.c_str(),
                  res.q_deg.size(), res.max_iterations, res.max_residual);
     return 0;

@@ -1,17 +1,29 @@
 // kincal: Newton compensation of a desired tool pose on a calibrated model (Samak, section II).
 //
-// F = [dX, dY, dZ, dA, dB, dC] in mm and degrees (eq. 6) between the calibrated model's pose at the
-// current machine coordinates and the desired pose; q <- q - J^-1 F (eq. 8) until |F|^2 < epsilon
-// (eq. 9). J is either the paper's finite-difference Jacobian (eq. 7, step delta in degrees of the
-// machine coordinates) or the analytic one (default): the geometric Jacobian of the compliant model
-// mapped to ABC rates.
+// F = [dX, dY, dZ, dR1, dR2, dR3] between the calibrated model's pose at the current machine
+// coordinates and the desired pose: the position difference in mm and, by default, the rotation
+// vector of R_model R_desired^T (base frame) in degrees, which has no singularity (a tool pose with
+// B = +-90 deg is an ordinary pose); or, as an option, the paper's ABC differences dA, dB, dC in
+// degrees (eq. 6), singular at B = +-90. q <- q - J^-1 F (eq. 8) until |F|^2 < epsilon (eq. 9) in
+// mm^2 + deg^2 (for the rotation vector: the squared rotation angle in deg^2). J is either the
+// paper's finite-difference Jacobian (eq. 7, step delta in degrees of the machine coordinates) or
+// the analytic one (default): the geometric Jacobian of the whole model (compliance, transmission
+// error, backlash, thermal expansion) mapped to the residual's rates.
 #pragma once
 
+#include "kincal/kinematics.hpp"
 #include "kincal/model.hpp"
 
 namespace kincal {
 
+/// The orientation part of Newton's residual F.
+enum class Residual {
+  RotationVector,  ///< rotation vector of R_model R_desired^T, degrees (default; no singularity)
+  Abc              ///< the paper's ABC differences (eq. 6), degrees; singular at B = +-90 deg
+};
+
 struct CompensationOptions {
+  Residual residual = Residual::RotationVector;
   bool finite_difference = false;  ///< the paper's eq. 7 instead of the analytic Jacobian
   double delta = 1e-8;             ///< finite-difference step (degrees of the machine coordinates)
   double epsilon = 1e-15;          ///< stop when |F|^2 < epsilon (mm^2 + deg^2)
@@ -29,16 +41,20 @@ struct CompensationResult {
   CompStatus status = CompStatus::NotConverged;
 };
 
-/// The pose deviation F (eq. 6) of the calibrated model at q_deg from the desired pose (xyz, abc).
-Vec6 pose_deviation(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired);
+/// The pose deviation F of the calibrated model (every effect acting in the context ctx) at q_deg
+/// from the desired pose (xyz, abc): mm, and degrees of the chosen residual.
+Vec6 pose_deviation(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired,
+                    Residual residual = Residual::RotationVector, const EffectContext& ctx = EffectContext());
 
 /// The analytic Jacobian of pose_deviation with respect to q_deg, as the default compensation uses
-/// it: rows mm and degrees, columns per degree (the ABC rates singular at B = +-90 deg).
-Mat6 pose_deviation_jacobian(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired);
+/// it: rows mm and degrees, columns per degree (with the ABC residual singular at B = +-90 deg).
+Mat6 pose_deviation_jacobian(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired,
+                             Residual residual = Residual::RotationVector, const EffectContext& ctx = EffectContext());
 
-/// Newton compensation from the start q0_deg (normally the nominal IK solution).
+/// Newton compensation from the start q0_deg (normally the nominal IK solution), every effect of
+/// the model acting in the context ctx (InputError when the context lacks what the model needs).
 CompensationResult compensate(const Model& cal, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& q0_deg,
-                              const CompensationOptions& opt = {});
+                              const CompensationOptions& opt = {}, const EffectContext& ctx = EffectContext());
 
 /// Each joint moved by whole turns to the position nearest the reference, inside its limits when one is.
 Eigen::Matrix<double, 6, 1> wrap_near(const Model& m, const Eigen::Matrix<double, 6, 1>& q_deg,
@@ -49,6 +65,7 @@ Eigen::Matrix<double, 6, 1> wrap_near(const Model& m, const Eigen::Matrix<double
 /// home and from seeded starts inside the joint limits; the converged solution within the limits
 /// nearest the reference (largest joint difference), polished by compensate(). false when none.
 bool numeric_ik(const Model& m, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& ref_deg,
-                Eigen::Matrix<double, 6, 1>& q_deg, const CompensationOptions& opt, int starts = 48);
+                Eigen::Matrix<double, 6, 1>& q_deg, const CompensationOptions& opt, int starts = 48,
+                const EffectContext& ctx = EffectContext());
 
 }  // namespace kincal

@@ -13,7 +13,8 @@
 //   tool 6: translation (mm) and rotation vector (rad, R = R0 Exp(phi));
 //   base 6: the same for the base frame in the instrument frame;
 //   per target 3: offset in the tool frame (mm, absolute);
-//   per extra effect (transmission_error 4, backlash 1, thermal_expansion 1), see Effect.
+//   per extra effect (transmission_error 2 per harmonic order, backlash 1, thermal_expansion 1), see
+//   effects.hpp (the registry).
 // Rows with a measured orientation (a, b, c) add 3 residuals: the weighted rotation vector from the
 // measured to the predicted tool frame.
 // Identification is Ceres Levenberg-Marquardt with an analytic Jacobian. Parameters the data cannot
@@ -26,28 +27,10 @@
 #include <array>
 #include <functional>
 #include <limits>
-#include <limits>
 #include <string>
 #include <vector>
 
 namespace kincal {
-
-/// A non-geometric effect of the measurement model (names of the contract), on one joint or none.
-///   transmission_error: dq_j = p0 sin q_j + p1 cos q_j + p2 sin 2q_j + p3 cos 2q_j (rad)
-///   backlash:           dq_j = p0 dir_j (rad; dir_j = +-1, the sign of the last motion into the pose)
-///   thermal_expansion:  the robot's lengths scale by 1 + p0 (T - t_ref) (p0 per deg C)
-/// (joint_compliance is built in: IdentifyOptions::compliance.)
-struct Effect {
-  std::string name;
-  int joint = -1;  ///< 0-based; -1 for thermal_expansion
-  int size() const;
-  std::string label() const;  ///< e.g. "transmission_error(joint 3)"
-};
-/// An effect with the values of its parameters (a simulation truth).
-struct EffectValue {
-  Effect effect;
-  std::vector<double> p;
-};
 
 struct Measurement {
   int pose = 0;
@@ -89,13 +72,13 @@ struct SimulationOptions {
   double orientation_noise_deg = -1;  ///< >= 0: the tool frame's orientation is measured too (6-D)
 };
 
-/// The point of target t (tool frame) in the instrument frame for commanded joint angles (deg) on a
-/// truth model (compliance and payload included), without noise.
-Vec3 simulate_point(const Model& truth, const VecQ& q_deg, const Vec3& target);
-/// The same with effects acting on the row (its dir and temperature).
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target,
-                    const std::vector<EffectValue>& effects, double t_ref);
+/// The point of target t (tool frame) in the instrument frame for the row's commanded joint angles
+/// on a model, every effect it carries acting (the row's dir and temperature), without noise.
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target);
+/// A campaign on the truth: its own effects and opt.effects (hidden) act.
 MeasurementSet simulate(const Model& truth, const SimulationOptions& opt);
+/// The truth's spec with the hidden effects of opt added (t_ref from opt when the truth has none).
+ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref);
 
 /// Layout of the identification parameter vector for a model and a number of targets.
 struct ParamLayout {
@@ -225,10 +208,8 @@ int row_residuals(const PointModel& pm, const Measurement& m, double weight, boo
 /// are too few for the free parameters.
 IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt);
 
-/// Position errors (mm) of every row of data predicted by a calibrated spec with the given targets.
+/// Position errors (mm) of every row of data predicted by a model (every effect it carries acting)
+/// with the given targets.
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data);
-/// The same with identified effects (values and the reference temperature of thermal_expansion).
-std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
-                                 const std::vector<EffectValue>& effects, double t_ref);
 
 }  // namespace kincal

@@ -6,6 +6,9 @@
 #include "kincal/fastmath.hpp"
 #include "kincal/model.hpp"
 
+#include <limits>
+#include <string>
+
 namespace kincal {
 
 /// Rotation by angle q (rad) about the unit axis k (Rodrigues), with the hot paths' sine and cosine.
@@ -46,6 +49,33 @@ void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau = nullp
 /// The joint angles after deflection under gravity: q + K tau(q); with dqd, also their derivative
 /// d(q + K tau)/dq = I + K dtau/dq (the identity for a model without compliance).
 VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd = nullptr);
+
+/// What the model's effects read besides the joint angles: each joint's direction of motion into
+/// the pose (+-1, backlash; empty when unknown) and the temperature (thermal expansion; NaN when
+/// unknown). Fixed size: no allocation.
+struct EffectContext {
+  VecQ dir;
+  double temperature_c = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// InputError naming what the model needs and the context lacks (`who` in front), e.g. the dir
+/// columns for backlash; nothing when the context suffices.
+void check_context(const Model& m, const EffectContext& ctx, const std::string& who);
+
+/// The angles the joints stand at for commanded q (rad): q + K tau(q) + transmission error(q) +
+/// backlash * dir; with dqd their derivative with respect to q. The context must suffice.
+VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ* dqd = nullptr);
+
+/// The factor every length of the robot scales by (thermal expansion; 1 without it).
+inline double length_scale(const Model& m, const EffectContext& ctx) {
+  return m.thermal_alpha() == 0 ? 1.0 : 1.0 + m.thermal_alpha() * (ctx.temperature_c - m.spec().t_ref_c);
+}
+
+/// Tool pose (base frame) with every effect of the model acting.
+Eigen::Isometry3d fk_model(const Model& m, const VecQ& q, const EffectContext& ctx);
+
+/// Tool pose and the 6xN Jacobian (as fk_jacobian) of the whole model with respect to commanded q.
+void fk_jacobian_model(const Model& m, const VecQ& q, const EffectContext& ctx, Eigen::Isometry3d& tool, Jac& jac);
 
 /// Tool pose with joint compliance (equals fk() for a model without compliance).
 Eigen::Isometry3d fk_compliant(const Model& m, const VecQ& q);

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "kincal/effects.hpp"
 #include "kincal/fastmath.hpp"
 
 namespace KDL {
@@ -86,6 +87,11 @@ struct ModelSpec {
   Vec3 gravity = Vec3(0, 0, -9.81);///< gravity in the base frame (m/s^2)
   Pose6 base_in_instrument;        ///< robot base frame seen from the measuring instrument
   std::vector<double> home_deg;    ///< preferred configuration for the first pose of a program
+  /// non-geometric effects besides the joints' compliance (effects.hpp): transmission error,
+  /// backlash, thermal expansion, with their values in core units (a joint_compliance entry sets the
+  /// joint's compliance_deg_per_knm)
+  std::vector<EffectValue> effects;
+  double t_ref_c = 20.0;           ///< reference temperature of thermal_expansion (deg C)
 };
 
 /// Which closed-form inverse kinematics applies to a model.
@@ -126,6 +132,12 @@ class Model {
   bool gravity_loaded(int j) const { return loaded_[j]; }
   int compliance_count() const;
   bool has_compliance() const { return has_compliance_; }
+  /// effects on the joint angles besides compliance (transmission error, backlash)
+  bool has_joint_effects() const { return !joint_effects_.empty(); }
+  const std::vector<EffectValue>& joint_effects() const { return joint_effects_; }
+  bool needs_dir() const { return needs_dir_; }                  ///< backlash: dir1..dirN needed
+  bool needs_temperature() const { return thermal_alpha_ != 0; }  ///< thermal expansion: T needed
+  double thermal_alpha() const { return thermal_alpha_; }         ///< 1/degC (0: none)
   const Vec3& axis(int j) const { return w_[j]; }
   const Vec3& point(int j) const { return p_[j]; }
   const Eigen::Isometry3d& tool() const { return tool_; }
@@ -159,6 +171,9 @@ class Model {
   IkStructure ik_;
   std::array<bool, kMaxJoints> loaded_{};
   bool has_compliance_ = false;
+  std::vector<EffectValue> joint_effects_;
+  bool needs_dir_ = false;
+  double thermal_alpha_ = 0;
   std::array<Vec3, kMaxJoints> w_, p_;
   std::array<double, kMaxJoints> k_{};
   Eigen::Isometry3d tool_, base_in_instrument_;

@@ -1,0 +1,48 @@
+// Bindings of the effect registry (kincal/effects.hpp): the one list of effect names, their
+// parameters and units, read by the Python package instead of lists of its own.
+#include "common.hpp"
+
+#include <pybind11/operators.h>
+
+#include "kincal/effects.hpp"
+#include "kincal/identify.hpp"
+#include "kincal/model.hpp"
+
+using namespace kincal;
+
+void define_effects(py::module_& m) {
+  py::class_<EffectKind>(m, "EffectKind", "One kind of effect of the registry")
+      .def_readonly("name", &EffectKind::name)
+      .def_readonly("domain", &EffectKind::domain, "'serial' or 'fivebar'")
+      .def_readonly("concerns", &EffectKind::concerns, "'joint', 'link' or 'robot'")
+      .def_readonly("needs", &EffectKind::needs, "the data column it reads: '', 'dir' or 'temperature_c'")
+      .def_readonly("acts_on", &EffectKind::acts_on, "'joint_angle', 'length_scale' or 'link_length'")
+      .def_readonly("description", &EffectKind::description)
+      .def_readonly("gravity_loaded_only", &EffectKind::gravity_loaded_only)
+      .def("__repr__", [](const EffectKind& k) { return "<EffectKind " + k.name + ">"; });
+  m.def("effect_kinds", &effect_kinds, py::return_value_policy::copy, "Every effect kind, in the diagnosis's order");
+  m.def("effect_kind", &effect_kind, py::arg("name"), py::return_value_policy::copy);
+
+  py::class_<Effect>(m, "Effect", "An effect on one joint (or link), or on the whole robot")
+      .def(py::init([](const std::string& name, int joint, std::vector<int> harmonics) {
+             Effect e{name, joint - 1, std::move(harmonics)};
+             effect_kind(name);
+             if (name != "transmission_error") e.harmonics.clear();
+             return e;
+           }),
+           py::arg("name"), py::arg("joint") = 0, py::arg("harmonics") = std::vector<int>{1, 2},
+           "joint counted from 1; 0 for an effect on the whole robot")
+      .def_readonly("name", &Effect::name)
+      .def_property_readonly("joint", [](const Effect& e) { return e.joint + 1; }, "from 1; 0: the whole robot")
+      .def_readonly("harmonics", &Effect::harmonics)
+      .def_property_readonly("size", &Effect::size)
+      .def_property_readonly("label", &Effect::label)
+      .def_property_readonly("parameter_names", &Effect::parameter_names)
+      .def_property_readonly("units", &Effect::units, "core units (angles in rad)")
+      .def_property_readonly("file_units", &Effect::file_units, "units in model files (angles in deg)")
+      .def_property_readonly("file_scale", &Effect::file_scale, "file value = core value * scale")
+      .def("check", [](const Effect& e, int dof) { check_effect(e, dof, ""); }, py::arg("dof"))
+      .def(py::self == py::self)
+      .def("__hash__", [](const Effect& e) { return py::hash(py::make_tuple(e.name, e.joint, e.harmonics)); })
+      .def("__repr__", [](const Effect& e) { return "<Effect " + e.label() + ">"; });
+}

@@ -7,7 +7,9 @@
 //   transmission_error (serial, per joint)  dq_j = sum_k s_k sin(k q_j) + c_k cos(k q_j), harmonic
 //                      orders k an option (default 1 and 2)                         amplitudes in deg
 //   backlash           (serial, per joint)  dq_j = b_j dir_j, dir_j = +-1 the sign of the last motion
-//                      into the pose                                                 b in deg
+//                      into the pose; a gear's play makes the joint lag behind the command: b < 0 b in deg
+//                      (with b > 0, a lead, a reversal smaller than 2|b| has no commanded angle that
+//                      reaches the pose: the compensated program then misses it by up to 2|b|)
 //   thermal_expansion  (serial, robot)      every length of the robot scales by 1 + alpha (T - t_ref):
 //                      the tool point in the base frame scales about the base origin alpha in 1/degC
 //   link_deflection    (five-bar, per link) the link's length varies as p1 cos t1 + p2 sin t1 +
@@ -50,7 +52,9 @@ struct Effect {
   std::vector<std::string> units() const;          ///< "rad", "1/degC", "deg/kNm", "mm"
   std::vector<std::string> file_units() const;     ///< units in model files: "deg" for "rad"
   std::vector<double> file_scale() const;          ///< file value = core value * scale
-  bool operator==(const Effect& o) const { return name == o.name && joint == o.joint && harmonics == o.harmonics; }
+  bool operator==(const Effect& o) const {
+    return name == o.name && joint == o.joint && (name != "transmission_error" || harmonics == o.harmonics);
+  }
 };
 
 /// An effect with the values of its parameters (core units).

@@ -1,0 +1,361 @@
+// The effects a model carries, through every consumer: the registry, model JSON version 2, FK and
+// its Jacobian, Newton compensation (FK(compensate(p)) = p with every effect), programs (backlash
+// directions from the commanded motion, temperature), B = +-90 deg poses and branch changes.
+#include "kincal/compensation.hpp"
+#include "kincal/effects.hpp"
+#include "kincal/identify.hpp"
+#include "kincal/io.hpp"
+#include "kincal/kinematics.hpp"
+
+#include <cstdio>
+#include <fstream>
+
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace kincal;
+
+namespace {
+
+using Q6 = Eigen::Matrix<double, 6, 1>;
+
+// Truth of these tests: kr500 with 1 mm / 0.05 deg geometric errors and compliance 0.003 deg/kNm
+// (seed 11), transmission error on joints 2 and 3 (harmonics 1, 2 and, on joint 3, 3), backlash
+// of 0.01-0.02 deg on joints 1, 2 and 4 (negative: the joint lags behind the command, as a gear's
+// play makes it), thermal expansion 12e-6 per deg C about 20 C.
+ModelSpec effects_spec(bool thermal = true) {
+  ModelSpec s = perturbed_spec(kr500_spec(), 11, 1.0, 0.05, 0.003);
+  const double d = kDeg;
+  s.effects.push_back({Effect{"transmission_error", 1, {1, 2}}, {0.02 * d, -0.01 * d, 0.005 * d, 0.008 * d}});
+  s.effects.push_back({Effect{"transmission_error", 2, {1, 2, 3}},
+                       {-0.015 * d, 0.01 * d, 0.004 * d, -0.006 * d, 0.003 * d, 0.002 * d}});
+  s.effects.push_back({Effect{"backlash", 0, {}}, {-0.01 * d}});
+  s.effects.push_back({Effect{"backlash", 1, {}}, {-0.02 * d}});
+  s.effects.push_back({Effect{"backlash", 3, {}}, {-0.015 * d}});
+  if (thermal) s.effects.push_back({Effect{"thermal_expansion", -1, {}}, {12e-6}});
+  s.t_ref_c = 20.0;
+  return s;
+}
+
+EffectContext random_context(std::mt19937_64& rng) {
+  EffectContext c;
+  c.dir.resize(6);
+  for (int j = 0; j < 6; ++j) c.dir[j] = rng() % 2 ? 1.0 : -1.0;
+  c.temperature_c = std::uniform_real_distribution<double>(15, 35)(rng);
+  return c;
+}
+
+double rot_deg(const Mat3& a, const Mat3& b) { return test::rot_dist(a, b) / kDeg; }
+
+}  // namespace
+
+TEST(Effects, RegistryNamesEveryEffectOnce) {
+  std::vector<std::string> names;
+  for (const auto& k : effect_kinds()) names.push_back(k.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"joint_compliance", "transmission_error", "backlash", "thermal_expansion",
+                                             "link_deflection"}));
+  EXPECT_EQ(effect_kind("backlash").needs, "dir");
+  EXPECT_EQ(effect_kind("link_deflection").domain, "fivebar");
+  EXPECT_THROW(effect_kind("gear_wobble"), InputError);
+  const Effect te{"transmission_error", 2, {1, 2, 5}};
+  EXPECT_EQ(te.size(), 6);
+  EXPECT_EQ(te.parameter_names()[4], "te_sin5");
+  EXPECT_EQ(te.file_units()[0], "deg");
+  EXPECT_THROW(check_effect(Effect{"backlash", 7, {}}, 6, ""), InputError);
+  EXPECT_THROW(check_effect(Effect{"link_deflection", 0, {}}, 6, ""), InputError);
+  EXPECT_THROW(check_effect(Effect{"transmission_error", 0, {2, 2}}, 6, ""), InputError);
+  // the harmonic basis against libm: sin(k q), cos(k q) and their derivatives
+  double b[6], db[6];
+  joint_basis(te, 0.7, 0.0, b, db);
+  const int k[3] = {1, 2, 5};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(b[2 * i], std::sin(k[i] * 0.7), 1e-14);
+    EXPECT_NEAR(b[2 * i + 1], std::cos(k[i] * 0.7), 1e-14);
+    EXPECT_NEAR(db[2 * i], k[i] * std::cos(k[i] * 0.7), 1e-13);
+    EXPECT_NEAR(db[2 * i + 1], -k[i] * std::sin(k[i] * 0.7), 1e-13);
+  }
+}
+
+TEST(Effects, ModelJsonVersion2RoundTripAndVersion1Reads) {
+  auto nom = std::make_shared<Model>(kr500_spec());
+  auto cal = std::make_shared<Model>(effects_spec());
+  const std::string text = robot_to_json(Robot{nom, cal});
+  EXPECT_NE(text.find("\"version\": 2"), std::string::npos);
+  const Robot back = robot_from_json(text, "t.json");
+  ASSERT_EQ(back.calibrated->spec().effects.size(), cal->spec().effects.size());
+  for (size_t i = 0; i < cal->spec().effects.size(); ++i) {
+    EXPECT_TRUE(back.calibrated->spec().effects[i].effect == cal->spec().effects[i].effect);
+    for (size_t k = 0; k < cal->spec().effects[i].p.size(); ++k)
+      EXPECT_NEAR(back.calibrated->spec().effects[i].p[k], cal->spec().effects[i].p[k], 1e-18);
+  }
+  for (int j = 0; j < 6; ++j)
+    EXPECT_EQ(back.calibrated->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
+  // a version 1 file (no effects, no reference temperature) still reads
+  std::string v1 = robot_to_json(Robot{nom, std::make_shared<Model>(perturbed_spec(kr500_spec(), 3))});
+  v1.replace(v1.find("\"version\": 2"), 12, "\"version\": 1");
+  const Robot r1 = robot_from_json(v1, "v1.json");
+  EXPECT_TRUE(r1.calibrated->spec().effects.empty());
+  // a wrong unit is an error naming where
+  std::string bad = text;
+  bad.replace(bad.find("\"unit\": \"deg\""), 13, "\"unit\": \"rad\"");
+  try {
+    robot_from_json(bad, "bad.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.json: calibrated.effects["), std::string::npos) << e.what();
+  }
+}
+
+TEST(Effects, ContextIsCheckedByName) {
+  const Model m(effects_spec());
+  EffectContext c;
+  try {
+    fk_model(m, VecQ::Zero(6), c);
+  } catch (const InputError&) {
+  }
+  EXPECT_THROW(check_context(m, c, ""), InputError);
+  c.dir = VecQ::Ones(6);
+  try {
+    check_context(m, c, "x: ");
+    FAIL() << "the temperature is missing";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("temperature"), std::string::npos);
+  }
+  c.temperature_c = 25;
+  EXPECT_NO_THROW(check_context(m, c, ""));
+}
+
+// The whole model's Jacobian (compliance, transmission error, backlash, thermal) against central
+// differences of fk_model, and the compensation's F Jacobian for both residuals.
+TEST(Effects, JacobiansMatchFiniteDifferences) {
+  const Model m(effects_spec());
+  std::mt19937_64 rng(41);
+  double worst = 0, worst_f = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Q6 q = test::random_q(m, rng, 1.0);
+    const EffectContext c = random_context(rng);
+    Eigen::Isometry3d t;
+    Jac j;
+    fk_jacobian_model(m, q * kDeg, c, t, j);
+    const double h = 1e-6;
+    for (int k = 0; k < 6; ++k) {
+      VecQ qp = q * kDeg, qm = q * kDeg;
+      qp[k] += h;
+      qm[k] -= h;
+      const Eigen::Isometry3d tp = fk_model(m, qp, c), tm = fk_model(m, qm, c);
+      const Vec3 dv = (tp.translation() - tm.translation()) / (2 * h);
+      const Eigen::AngleAxisd aa(tp.linear() * tm.linear().transpose());
+      const Vec3 dw = aa.angle() * aa.axis() / (2 * h);
+      worst = std::max(worst, (dv - j.col(k).head<3>()).norm() / std::max(1.0, dv.norm()));
+      worst = std::max(worst, (dw - j.col(k).tail<3>()).norm());
+    }
+    for (Residual res : {Residual::RotationVector, Residual::Abc}) {
+      Q6 qt = q;
+      qt[0] += 2, qt[4] += 1;  // a desired pose near, not at, the current one
+      const Pose6 desired = iso_to_pose(fk_model(m, qt * kDeg, c));
+      if (res == Residual::Abc && std::abs(desired.abc[1]) > 80) continue;
+      const Mat6 jf = pose_deviation_jacobian(m, q, desired, res, c);
+      for (int k = 0; k < 6; ++k) {
+        Q6 qp = q, qm = q;
+        qp[k] += 1e-5, qm[k] -= 1e-5;
+        const Vec6 col = (pose_deviation(m, qp, desired, res, c) - pose_deviation(m, qm, desired, res, c)) / 2e-5;
+        worst_f = std::max(worst_f, (col - jf.col(k)).cwiseAbs().maxCoeff() / std::max(1.0, col.cwiseAbs().maxCoeff()));
+      }
+    }
+  }
+  std::printf("whole-model Jacobian vs central differences: %.2e; F Jacobians: %.2e\n", worst, worst_f);
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_LT(worst_f, 1e-6);
+}
+
+// FK(compensate(p)) = p with every effect: random reachable poses of the truth (more than 1 deg
+// from its singularities), random directions and temperatures; Newton from the nominal IK.
+TEST(Effects, CompensationInvertsEveryEffect) {
+  auto nom = std::make_shared<Model>(kr500_spec());
+  auto cal = std::make_shared<Model>(effects_spec());
+  const Robot robot{nom, cal};
+  ProgramOptions opt;
+  opt.comp.epsilon = 1e-20;
+  opt.comp.max_iterations = 30;
+  std::mt19937_64 rng(42);
+  int n = 0, ok = 0;
+  double worst_mm = 0, worst_deg = 0;
+  while (n < test::count(2000)) {
+    const Q6 q = test::random_q(*nom, rng, 2.0);
+    if (test::singularity_distance_deg(*nom, q) < 1.0) continue;
+    const EffectContext c = random_context(rng);
+    const Eigen::Isometry3d want = fk_model(*cal, q * kDeg, c);
+    ++n;
+    Q6 out;
+    int it;
+    double r;
+    bool changed;
+    std::string err;
+    if (!solve_pose(robot, opt, iso_to_pose(want), q, c, out, it, r, changed, err)) continue;
+    ++ok;
+    const Eigen::Isometry3d got = fk_model(*cal, out * kDeg, c);
+    worst_mm = std::max(worst_mm, (got.translation() - want.translation()).norm());
+    worst_deg = std::max(worst_deg, rot_deg(got.linear(), want.linear()));
+  }
+  std::printf("every effect: %d of %d poses compensated, worst %.2e mm %.2e deg\n", ok, n, worst_mm, worst_deg);
+  EXPECT_GE(ok, n - n / 500);  // as the rigid model's convergence test: poses at the limits may fail
+  EXPECT_LT(worst_mm, 1e-9);
+  EXPECT_LT(worst_deg, 1e-9);
+}
+
+// A tool pose with B = +-90 deg (tool horizontal) is an ordinary pose for the rotation-vector
+// residual; the paper's ABC residual stops there. Poses: reachable ones with |B| > 80 deg turned to
+// B = +-90 exactly.
+TEST(Effects, PosesAtBPlusMinus90Compensate) {
+  auto nom = std::make_shared<Model>(kr500_spec());
+  auto cal = std::make_shared<Model>(effects_spec(false));
+  const Robot robot{nom, cal};
+  EffectContext c;
+  c.dir = VecQ::Ones(6);
+  std::mt19937_64 rng(44);
+  int done = 0, paper_stopped = 0;
+  while (done < 20) {
+    const Q6 q = test::random_q(*nom, rng, 10.0);
+    if (test::singularity_distance_deg(*nom, q) < 5.0) continue;
+    Pose6 p = iso_to_pose(fk(*nom, q * kDeg));
+    if (std::abs(p.abc[1]) < 80) continue;
+    p.abc[1] = p.abc[1] > 0 ? 90.0 : -90.0;
+    Q6 out;
+    int it;
+    double r;
+    bool changed;
+    std::string err;
+    ProgramOptions opt;
+    opt.comp.epsilon = 1e-20;
+    ASSERT_TRUE(solve_pose(robot, opt, p, q, c, out, it, r, changed, err)) << err;
+    const Eigen::Isometry3d got = fk_model(*cal, out * kDeg, c);
+    EXPECT_LT((got.translation() - p.xyz).norm(), 1e-9);
+    EXPECT_LT(rot_deg(got.linear(), abc_to_rotation(p.abc)), 1e-9);
+    ProgramOptions paper = opt;
+    paper.comp.residual = Residual::Abc;
+    // the ABC rates are singular there: the paper's Newton stops at the singularity or wanders off
+    if (!solve_pose(robot, paper, p, q, c, out, it, r, changed, err)) ++paper_stopped;
+    ++done;
+  }
+  std::printf("20 poses at B = +-90 deg compensated; the ABC residual failed on %d\n", paper_stopped);
+  EXPECT_GE(paper_stopped, 15);
+}
+
+// Point-to-point: poses whose nearest branch's compensated solution leaves a joint limit (the
+// nominal solution sits 0.05 deg inside the limit of q2 or q3, the calibrated robot has 0.2 deg
+// axis errors), where another branch's compensated solution is inside the limits.
+TEST(Effects, BranchChangesToStayWithinLimits) {
+  auto nom = std::make_shared<Model>(kr500_spec());
+  auto cal = std::make_shared<Model>(perturbed_spec(kr500_spec(), 12, 1.0, 0.2, 0.003));
+  const Robot robot{nom, cal};
+  std::mt19937_64 rng(43);
+  CompensationOptions co;
+  co.epsilon = 1e-20;
+  int tried = 0;
+  for (int i = 0; i < 4000 && tried < 20; ++i) {
+    Q6 q = test::random_q(*nom, rng, 5.0);
+    const int j = 1 + i % 2;
+    const auto& js = nom->spec().joints[j];
+    q[j] = i % 4 < 2 ? js.upper_deg - 0.05 : js.lower_deg + 0.05;
+    if (test::singularity_distance_deg(*nom, q) < 5.0) continue;
+    const Pose6 p = iso_to_pose(fk(*nom, q * kDeg));
+    // the nearest branch alone leaves the limits; some other branch does not
+    const CompensationResult alone = compensate(*cal, p, q, co);
+    if (alone.status != CompStatus::Converged || cal->within_limits_deg(alone.q_deg)) continue;
+    const IkSolutions all = ik_all(*nom, pose_to_iso(p), q.data());
+    bool other = false;
+    for (int k = 0; k < all.count; ++k) {
+      const CompensationResult r = compensate(*cal, p, all.sol[k].q_deg, co);
+      other = other || (r.status == CompStatus::Converged && cal->within_limits_deg(r.q_deg));
+    }
+    if (!other) continue;
+    ++tried;
+    Q6 out;
+    int it;
+    double r;
+    bool changed;
+    std::string err;
+    ProgramOptions opt;
+    opt.comp.epsilon = 1e-20;
+    opt.corrected_start = false;  // Newton from the nearest branch itself, as "alone"
+    ASSERT_TRUE(solve_pose(robot, opt, p, q, EffectContext(), out, it, r, changed, err)) << err;
+    EXPECT_TRUE(changed);
+    EXPECT_TRUE(cal->within_limits_deg(out));
+    const Eigen::Isometry3d got = fk_compliant(*cal, out * kDeg);
+    EXPECT_LT((got.translation() - p.xyz).norm(), 1e-9);
+    // with --keep-branch the program stops at that pose instead
+  }
+  std::printf("%d poses whose nearest branch leaves the limits once compensated: solved on another branch\n", tried);
+  EXPECT_GE(tried, 10);
+}
+
+// Backlash directions in programs: the sign of each joint's change, held while it stands still.
+TEST(Effects, MotionDirections) {
+  std::vector<Q6> q(5, Q6::Zero());
+  q[1][0] = 1, q[2][0] = 1, q[3][0] = 0.5, q[4][0] = 0.5 + 1e-9;
+  q[1][1] = -1;
+  const auto d = motion_directions(q, {});
+  EXPECT_EQ(d[0][0], 1.0);   // the direction of the first motion
+  EXPECT_EQ(d[2][0], 1.0);   // held while it stands still
+  EXPECT_EQ(d[3][0], -1.0);  // turned around
+  EXPECT_EQ(d[4][0], -1.0);  // a change below kStillDeg is standing still
+  EXPECT_EQ(d[0][1], -1.0);
+  EXPECT_EQ(d[0][2], 1.0);  // never moves: +1
+  const auto d2 = motion_directions(q, {-1});
+  EXPECT_EQ(d2[0][0], -1.0);
+  EXPECT_EQ(d2[1][0], 1.0);
+}
+
+// A back-and-forth program compensated with every effect runs on the same model (the directions
+// its commanded motion really has, the program's temperature) to the desired poses; the stream
+// (given the initial directions) equals the file.
+TEST(Effects, ProgramWithBacklashRunsToTheDesiredPoses) {
+  auto nom = std::make_shared<Model>(kr500_spec());
+  auto cal = std::make_shared<Model>(effects_spec());
+  const Robot robot{nom, cal};
+  std::vector<Pose6> poses;
+  std::vector<std::string> where;
+  for (int i = 0; i < 60; ++i) {
+    const double s = (i < 30 ? i : 59 - i) * 10.0;  // out along y and back
+    poses.push_back(Pose6{Vec3(2000.0, -300.0 + s, 700.0 + 0.5 * s), Vec3(180.0, 0.0, 180.0)});
+    where.push_back("line " + std::to_string(i + 2));
+  }
+  ProgramOptions opt;
+  opt.comp.epsilon = 1e-20;
+  opt.temperature_c = 27.5;
+  const ProgramResult res = compensate_poses(robot, poses, where, opt);
+  const auto dirs = motion_directions(res.q_deg, {});
+  double worst = 0;
+  int reversals = 0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    EffectContext c;
+    c.dir = dirs[i];
+    c.temperature_c = 27.5;
+    EXPECT_EQ(Q6(c.dir), res.dir[i]);
+    if (i > 0) reversals += (dirs[i] - dirs[i - 1]).cwiseAbs().sum() > 0;
+    const Eigen::Isometry3d got = fk_model(*cal, res.q_deg[i] * kDeg, c);
+    worst = std::max(worst, (got.translation() - poses[i].xyz).norm());
+  }
+  std::printf("back and forth with every effect: worst %.2e mm on the model, %d direction changes\n", worst, reversals);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GE(reversals, 1);
+  // the stream equals the file when told the first pose's directions
+  ProgramOptions so = opt;
+  so.initial_direction.assign(res.dir[0].data(), res.dir[0].data() + 6);
+  StreamCompensator sc(robot, so);
+  char buf[512];
+  const std::string hdr = "x,y,z,a,b,c";
+  sc.process(hdr.data(), hdr.size(), buf, sizeof buf);
+  for (size_t i = 0; i < poses.size(); ++i) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", poses[i].xyz[0], poses[i].xyz[1],
+                  poses[i].xyz[2], poses[i].abc[0], poses[i].abc[1], poses[i].abc[2]);
+    const size_t n = sc.process(line, std::strlen(line), buf, sizeof buf);
+    double v[6];
+    ASSERT_EQ(std::sscanf(std::string(buf, n).c_str(), "%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4, v + 5), 6);
+    for (int j = 0; j < 6; ++j) EXPECT_NEAR(v[j], res.q_deg[i][j], 1e-9);
+  }
+  // without the initial directions a stream cannot start: a clear error
+  EXPECT_THROW(StreamCompensator(robot, opt), InputError);
+}

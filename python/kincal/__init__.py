@@ -19,7 +19,7 @@ from . import _core
 from ._core import Robot
 from .urdf import urdf_model_json
 
-__all__ = ["Robot", "load_robot", "fk", "ik", "compensate", "jacobian", "line_program", "__version__"]
+__all__ = ["Robot", "load_robot", "fk", "ik", "compensate", "run_program", "jacobian", "line_program", "__version__"]
 __version__ = "0.1.0"
 
 ArrayLike = Union[np.ndarray, Sequence[Sequence[float]]]
@@ -33,12 +33,29 @@ def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: 
     return Robot.load(s)
 
 
-def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "base") -> np.ndarray:
-    """Tool poses (N x 6: x,y,z mm, a,b,c deg) for joint angles in degrees (N x dof)."""
+def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "base",
+       dir: Optional[ArrayLike] = None, temperature_c: Union[None, float, Sequence[float]] = None) -> np.ndarray:
+    """Tool poses (N x 6: x,y,z mm, a,b,c deg) for joint angles in degrees (N x dof), every effect
+    of the model acting: ``dir`` (N x dof signs +-1, the direction of each joint's last motion into
+    the pose) when it has backlash, ``temperature_c`` (one value or N) when it has thermal expansion."""
     if frame not in ("base", "instrument"):
         raise ValueError(f"frame must be 'base' or 'instrument', not '{frame}'")
     q = np.atleast_2d(np.asarray(q_deg, dtype=float))
-    return _core.fk(robot, q, calibrated, frame == "instrument")
+    d = None if dir is None else np.atleast_2d(np.asarray(dir, dtype=float))
+    t = None if temperature_c is None else np.broadcast_to(np.asarray(temperature_c, dtype=float), (len(q),)).copy()
+    return _core.fk(robot, q, calibrated, frame == "instrument", d, t)
+
+
+def run_program(robot: Robot, q_deg: ArrayLike, *, initial_direction: Union[None, float, Sequence[float]] = None,
+                temperature_c: Union[None, float, Sequence[float]] = None, frame: str = "base") -> np.ndarray:
+    """The tool poses a robot reaches when it runs a joint program (N x 6 joint angles in degrees,
+    in order): each joint's direction into each pose is the sign of its commanded change, held while
+    it stands still (the first pose's from ``initial_direction``, default the direction of the first
+    motion), as backlash sees it; ``temperature_c`` for thermal expansion."""
+    q = np.atleast_2d(np.asarray(q_deg, dtype=float))
+    init = [] if initial_direction is None else [float(v) for v in np.atleast_1d(initial_direction)]
+    d = _core.motion_directions(q, init) if robot.needs_dir else None
+    return fk(robot, q, frame=frame, dir=d, temperature_c=temperature_c)
 
 
 def jacobian(robot: Robot, q_deg: Sequence[float], calibrated: bool = True) -> np.ndarray:
@@ -56,13 +73,24 @@ def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] =
 
 def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finite_difference: bool = False,
                delta: float = 1e-8, epsilon: float = 1e-15, max_iterations: int = 20,
-               corrected_start: bool = True, frame: str = "base") -> dict:
-    """Machine coordinates for desired tool poses (N x 6) on the robot's calibrated model.
+               corrected_start: bool = True, frame: str = "base", residual: str = "rotation_vector",
+               temperature_c: Union[None, float, Sequence[float]] = None,
+               initial_direction: Union[None, float, Sequence[float]] = None, keep_branch: bool = False) -> dict:
+    """Machine coordinates for desired tool poses (N x 6, in program order) on the robot's calibrated
+    model, every effect it carries acting: backlash with the directions of the program's own
+    commanded motion (the first pose's from ``initial_direction``, default the direction of the
+    first motion), thermal expansion at ``temperature_c`` (one value or one per pose). Newton's
+    orientation residual is the rotation vector (``residual="abc"``: the paper's eq. 6).
 
-    Returns ``q_deg`` (N x 6), ``iterations`` and ``residual`` (|F| of eq. 9) per pose."""
+    Returns ``q_deg`` (N x 6), ``iterations`` and ``residual`` (|F| of eq. 9) per pose, ``dir``
+    (each joint's direction into each pose, zeros without backlash) and ``warnings`` (branch changes)."""
     p = np.atleast_2d(np.asarray(poses, dtype=float))
+    temps = None
+    if temperature_c is not None:
+        temps = np.broadcast_to(np.asarray(temperature_c, dtype=float), (len(p),)).copy()
+    init = [] if initial_direction is None else [float(v) for v in np.atleast_1d(initial_direction)]
     return _core.compensate_poses(robot, p, compensate, frame == "instrument", finite_difference, delta, epsilon,
-                                  max_iterations, corrected_start)
+                                  max_iterations, corrected_start, residual, None, init, keep_branch, temps)
 
 
 def line_program(start: Sequence[float] = (2000.0, -740.0, 500.0), direction: Sequence[float] = (0.0, 1.0, 0.0),

@@ -184,6 +184,15 @@ def urdf_model_json(path: str | Path, base: str | None = None, tip: str | None =
     return json.dumps({"format": "kincal-model", "version": 1, "nominal": urdf_spec(path, base, tip)})
 
 
+def urdf_left_out(spec: dict) -> list:
+    """Labels of the effects of a model JSON section that a URDF cannot carry (every one: URDF is
+    geometry, masses and limits), e.g. ``joint_compliance(joint 2)``."""
+    out = []
+    for e in spec.get("effects", []):
+        out.append(e["effect"] + (f"(joint {e['joint']})" if e.get("joint") else ""))
+    return out
+
+
 def spec_urdf(spec: dict, name: str = "kincal_calibrated") -> str:
     """A URDF of a kincal geometry (a model JSON "nominal" or "calibrated" section).
 
@@ -194,7 +203,12 @@ def spec_urdf(spec: dict, name: str = "kincal_calibrated") -> str:
     def f(v) -> str:
         return " ".join(repr(float(x)) for x in v)
 
-    out = ['<?xml version="1.0"?>', f'<robot name="{name}">', '  <link name="base_link"/>']
+    out = ['<?xml version="1.0"?>', f'<robot name="{name}">']
+    left = urdf_left_out(spec)
+    if left:
+        out.append("  <!-- kincal: URDF carries geometry only; identified effects left out: " +
+                   ", ".join(left) + " (the model JSON has them) -->")
+    out.append('  <link name="base_link"/>')
     prev = np.zeros(3)
     parent = "base_link"
     for i, j in enumerate(spec["joints"]):

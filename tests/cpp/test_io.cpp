@@ -158,3 +158,50 @@ TEST(Io, StreamEqualsFileAndAllocatesNothingPerLine) {
     EXPECT_EQ(std::string(buf, n), e);
   }
 }
+
+// The stream with every effect (compliance, transmission error, backlash with the directions of the
+// commanded motion, thermal expansion at --temperature) on a back-and-forth G-code program: equal to
+// the file given the same first directions, and still no allocation per line.
+TEST(Io, StreamWithEveryEffectAllocatesNothingPerLine) {
+  ModelSpec s = perturbed_spec(kr500_spec(), 8, 1.0, 0.05, 0.003);
+  s.effects.push_back({Effect{"transmission_error", 1, {1, 2}}, {3e-4, -2e-4, 1e-4, 0.0}});
+  s.effects.push_back({Effect{"backlash", 0, {}}, {-2e-4}});
+  s.effects.push_back({Effect{"backlash", 2, {}}, {-3e-4}});
+  s.effects.push_back({Effect{"thermal_expansion", -1, {}}, {1.2e-5}});
+  auto nom = std::make_shared<Model>(kr500_spec());
+  const Robot r{nom, std::make_shared<Model>(s)};
+  std::ostringstream prog;
+  for (int i = 0; i < 200; ++i) {
+    const int k = i < 100 ? i : 199 - i;  // out and back
+    prog << "N" << 10 * (i + 1) << " G1 X" << 1900 + 2 * k << " Y" << -500 + 5 * k << " Z" << 600 + k
+         << " A180 B0 C180\n";
+  }
+  ProgramOptions opt;
+  opt.temperature_c = 26.0;
+  const std::string in = tmp("e.gcode", prog.str()), out = ::testing::TempDir() + "e_out.gcode";
+  const ProgramResult res = compensate_program_file(r, in, out, opt);
+  std::ifstream fo(out);
+  std::vector<std::string> expected;
+  for (std::string l; std::getline(fo, l);) expected.push_back(l);
+  ProgramOptions so = opt;
+  so.initial_direction.assign(res.dir[0].data(), res.dir[0].data() + 6);
+  StreamCompensator sc(r, so);
+  std::istringstream lines(prog.str());
+  std::vector<std::string> inl;
+  for (std::string l; std::getline(lines, l);) inl.push_back(l);
+  char buf[8192];
+  size_t n = sc.process(inl[0].data(), inl[0].size(), buf, sizeof buf);
+  ASSERT_EQ(std::string(buf, n), expected[0]);
+  std::vector<std::string> got(inl.size());
+  for (auto& g : got) g.reserve(512);
+  const long before = g_allocs.load();
+  for (size_t i = 1; i < inl.size(); ++i) {
+    n = sc.process(inl[i].data(), inl[i].size(), buf, sizeof buf);
+    got[i].assign(buf, n);
+  }
+  EXPECT_EQ(g_allocs.load() - before, 0);
+  for (size_t i = 1; i < inl.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "line " << i + 1;
+  int turns = 0;
+  for (size_t i = 1; i < res.dir.size(); ++i) turns += res.dir[i] != res.dir[i - 1];
+  EXPECT_GE(turns, 1);  // the program does reverse its axes
+}

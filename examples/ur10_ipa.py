@@ -24,7 +24,8 @@ def main() -> None:
     p.add_argument("data", nargs="?", default=str(Path(__file__).resolve().parents[1] / ".." / "shared" / "data" /
                                                   "ipa-robot-accuracy"))
     p.add_argument("--fit", default="B", choices=sorted(SERIES))
-    p.add_argument("--effects", default="joint_compliance")
+    p.add_argument("--effects", default="joint_compliance",
+                   help="as kincal identify --effects: NAME or NAME:J, comma separated, or none")
     p.add_argument("--diagnose", metavar="DIR", help="also run the diagnosis on the fit series, report in DIR")
     p.add_argument("--orientation", action="store_true",
                    help="use the probe's measured orientations too (6-D poses, weighted by the tracker's "
@@ -32,7 +33,7 @@ def main() -> None:
     args = p.parse_args()
     robot = kincal.load_robot("ur10")
     data = {k: datasets.read_ipa(Path(args.data) / v) for k, v in SERIES.items()}
-    effects = [e for e in args.effects.split(",") if e and e != "none"]
+    effects = ident.parse_effects(args.effects, robot)
     if args.orientation:
         import math
 

@@ -43,6 +43,11 @@ void define_effects(py::module_& m) {
       .def_property_readonly("file_scale", &Effect::file_scale, "file value = core value * scale")
       .def("check", [](const Effect& e, int dof) { check_effect(e, dof, ""); }, py::arg("dof"))
       .def(py::self == py::self)
-      .def("__hash__", [](const Effect& e) { return py::hash(py::make_tuple(e.name, e.joint, e.harmonics)); })
+      .def("__hash__",
+           [](const Effect& e) {
+             // consistent with ==: the harmonic orders count for the transmission error only
+             py::tuple h = py::tuple(py::cast(e.name == "transmission_error" ? e.harmonics : std::vector<int>{}));
+             return py::hash(py::make_tuple(e.name, e.joint, h));
+           })
       .def("__repr__", [](const Effect& e) { return "<Effect " + e.label() + ">"; });
 }

@@ -3,6 +3,8 @@
 // for the model's payload), line (n: source line, 0 when simulated).
 #include "common.hpp"
 
+#include <algorithm>
+#include <optional>
 #include <tuple>
 
 #include "kincal/identify.hpp"
@@ -102,33 +104,20 @@ MeasurementSet from_dict(const py::dict& d, int dof) {
   return m;
 }
 
-/// ("name", joint from 1 or 0 for none) pairs
-std::vector<Effect> effects_from(const std::vector<std::pair<std::string, int>>& e) {
-  std::vector<Effect> out;
-  for (const auto& p : e) {
-    Effect ef{p.first, p.second - 1};
-    ef.size();
-    out.push_back(ef);
-  }
-  return out;
-}
-
-std::vector<EffectValue> effect_values_from(const std::vector<std::tuple<std::string, int, std::vector<double>>>& e) {
+std::vector<EffectValue> effect_values_from(const std::vector<std::pair<Effect, std::vector<double>>>& e) {
   std::vector<EffectValue> out;
-  for (const auto& [name, joint, p] : e) {
-    EffectValue v;
-    v.effect = Effect{name, joint - 1};
-    if (static_cast<int>(p.size()) != v.effect.size())
-      throw InputError(v.effect.label() + ": " + std::to_string(v.effect.size()) + " values needed");
-    v.p = p;
-    out.push_back(v);
+  for (const auto& [effect, p] : e) {
+    if (static_cast<int>(p.size()) != effect.size())
+      throw InputError(effect.label() + ": " + std::to_string(effect.size()) + " value(s) needed, " +
+                       std::to_string(p.size()) + " given");
+    out.push_back(EffectValue{effect, p});
   }
   return out;
 }
 
 py::list effect_values_to(const std::vector<EffectValue>& e) {
   py::list l;
-  for (const auto& v : e) l.append(py::make_tuple(v.effect.name, v.effect.joint + 1, v.p));
+  for (const auto& v : e) l.append(py::make_tuple(v.effect, v.p));
   return l;
 }
 
@@ -142,6 +131,85 @@ RowMat targets_to(const std::vector<Vec3>& v) {
   RowMat t(v.size(), 3);
   for (size_t i = 0; i < v.size(); ++i) t.row(i) = v[i].transpose();
   return t;
+}
+
+/// One parameter of the identification vector, described for Python (no name parsing there).
+struct Parameter {
+  std::string name, kind, unit;
+  int joint = 0;    ///< from 1; 0 when the parameter concerns no joint (or link)
+  int target = -1;  ///< from 0; -1 when not a target offset
+  int index = 0;
+  std::optional<Effect> effect;  ///< the effect (of the layout's effect list) it belongs to
+};
+
+std::vector<Parameter> parameters_of(const ParamLayout& L) {
+  std::vector<Parameter> out;
+  for (int i = 0; i < L.size; ++i) {
+    Parameter p;
+    p.name = L.names[i];
+    p.unit = L.units[i];
+    p.index = i;
+    if (i < L.compliance) {
+      p.kind = "joint_geometry";
+      p.joint = (i - L.joints) / 4 + 1;
+    } else if (i < L.tool) {
+      p.kind = "compliance";
+      p.joint = L.loaded[i - L.compliance] + 1;
+    } else if (i < L.base) {
+      p.kind = "tool";
+    } else if (i < L.targets) {
+      p.kind = "base";
+    } else if (i < L.effects) {
+      p.kind = "target";
+      p.target = (i - L.targets) / 3;
+    } else {
+      for (size_t e = 0; e < L.effect_list.size(); ++e)
+        if (i >= L.effect_offset[e] && i < L.effect_offset[e] + L.effect_list[e].size()) {
+          p.kind = L.effect_list[e].name;
+          p.joint = L.effect_list[e].joint + 1;
+          p.effect = L.effect_list[e];
+        }
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+/// The identification result with the robots Python sees (nominal + calibrated).
+struct PyIdentifyResult {
+  IdentifyResult r;
+  Robot robot, nominal_fitted;
+};
+
+py::array_t<double> vec(const std::vector<double>& v) { return py::array_t<double>(v.size(), v.data()); }
+
+/// joint_compliance effects in the options' effect list are the compliance switches of the core
+IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
+  std::vector<Effect> rest;
+  bool any = false;
+  std::vector<int> joints;
+  for (const Effect& e : o.effects) {
+    if (e.name != "joint_compliance") {
+      rest.push_back(e);
+      continue;
+    }
+    check_effect(e, model.dof(), "");
+    if (!model.gravity_loaded(e.joint))
+      throw InputError("joint_compliance: gravity does not load joint " + std::to_string(e.joint + 1) +
+                       " of this robot (its axis is vertical)");
+    any = true;
+    joints.push_back(e.joint);
+  }
+  if (any) {
+    if (!o.compliance) o.compliance_joints.clear();
+    o.compliance = true;
+    // the joints named: exactly those (with any compliance_joints given too)
+    for (int j : joints)
+      if (std::find(o.compliance_joints.begin(), o.compliance_joints.end(), j) == o.compliance_joints.end())
+        o.compliance_joints.push_back(j);
+  }
+  o.effects = rest;
+  return o;
 }
 
 }  // namespace
@@ -161,9 +229,8 @@ void define_identify(py::module_& m) {
   m.def(
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
-         const RowMat& targets, double limit_margin,
-         const std::vector<std::tuple<std::string, int, std::vector<double>>>& effects, double t_ref,
-         double orientation_noise_deg) {
+         const RowMat& targets, double limit_margin, const std::vector<std::pair<Effect, std::vector<double>>>& effects,
+         double t_ref, double orientation_noise_deg) {
         SimulationOptions o;
         o.orientation_noise_deg = orientation_noise_deg;
         o.effects = effect_values_from(effects);
@@ -179,90 +246,207 @@ void define_identify(py::module_& m) {
       },
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
-      py::arg("effects") = std::vector<std::tuple<std::string, int, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
+      py::arg("effects") = std::vector<std::pair<Effect, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
       py::arg("orientation_noise_deg") = -1.0,
-      "A measurement campaign on the calibrated (true) model of a robot");
+      "A measurement campaign on the calibrated (true) model of a robot; effects: (Effect, values in core\n"
+      "units) hidden in the truth");
   m.def(
       "point_errors",
-      [](const Robot& r, const RowMat& targets, const py::dict& d,
-         const std::vector<std::tuple<std::string, int, std::vector<double>>>& effects, double t_ref) {
-        const auto e = point_errors(*r.calibrated, targets_from(targets), from_dict(d, r.calibrated->dof()),
-                                    effect_values_from(effects), t_ref);
+      [](const Robot& r, const RowMat& targets, const py::dict& d) {
+        const auto e = point_errors(*r.calibrated, targets_from(targets), from_dict(d, r.calibrated->dof()));
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("targets"), py::arg("data"),
-      py::arg("effects") = std::vector<std::tuple<std::string, int, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
-      "Distance (mm) between every measured point and the calibrated model's prediction");
+      "Distance (mm) between every measured point and the calibrated model's prediction (its effects acting)");
+
+  py::class_<Parameter>(m, "Parameter", "One parameter of the identification vector")
+      .def_readonly("name", &Parameter::name, "e.g. 'joint3.tilt_u', 'base.ry', 'joint2.te_sin1'")
+      .def_readonly("kind", &Parameter::kind,
+                    "'joint_geometry', 'compliance', 'tool', 'base', 'target' or the effect's name")
+      .def_readonly("joint", &Parameter::joint, "joint (or link) from 1; 0 when none")
+      .def_readonly("target", &Parameter::target, "target from 0; -1 when none")
+      .def_readonly("unit", &Parameter::unit, "'rad', 'mm', 'deg/kNm', '1/degC'")
+      .def_readonly("index", &Parameter::index, "position in the parameter vector")
+      .def_readonly("effect", &Parameter::effect, "the effect it belongs to (None for the others)")
+      .def("__repr__", [](const Parameter& p) { return "<Parameter " + std::to_string(p.index) + " " + p.name + ">"; });
+
+  py::class_<ParamLayout>(m, "ParamLayout", "Layout of the identification parameter vector")
+      .def_readonly("dof", &ParamLayout::dof)
+      .def_readonly("n_targets", &ParamLayout::n_targets)
+      .def_readonly("size", &ParamLayout::size)
+      .def_readonly("joints", &ParamLayout::joints, "offset of the joint geometry (4 per joint)")
+      .def_readonly("compliance", &ParamLayout::compliance, "offset of the compliances (1 per gravity-loaded joint)")
+      .def_readonly("tool", &ParamLayout::tool, "offset of the tool frame (6)")
+      .def_readonly("base", &ParamLayout::base, "offset of the base frame in the instrument frame (6)")
+      .def_readonly("targets", &ParamLayout::targets, "offset of the target offsets (3 per target)")
+      .def_readonly("effects", &ParamLayout::effects, "offset of the extra effects' parameters")
+      .def_readonly("effect_list", &ParamLayout::effect_list, "the extra effects, in order")
+      .def_readonly("effect_offset", &ParamLayout::effect_offset, "offset of each extra effect")
+      .def_readonly("t_ref", &ParamLayout::t_ref)
+      .def_property_readonly("loaded", [](const ParamLayout& L) {
+             std::vector<int> j;
+             for (int k : L.loaded) j.push_back(k + 1);
+             return j;
+           }, "joints (from 1) with a compliance parameter: the gravity-loaded ones")
+      .def_readonly("names", &ParamLayout::names)
+      .def_readonly("units", &ParamLayout::units)
+      .def_property_readonly("parameters", &parameters_of)
+      .def(
+          "indices",
+          [](const ParamLayout& L, const std::string& kind, int joint) {
+            std::vector<int> out;
+            for (const Parameter& p : parameters_of(L))
+              if (p.kind == kind && (joint < 0 || p.joint == joint)) out.push_back(p.index);
+            return out;
+          },
+          py::arg("kind"), py::arg("joint") = -1,
+          "indices of the parameters of a kind (and of one joint, from 1, when joint >= 0)")
+      .def("__len__", [](const ParamLayout& L) { return L.size; });
+
+  const IdentifyOptions def;
+  py::class_<IdentifyOptions>(m, "IdentifyOptions", "Options of identify()")
+      .def(py::init([](bool compliance, const std::string& loss, double loss_scale_mm, int max_iterations,
+                       const std::vector<std::string>& fix, const std::vector<int>& compliance_joints,
+                       const std::vector<Effect>& effects, bool covariance, double orientation_weight,
+                       double rank_tolerance, double weak_tolerance, double min_torque_share,
+                       double correlation_threshold) {
+             IdentifyOptions o;
+             o.compliance = compliance;
+             o.loss = loss;
+             o.loss_scale_mm = loss_scale_mm;
+             o.max_iterations = max_iterations;
+             o.fix = fix;
+             for (int j : compliance_joints) o.compliance_joints.push_back(j - 1);
+             o.effects = effects;
+             o.covariance = covariance;
+             o.orientation_weight = orientation_weight;
+             o.rank_tolerance = rank_tolerance;
+             o.weak_tolerance = weak_tolerance;
+             o.min_torque_share = min_torque_share;
+             o.correlation_threshold = correlation_threshold;
+             return o;
+           }),
+           py::arg("compliance") = def.compliance, py::arg("loss") = def.loss,
+           py::arg("loss_scale_mm") = def.loss_scale_mm, py::arg("max_iterations") = def.max_iterations,
+           py::arg("fix") = std::vector<std::string>{}, py::arg("compliance_joints") = std::vector<int>{},
+           py::arg("effects") = std::vector<Effect>{}, py::arg("covariance") = def.covariance,
+           py::arg("orientation_weight") = def.orientation_weight, py::arg("rank_tolerance") = def.rank_tolerance,
+           py::arg("weak_tolerance") = def.weak_tolerance, py::arg("min_torque_share") = def.min_torque_share,
+           py::arg("correlation_threshold") = def.correlation_threshold)
+      .def_readwrite("compliance", &IdentifyOptions::compliance, "identify the joint compliances")
+      .def_readwrite("loss", &IdentifyOptions::loss, "'none', 'huber' or 'cauchy'")
+      .def_readwrite("loss_scale_mm", &IdentifyOptions::loss_scale_mm, "where the robust loss bends (mm)")
+      .def_readwrite("max_iterations", &IdentifyOptions::max_iterations)
+      .def_readwrite("rank_tolerance", &IdentifyOptions::rank_tolerance)
+      .def_readwrite("min_torque_share", &IdentifyOptions::min_torque_share)
+      .def_readwrite("weak_tolerance", &IdentifyOptions::weak_tolerance)
+      .def_readwrite("correlation_threshold", &IdentifyOptions::correlation_threshold)
+      .def_readwrite("covariance", &IdentifyOptions::covariance, "standard deviations and correlations")
+      .def_readwrite("fix", &IdentifyOptions::fix, "parameter names held in any case")
+      .def_property(
+          "compliance_joints",
+          [](const IdentifyOptions& o) {
+            std::vector<int> j;
+            for (int k : o.compliance_joints) j.push_back(k + 1);
+            return j;
+          },
+          [](IdentifyOptions& o, const std::vector<int>& j) {
+            o.compliance_joints.clear();
+            for (int k : j) o.compliance_joints.push_back(k - 1);
+          },
+          "with compliance: only these joints (from 1; empty: every gravity-loaded joint)")
+      .def_readwrite("effects", &IdentifyOptions::effects,
+                     "effects identified with the rest (assign a whole list); joint_compliance entries turn\n"
+                     "the compliance of their joints on")
+      .def_readwrite("orientation_weight", &IdentifyOptions::orientation_weight,
+                     "mm per rad: how orientation residuals weigh against positions");
+
+  py::class_<PyIdentifyResult>(m, "IdentifyResult", "What identify() found")
+      .def_property_readonly("robot", [](const PyIdentifyResult& r) { return r.robot; },
+                             "nominal + calibrated (with the identified effects)")
+      .def_property_readonly("nominal_fitted", [](const PyIdentifyResult& r) { return r.nominal_fitted; },
+                             "the nominal geometry with the fitted base frame")
+      .def_property_readonly("layout", [](const PyIdentifyResult& r) -> const ParamLayout& { return r.r.layout; },
+                             py::return_value_policy::reference_internal)
+      .def_property_readonly("parameters", [](const PyIdentifyResult& r) { return parameters_of(r.r.layout); })
+      .def_property_readonly("x", [](const PyIdentifyResult& r) { return vec(r.r.x); })
+      .def_property_readonly("start", [](const PyIdentifyResult& r) { return vec(r.r.start); })
+      .def_property_readonly("nominal_x", [](const PyIdentifyResult& r) { return vec(r.r.nominal_x); })
+      .def_property_readonly("stddev", [](const PyIdentifyResult& r) { return vec(r.r.stddev); },
+                             "NaN for held parameters")
+      .def_property_readonly("fixed",
+                             [](const PyIdentifyResult& r) {
+                               py::array_t<bool> a(r.r.fixed.size());
+                               for (size_t i = 0; i < r.r.fixed.size(); ++i) a.mutable_at(i) = r.r.fixed[i];
+                               return a;
+                             })
+      .def_property_readonly("fixed_reason", [](const PyIdentifyResult& r) { return r.r.fixed_reason; })
+      .def_property_readonly("targets", [](const PyIdentifyResult& r) { return targets_to(r.r.targets); })
+      .def_property_readonly("nominal_targets", [](const PyIdentifyResult& r) { return targets_to(r.r.nominal_targets); })
+      .def_property_readonly("effects", [](const PyIdentifyResult& r) { return effect_values_to(r.r.effects); },
+                             "(Effect, values in core units) of every extra effect")
+      .def_property_readonly("t_ref", [](const PyIdentifyResult& r) { return r.r.t_ref; })
+      .def_property_readonly("iterations", [](const PyIdentifyResult& r) { return r.r.iterations; })
+      .def_property_readonly("initial_cost", [](const PyIdentifyResult& r) { return r.r.initial_cost; })
+      .def_property_readonly("final_cost", [](const PyIdentifyResult& r) { return r.r.final_cost; })
+      .def_property_readonly("rms_mm", [](const PyIdentifyResult& r) { return r.r.rms_mm; })
+      .def_property_readonly("max_mm", [](const PyIdentifyResult& r) { return r.r.max_mm; })
+      .def_property_readonly("nominal_rms_mm", [](const PyIdentifyResult& r) { return r.r.nominal_rms_mm; })
+      .def_property_readonly("nominal_max_mm", [](const PyIdentifyResult& r) { return r.r.nominal_max_mm; })
+      .def_property_readonly("condition_number", [](const PyIdentifyResult& r) { return r.r.condition_number; })
+      .def_property_readonly("observability_index", [](const PyIdentifyResult& r) { return r.r.observability_index; })
+      .def_property_readonly("correlations",
+                             [](const PyIdentifyResult& r) {
+                               std::vector<std::tuple<std::string, std::string, double>> c;
+                               for (const auto& x : r.r.correlations) c.emplace_back(x.a, x.b, x.r);
+                               return c;
+                             },
+                             "(name a, name b, r) above the threshold")
+      .def_property_readonly("termination", [](const PyIdentifyResult& r) { return r.r.termination; })
+      .def(
+          "__getitem__",
+          [](py::object self, const std::string& key) -> py::object {
+            // the dict of earlier versions: every attribute by its name, and names / units
+            const auto& r = self.cast<const PyIdentifyResult&>();
+            if (key == "names") return py::cast(r.r.layout.names);
+            if (key == "units") return py::cast(r.r.layout.units);
+            if (key == "layout" || key == "parameters" || !py::hasattr(self, key.c_str()))
+              throw py::key_error(key);
+            return self.attr(key.c_str());
+          },
+          py::arg("key"), "the attribute of that name (the dict access of earlier versions)");
+
   m.def(
       "identify",
-      [](const Robot& robot, const py::dict& d, bool compliance, const std::string& loss, double loss_scale_mm,
-         int max_iterations, const std::vector<std::string>& fix, py::object progress, bool from_calibrated, bool covariance,
-         const std::vector<std::pair<std::string, int>>& effects, const std::vector<int>& compliance_joints,
-         double orientation_weight) {
+      [](const Robot& robot, const py::dict& d, const IdentifyOptions& options, py::object progress,
+         bool from_calibrated) {
         const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
         const MeasurementSet data = from_dict(d, nominal.dof());
-        IdentifyOptions o;
-        o.compliance = compliance;
-        o.loss = loss;
-        o.loss_scale_mm = loss_scale_mm;
-        o.max_iterations = max_iterations;
-        o.fix = fix;
-        o.covariance = covariance;
-        o.effects = effects_from(effects);
-        o.orientation_weight = orientation_weight;
-        for (int j : compliance_joints) o.compliance_joints.push_back(j - 1);
+        IdentifyOptions o = core_options(options, nominal);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
-        const IdentifyResult r = identify(nominal, data, o);
-        py::dict out;
-        out["robot"] = Robot{robot.nominal, std::make_shared<const Model>(r.calibrated)};
-        out["nominal_fitted"] = Robot{robot.nominal, std::make_shared<const Model>(r.nominal_fitted)};
-        out["termination"] = r.termination;
-        out["targets"] = targets_to(r.targets);
-        out["nominal_targets"] = targets_to(r.nominal_targets);
-        out["names"] = r.layout.names;
-        out["units"] = r.layout.units;
-        out["x"] = r.x;
-        out["start"] = r.start;
-        out["nominal_x"] = r.nominal_x;
-        out["stddev"] = r.stddev;
-        std::vector<bool> fixed(r.fixed.begin(), r.fixed.end());
-        out["fixed"] = fixed;
-        out["fixed_reason"] = r.fixed_reason;
-        out["iterations"] = r.iterations;
-        out["initial_cost"] = r.initial_cost;
-        out["final_cost"] = r.final_cost;
-        out["rms_mm"] = r.rms_mm;
-        out["max_mm"] = r.max_mm;
-        out["nominal_rms_mm"] = r.nominal_rms_mm;
-        out["nominal_max_mm"] = r.nominal_max_mm;
-        out["condition_number"] = r.condition_number;
-        out["observability_index"] = r.observability_index;
-        py::list corr;
-        for (const auto& c : r.correlations) corr.append(py::make_tuple(c.a, c.b, c.r));
-        out["correlations"] = corr;
-        out["termination"] = r.termination;
-        out["compliance_joints"] = r.layout.loaded;
-        out["effects"] = effect_values_to(r.effects);
-        out["t_ref"] = r.t_ref;
+        PyIdentifyResult out{identify(nominal, data, o), Robot{}, Robot{}};
+        out.robot = Robot{robot.nominal, std::make_shared<const Model>(out.r.calibrated)};
+        out.nominal_fitted = Robot{robot.nominal, std::make_shared<const Model>(out.r.nominal_fitted)};
         return out;
       },
-      py::arg("robot"), py::arg("data"), py::arg("compliance") = true, py::arg("loss") = "huber",
-      py::arg("loss_scale_mm") = 0.1, py::arg("max_iterations") = 100, py::arg("fix") = std::vector<std::string>{},
-      py::arg("progress") = py::none(), py::arg("from_calibrated") = false, py::arg("covariance") = true,
-      py::arg("effects") = std::vector<std::pair<std::string, int>>{}, py::arg("compliance_joints") = std::vector<int>{},
-      py::arg("orientation_weight") = 100.0,
+      py::arg("robot"), py::arg("data"), py::arg("options") = IdentifyOptions{}, py::arg("progress") = py::none(),
+      py::arg("from_calibrated") = false,
       "Identify from measurements, starting from the nominal model (or from the calibrated one: then\n"
-      "the parameters are corrections to it, e.g. to refit only the base frame and targets)");
+      "the parameters are corrections to it, e.g. to refit only the base frame and targets). progress:\n"
+      "called with (iteration, cost).");
 
   py::class_<PointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
-      .def(py::init([](const Robot& r, int n_targets, const std::vector<std::pair<std::string, int>>& effects,
-                       double t_ref, bool from_calibrated) {
-             return new PointModel(from_calibrated ? *r.calibrated : *r.nominal, n_targets, effects_from(effects), t_ref);
+      .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
+                       bool from_calibrated) {
+             return new PointModel(from_calibrated ? *r.calibrated : *r.nominal, n_targets, effects, t_ref);
            }),
-           py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<std::pair<std::string, int>>{},
+           py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
            py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::keep_alive<1, 2>())
+      .def_property_readonly("layout", [](const PointModel& p) -> const ParamLayout& { return p.layout(); },
+                             py::return_value_policy::reference_internal)
       .def_property_readonly("names", [](const PointModel& p) { return p.layout().names; })
-      .def("start", [](const PointModel& p, const py::dict& d) { return p.start(from_dict(d, p.layout().dof)); })
+      .def("start", [](const PointModel& p, const py::dict& d) { return p.start(from_dict(d, p.layout().dof)); },
+           py::arg("data"))
       .def(
           "residuals",
           [](PointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {

@@ -504,6 +504,7 @@ struct Reader {
         ev.effect.harmonics.push_back(k.get<int>());
       }
     }
+    if (ev.effect.name != "transmission_error") ev.effect.harmonics.clear();
     const json& params = at(eo, "parameters", w);
     if (!params.is_array()) fail(w + ".parameters", "needs a list");
     const auto names = ev.effect.parameter_names();

@@ -18,7 +18,7 @@ from . import diagnose as diagnosis
 from . import feed as feedmod
 from . import fivebar
 from . import identify as ident
-from .urdf import spec_urdf
+from .urdf import spec_urdf, urdf_left_out
 
 
 def _fmt_rows(header: Sequence[str], rows) -> str:
@@ -48,7 +48,8 @@ def cmd_fk(args) -> None:
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.robot}: --frame instrument needs an identified model (kincal identify)")
     q, _ = _core.read_joint_program(args.joints, robot.dof)
-    poses = fk(robot, q, frame=args.frame)
+    ctx = _effect_columns(args.joints, robot, len(q), args.temperature)
+    poses = fk(robot, q, frame=args.frame, dir=ctx.get("dir"), temperature_c=ctx.get("temperature_c"))
     extra = _csv_columns(args.joints, ["pose", "target"]) if args.joints.lower().endswith(".csv") else {}
     if "target" in extra:
         targets = _identified_targets(args.robot)
@@ -65,6 +66,54 @@ def cmd_fk(args) -> None:
     header = list(extra) + ["x", "y", "z", "a", "b", "c"]
     rows = [[extra[k][i] for k in extra] + list(p) for i, p in enumerate(poses)]
     _core.write_file_atomic(args.out, _fmt_rows(header, rows))
+
+
+def _effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional[float]) -> dict:
+    """What the model's effects read from a joint file: dir1..dirN (backlash) and temperature_c
+    (thermal expansion, unless --temperature); a missing column is an error naming it."""
+    out: dict = {}
+    if not (robot.needs_dir or (robot.needs_temperature and temperature is None)):
+        if robot.needs_temperature:
+            out["temperature_c"] = np.full(n, float(temperature))
+        return out
+    header: list = []
+    if path.lower().endswith(".csv"):
+        with open(path, newline="") as f:
+            header = [h.strip() for h in next(csv.reader(f), [])]
+    if robot.needs_dir:
+        names = [f"dir{j + 1}" for j in range(robot.dof)]
+        missing = [c for c in names if c not in header]
+        if missing:
+            raise ValueError(f"{path}:1: missing column '{missing[0]}': the model has backlash, which needs each "
+                             f"joint's direction of motion into the pose (dir1..dir{robot.dof}, +1 or -1)")
+        d = _core.read_csv_columns(path, names)
+        bad = np.argwhere((d != 1.0) & (d != -1.0))
+        if len(bad):
+            raise ValueError(f"{path}: row {bad[0][0] + 1}: column '{names[bad[0][1]]}': "
+                             f"{d[bad[0][0], bad[0][1]]:g} is not +1 or -1")
+        out["dir"] = d
+    if robot.needs_temperature:
+        if temperature is not None:
+            out["temperature_c"] = np.full(n, float(temperature))
+        elif "temperature_c" not in header:
+            raise ValueError(f"{path}:1: missing column 'temperature_c': the model has thermal expansion "
+                             "(or give --temperature C)")
+        else:
+            out["temperature_c"] = _core.read_csv_columns(path, ["temperature_c"])[:, 0]
+    return out
+
+
+def _directions(text: Optional[str]) -> list:
+    """--initial-direction: +1, -1, or one sign per joint, comma separated."""
+    if text is None:
+        return []
+    try:
+        v = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise ValueError(f"--initial-direction {text}: expected +1, -1 or s1,..,s6") from None
+    if len(v) not in (1, 6) or any(x not in (1.0, -1.0) for x in v):
+        raise ValueError(f"--initial-direction {text}: one sign (+1 or -1) for all joints, or one per joint")
+    return v
 
 
 def _identified_targets(robot_arg: str) -> np.ndarray:
@@ -106,7 +155,9 @@ def cmd_ik(args) -> None:
 def _comp_kwargs(args) -> dict:
     return dict(compensate=not args.nominal, instrument=args.frame == "instrument",
                 finite_difference=args.finite_difference, delta=args.delta, epsilon=args.epsilon,
-                max_iterations=args.max_iterations, corrected_start=not args.paper_start)
+                max_iterations=args.max_iterations, corrected_start=not args.paper_start, residual=args.residual,
+                temperature_c=args.temperature, initial_direction=_directions(args.initial_direction),
+                keep_branch=args.keep_branch)
 
 
 def cmd_compensate(args) -> None:
@@ -114,6 +165,8 @@ def cmd_compensate(args) -> None:
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
     res = _core.compensate_program(robot, args.program, args.out, **_comp_kwargs(args))
+    for w in res["warnings"]:
+        print(f"kincal compensate: warning: {w}", file=sys.stderr)
     it = np.asarray(res["iterations"])
     print(f"{args.out}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
@@ -129,28 +182,41 @@ def _progress(label: str):
     return report
 
 
-def _hidden_effect(text: str, dof: int) -> tuple:
-    """NAME:JOINT:V1,V2.. of --hide: transmission_error and backlash values in degrees,
-    thermal_expansion in 1/C (joint 0)."""
+def _harmonics(text: str) -> list:
+    """--harmonics 1,2,3: transmission_error's harmonic orders."""
+    try:
+        h = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected harmonic orders such as 1,2,3, not '{text}'") from None
+    if not h or any(k < 1 for k in h) or len(set(h)) != len(h):
+        raise argparse.ArgumentTypeError(f"harmonic orders must be distinct positive integers, not '{text}'")
+    return h
+
+
+def _hidden_effect(text: str, dof: int, harmonics: Sequence[int] = ident.DEFAULT_HARMONICS) -> tuple:
+    """NAME:JOINT:V1,V2.. of --hide: (Effect, values in core units). The values are in the model
+    file's units (degrees for angles, 1/C for thermal_expansion: joint 0); their number comes from
+    the registry (transmission_error: a sine and a cosine amplitude per harmonic order)."""
     parts = text.split(":")
     if len(parts) != 3:
         raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
     name, joint, vals = parts[0], parts[1], parts[2]
-    n = {"transmission_error": 4, "backlash": 1, "thermal_expansion": 1}.get(name)
-    if n is None:
-        raise ValueError(f"--hide {text}: unknown effect '{name}' (transmission_error, backlash, thermal_expansion)")
+    kinds = [k for k in _core.effect_kinds() if k.domain == "serial" and k.name != "joint_compliance"]
+    kind = next((k for k in kinds if k.name == name), None)
+    if kind is None:
+        raise ValueError(f"--hide {text}: unknown effect '{name}' ({', '.join(k.name for k in kinds)})")
     try:
         j = int(joint)
         v = [float(x) for x in vals.split(",")]
     except ValueError:
         raise ValueError(f"--hide {text}: joint and values must be numbers") from None
-    if len(v) != n or not all(math.isfinite(x) for x in v):
-        raise ValueError(f"--hide {text}: {name} takes {n} finite value(s)")
-    if name != "thermal_expansion":
-        if not 1 <= j <= dof:
-            raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
-        v = [math.radians(x) for x in v]
-    return name, (j if name != "thermal_expansion" else 0), v
+    if kind.concerns == "joint" and not 1 <= j <= dof:
+        raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
+    e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
+    if len(v) != e.size or not all(math.isfinite(x) for x in v):
+        raise ValueError(f"--hide {text}: {e.label} takes {e.size} finite value(s) "
+                         f"({', '.join(f'{n} ({u})' for n, u in zip(e.parameter_names, e.file_units))})")
+    return e, [x / sc for x, sc in zip(v, e.file_scale)]
 
 
 def cmd_simulate(args) -> None:
@@ -166,7 +232,7 @@ def cmd_simulate(args) -> None:
     pool = args.poses * (10 if args.select == "observability" else 1)
     data = ident.simulate(truth, pool, seed=args.seed, noise_mm=args.noise, targets=args.targets,
                           outlier_fraction=args.outliers, outlier_mm=args.outlier_mm,
-                          effects=[_hidden_effect(h, robot.dof) for h in args.hide],
+                          effects=[_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide],
                           orientation_noise_deg=args.orientation_noise)
     if args.select == "observability":
         data = ident.select_observable(robot, data, args.poses)
@@ -174,10 +240,21 @@ def cmd_simulate(args) -> None:
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
 
+def _effects(args, robot) -> list:
+    """--effects (and --harmonics) as _core.Effect objects."""
+    return ident.parse_effects(args.effects, robot, args.harmonics)
+
+
+def _check_columns(effects: list, data: dict, path: str, robot) -> None:
+    """The data columns the effects read are there (the error names the file and the column)."""
+    ident.check_data_for(effects, dict(data, source=path), robot)
+
+
 def cmd_identify(args) -> None:
     robot = _robot(args)
-    effects = [] if args.effects in ("", "none") else [e.strip() for e in args.effects.split(",") if e.strip()]
+    effects = _effects(args, robot)
     data = ident.read_measurements(args.data, robot)
+    _check_columns(effects, data, args.data, robot)
     res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
                          holdout=args.holdout, k_folds=args.folds, seed=args.seed,
                          progress=_progress("identify"), orientation_weight=args.orientation_weight)
@@ -189,6 +266,10 @@ def cmd_identify(args) -> None:
     if args.urdf:
         cal = json.loads(text)["calibrated"]
         _core.write_file_atomic(args.urdf, spec_urdf(cal, cal.get("name", "calibrated").replace(" ", "_")))
+        left = urdf_left_out(cal)
+        if left:
+            print(f"kincal identify: {args.urdf}: URDF carries geometry only; left out: {', '.join(left)} "
+                  f"(in {args.out})", file=sys.stderr)
     _core.write_file_atomic(args.out, text)
     print(res.summary())
 
@@ -217,13 +298,15 @@ def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
             ts.append(time.perf_counter() - t)
         return float(np.median(ts)) * 1e3, out
 
-    ours, res = median_ms(lambda: _core.identify(robot, data, True, "none", 0.1, 100, [], None, False, False), repeats)
-    ours_cov, _ = median_ms(lambda: _core.identify(robot, data, True, "none", 0.1, 100, [], None, False, True), repeats)
+    opts = _core.IdentifyOptions(compliance=True, loss="none", covariance=False)
+    opts_cov = _core.IdentifyOptions(compliance=True, loss="none", covariance=True)
+    ours, res = median_ms(lambda: _core.identify(robot, data, opts), repeats)
+    ours_cov, _ = median_ms(lambda: _core.identify(robot, data, opts_cov), repeats)
     pm = _core.PointModel(robot, 1)
-    free = ~np.asarray(res["fixed"])
+    free = ~np.asarray(res.fixed)
     # scipy starts where our second stage starts (after our first stage fitted the base frame and
     # target on the nominal geometry): the held parameters then have the same values in both
-    x0 = np.asarray(res["nominal_x"], dtype=float)
+    x0 = np.asarray(res.nominal_x, dtype=float)
 
     def full(z):
         x = x0.copy()
@@ -246,13 +329,13 @@ def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
     npm = NumpyPointModel(robot, 1)
     np_ms, npr = median_ms(lambda: least_squares(lambda z: npm.residuals(full(z), data), x0[free], jac="2-point",
                                                  **tol), 3)
-    return {"identify_poses": poses, "identify_parameters": len(res["names"]),
+    return {"identify_poses": poses, "identify_parameters": res.layout.size,
             "identify_free_parameters": int(free.sum()), "identify_ms": ours,
             "identify_with_covariance_ms": ours_cov, "scipy_numpy_identify_ms": np_ms,
             "identify_speedup_vs_scipy_numpy": np_ms / ours, "scipy_numpy_identify_cost": float(npr.cost),
             "scipy_identify_ms": fd_ms,
             "scipy_analytic_identify_ms": an_ms, "identify_speedup_vs_scipy": fd_ms / ours,
-            "identify_speedup_vs_scipy_analytic": an_ms / ours, "identify_cost": res["final_cost"],
+            "identify_speedup_vs_scipy_analytic": an_ms / ours, "identify_cost": res.final_cost,
             "scipy_identify_cost": float(fd.cost), "scipy_analytic_identify_cost": float(an.cost)}
 
 
@@ -384,7 +467,7 @@ def _diagnose_fivebar(args) -> None:
     out.mkdir(parents=True, exist_ok=True)
     x0 = fivebar.fit_with_effects(pts, [])
     before = dict(pts, desired=fivebar._predict(pts, x0, []))
-    effects = [(s["effect"], fivebar.LINKS.index(s["link"]) if s.get("link") else s["joint"] - 1)
+    effects = [_core.Effect(s["effect"], fivebar.LINKS.index(s["link"]) + 1 if s.get("link") else s["joint"])
                for s in diag["steps"]]
     after = dict(pts, desired=fivebar._predict(pts, fivebar.fit_with_effects(pts, effects), effects))
     fivebar.error_map_figure([("four lengths", before), ("with the named effects", after)], str(out / "residual_map.png"),
@@ -412,21 +495,36 @@ def cmd_diagnose(args) -> None:
         _diagnose_fivebar(args)
         return
     robot = _robot(args)
+    start = _effects(args, robot)
     data = ident.read_measurements(args.data, robot)
+    _check_columns(start, data, args.data, robot)
+    known = _core.read_csv_columns(args.tool_targets, ["x", "y", "z"]) if args.tool_targets else None
     t0 = time.perf_counter()
     diag = diagnosis.diagnose(robot, data, folds=args.folds, seed=args.seed, noise_mm=args.noise,
-                              progress=lambda s: print(s, file=sys.stderr, flush=True))
+                              progress=lambda s: print(s, file=sys.stderr, flush=True), effects=start,
+                              loss=args.loss, loss_scale_mm=args.loss_scale,
+                              orientation_weight=args.orientation_weight)
+    print("identifying the final model on all the data", file=sys.stderr, flush=True)
+    model = diagnosis.final_identification(robot, data, diag, known)
+    diag["final_model"]["file"] = "model.json"
+    diag["final_model"]["parameters"] = [
+        {"effect": e.name, "joint": e.joint or None, "label": e.label,
+         "values": [v * sc for v, sc in zip(vals, e.file_scale)], "units": e.file_units}
+        for e, vals in model.robot.effects]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    diagnosis.write_report(robot, data, diag, out, title=f"kincal diagnose: {Path(args.data).name}")
+    diagnosis.write_report(robot, data, diag, out, title=f"kincal diagnose: {Path(args.data).name}",
+                           model_file="model.json")
     _core.write_file_atomic(str(out / "diagnosis.json"), json.dumps(diagnosis.contract_json(diag), indent=1) + "\n")
+    _core.write_file_atomic(str(out / "model.json"), model.model_json())
     for st in diag["steps"]:
         j = f" joint {st['joint']}" if st["joint"] else ""
         print(f"{st['effect']}{j}: cross-validated RMS {st['rms_before_mm'] * 1000:.1f} -> "
               f"{st['rms_after_mm'] * 1000:.1f} um (F = {st['evidence']['F']:.3g})")
     print(f"final cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um, noise estimate "
           f"{diag['noise_rms_mm'] * 1000:.1f} um: {diag['verdict']} ({time.perf_counter() - t0:.1f} s); "
-          f"report: {out / 'report.html'}")
+          f"report: {out / 'report.html'}; model ({' + '.join(['geometry'] + model.effect_labels())}): "
+          f"{out / 'model.json'}")
 
 
 def bench_diagnose(seed: int) -> dict:
@@ -434,7 +532,7 @@ def bench_diagnose(seed: int) -> dict:
     hidden backlash on joint 2), every candidate on every joint, 5 folds: seconds."""
     robot = load_robot("kr500")
     data = ident.simulate(ident.default_truth(robot, seed=seed), 500, seed=seed, targets=1,
-                          effects=[("backlash", 2, [math.radians(0.01)])])
+                          effects=[(_core.Effect("backlash", 2), [math.radians(0.01)])])
     t0 = time.perf_counter()
     d = diagnosis.diagnose(robot, data)
     return {"diagnose_500_poses_s": time.perf_counter() - t0, "diagnose_500_poses_steps": len(d["steps"])}
@@ -479,11 +577,33 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--base", help="URDF: base link of the chain (default: the root link)")
         sp.add_argument("--tip", help="URDF: tip link of the chain (default: the only leaf)")
 
+    def effect_opts(sp, default: str, what: str):
+        names = ", ".join(k.name for k in _core.effect_kinds() if k.domain == "serial")
+        sp.add_argument("--effects", default=default,
+                        help=f"{what}, comma separated: NAME (every joint where it applies) or NAME:J (joint J); "
+                             f"'none' for the geometry alone (default: {default}; known: {names})")
+        sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
+                        help="harmonic orders of transmission_error (default 1,2)")
+
+    def loss_opts(sp):
+        sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
+        sp.add_argument("--loss-scale", type=float, default=0.1, help="where the robust loss bends (mm)")
+
+    def model_opts(sp):
+        sp.add_argument("--tool-targets", metavar="CSV",
+                        help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
+                             "order): places the tool frame (TCP), which reflectors alone cannot")
+        sp.add_argument("--orientation-weight", type=float, default=100.0, metavar="MM_PER_RAD",
+                        help="with measured orientations (a,b,c): mm of position residual worth one rad (default "
+                             "100: 0.02 mm against 0.011 deg of noise)")
+
     sp = sub.add_parser("fk", help="forward kinematics of a joint program")
     robot_opts(sp)
     sp.add_argument("--joints", required=True, help="CSV q1..qN (or a G-code joint program)")
     sp.add_argument("--out", required=True, help="CSV x,y,z,a,b,c")
     sp.add_argument("--frame", choices=["base", "instrument"], default="base")
+    sp.add_argument("--temperature", type=float, help="thermal expansion: the temperature (C), instead of a "
+                                                       "temperature_c column")
     sp.set_defaults(func=cmd_fk)
 
     sp = sub.add_parser("ik", help="nominal closed-form inverse kinematics of a pose program")
@@ -504,6 +624,15 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--delta", type=float, default=1e-8, help="finite-difference step, degrees (eq. 7)")
     sp.add_argument("--epsilon", type=float, default=1e-15, help="stop when |F|^2 < epsilon (eq. 9)")
     sp.add_argument("--max-iterations", type=int, default=20)
+    sp.add_argument("--residual", choices=["rotation_vector", "abc"], default="rotation_vector",
+                    help="Newton's orientation residual: the rotation vector (no singularity) or the paper's ABC "
+                         "differences (eq. 6, singular at B = +-90)")
+    sp.add_argument("--temperature", type=float, help="thermal expansion: the temperature (C) of every pose, unless "
+                                                       "the CSV program has a temperature_c column")
+    sp.add_argument("--initial-direction", help="backlash: each joint's direction into the first pose, +1 or -1 "
+                                                "(one for all, or s1,..,s6; default: the direction of the first motion)")
+    sp.add_argument("--keep-branch", action="store_true",
+                    help="a branch change inside the program (to stay within the joint limits) is an error")
     sp.set_defaults(func=cmd_compensate)
 
     sp = sub.add_parser("simulate", help="a simulated measurement campaign on a true model")
@@ -522,8 +651,11 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--select", choices=["random", "observability"], default="random",
                     help="poses drawn at random inside the limits, or the most observable of 10 times as many")
     sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
-                    help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg), backlash:J:b (deg per "
-                         "direction sign), thermal_expansion:0:alpha (1/C, about 20 C); repeatable")
+                    help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg; a sine and a cosine "
+                         "amplitude per order of --harmonics), backlash:J:b (deg per direction sign), "
+                         "thermal_expansion:0:alpha (1/C, about 20 C); repeatable")
+    sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
+                    help="harmonic orders of a hidden transmission_error (default 1,2)")
     sp.add_argument("--seed", type=int, default=1)
     sp.set_defaults(func=cmd_simulate)
 
@@ -531,20 +663,13 @@ def build_parser() -> argparse.ArgumentParser:
     robot_opts(sp)
     sp.add_argument("--data", required=True, help="measurement CSV (pose, q1..qN, x, y, z[, target, payload_kg])")
     sp.add_argument("--out", required=True, help="model JSON")
-    sp.add_argument("--effects", default="joint_compliance",
-                    help="non-geometric effects to identify, comma separated, or 'none' (default: joint_compliance)")
-    sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
-    sp.add_argument("--loss-scale", type=float, default=0.1, help="where the robust loss bends (mm)")
+    effect_opts(sp, "joint_compliance", "non-geometric effects to identify")
+    loss_opts(sp)
     sp.add_argument("--holdout", type=float, default=0.25, help="share of poses held out for validation")
     sp.add_argument("--folds", type=int, default=0, help="k-fold cross-validation instead of a split (k >= 2)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
-    sp.add_argument("--tool-targets", metavar="CSV",
-                    help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
-                         "order): places the tool frame (TCP), which reflectors alone cannot")
-    sp.add_argument("--orientation-weight", type=float, default=100.0, metavar="MM_PER_RAD",
-                    help="with measured orientations (a,b,c): mm of position residual worth one rad (default 100: "
-                         "0.02 mm against 0.011 deg of noise)")
+    model_opts(sp)
     sp.set_defaults(func=cmd_identify)
 
     sp = sub.add_parser("feed", help="derivative analysis of joint programs (Samak section III)")
@@ -566,10 +691,14 @@ def build_parser() -> argparse.ArgumentParser:
     robot_opts(sp)
     sp.add_argument("--data", required=True, help="measurement CSV (with dir1..dirN, temperature_c when present); "
                                                   "with --robot fivebar a table with the columns of Table I")
-    sp.add_argument("--out", required=True, help="folder for diagnosis.json, report.html and figures")
+    sp.add_argument("--out", required=True, help="folder for diagnosis.json, report.html, figures and model.json "
+                                                 "(the final model, for compensate)")
     sp.add_argument("--folds", type=int, default=5, help="folds of poses for the cross-validation")
     sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
     sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
+    effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")
+    loss_opts(sp)
+    model_opts(sp)
     sp.set_defaults(func=cmd_diagnose)
 
     hr = sub.add_parser("hidden-robot", help="five-bar hidden-robot calibration (the Kiper paper)")

@@ -14,7 +14,7 @@ RMS must fall; otherwise, or when no candidate is significant, the workflow stop
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -23,55 +23,64 @@ from ._core import Robot
 from . import identify as ident
 
 
-def _effect_name(e: tuple) -> str:
-    return e[0] if e[1] <= 0 else f"{e[0]}(joint {e[1]})"
+def _label(effect: str, joint: Optional[int]) -> str:
+    return _core.Effect(effect, joint or 0).label
 
 
-def candidates(robot: Robot, data: dict) -> tuple[list, list]:
-    """(name, joint) of every candidate the data can support, and notes on those skipped."""
+def _needs_column(kind) -> str:
+    """The measurement-set key of the column an effect kind reads ('' when none)."""
+    return "dir" if kind.needs == "dir" else kind.needs
+
+
+def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, list]:
+    """Every candidate effect (a _core.Effect per joint where it applies, from the registry) the data
+    can support, and notes on those skipped. Effects of ``start`` (the model the diagnosis starts
+    from) are no candidates."""
     out, notes = [], []
-    lim = _core.PointModel(robot, 1)
-    loaded = [int(n.split(".")[0][5:]) for n in lim.names if n.endswith(".compliance")]
-    for j in loaded:
-        out.append(("joint_compliance", j))
-    for j in range(1, robot.dof + 1):
-        out.append(("transmission_error", j))
-    if "dir" in data:
-        out.extend(("backlash", j) for j in range(1, robot.dof + 1))
-    else:
-        notes.append("backlash skipped: the data have no dir1..dirN columns")
-    if "temperature_c" in data and np.ptp(data["temperature_c"]) > 0.5:
-        out.append(("thermal_expansion", 0))
-    else:
-        notes.append("thermal_expansion skipped: no temperature_c column, or it does not vary")
+    have = {(e.name, e.joint) for e in start}
+    for kind in _core.effect_kinds():
+        if kind.domain != "serial":
+            continue
+        col = _needs_column(kind)
+        if col == "dir" and col not in data:
+            notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
+            continue
+        if col == "temperature_c" and (col not in data or np.ptp(data[col]) <= 0.5):
+            notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
+            continue
+        if col and col not in data:
+            notes.append(f"{kind.name} skipped: the data have no {col} column")
+            continue
+        joints = ident.applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
+        out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
     return out, notes
 
 
 class Spec:
-    """The model under test: which joints carry a compliance, which extra effects."""
+    """The model under test: its effects (joint_compliance per joint included) and the fit's options."""
 
-    def __init__(self):
-        self.compliance: list[int] = []
-        self.effects: list[tuple[str, int]] = []
+    def __init__(self, effects: Sequence = (), **fit_options):
+        self.effects: list = list(effects)
+        self.fit_options = dict(fit_options)
 
-    def with_(self, cand: tuple) -> "Spec":
-        s = Spec()
-        s.compliance, s.effects = list(self.compliance), list(self.effects)
-        if cand[0] == "joint_compliance":
-            s.compliance.append(cand[1])
-        else:
-            s.effects.append(cand)
-        return s
+    def with_(self, cand) -> "Spec":
+        return Spec(self.effects + [cand], **self.fit_options)
 
-    def has(self, cand: tuple) -> bool:
-        return cand[1] in self.compliance if cand[0] == "joint_compliance" else cand in self.effects
+    def has(self, cand) -> bool:
+        return any(e.name == cand.name and e.joint == cand.joint for e in self.effects)
 
-    def fit(self, robot: Robot, data: dict, loss: str = "huber") -> dict:
-        return _core.identify(robot, data, bool(self.compliance), loss, 0.1, 100, [], None, False, False,
-                              self.effects, self.compliance)
+    @property
+    def compliance(self) -> list:
+        return [e.joint for e in self.effects if e.name == "joint_compliance"]
 
-    def errors(self, res: dict, data: dict) -> np.ndarray:
-        return _core.point_errors(res["robot"], res["targets"], data, res["effects"], res["t_ref"])
+    def label(self) -> str:
+        return " + ".join(["geometry"] + [e.label for e in self.effects])
+
+    def fit(self, robot: Robot, data: dict) -> "_core.IdentifyResult":
+        return _core.identify(robot, data, ident.options(self.effects, covariance=False, **self.fit_options))
+
+    def errors(self, res, data: dict) -> np.ndarray:
+        return _core.point_errors(res.robot, res.targets, data)
 
 
 def cv_rms(spec: Spec, robot: Robot, data: dict, folds: list) -> float:
@@ -85,44 +94,31 @@ def cv_rms(spec: Spec, robot: Robot, data: dict, folds: list) -> float:
     return math.sqrt(sq / n)
 
 
-def _regressors(robot: Robot, res: dict, data: dict, spec: Spec, cand: tuple):
+def _key(p) -> tuple:
+    return (p.kind, p.joint, p.target, p.name)
+
+
+def _regressors(robot: Robot, res, data: dict, spec: Spec, cand):
     """Residual r (3n), the current model's free columns and the candidate's columns at the fit."""
-    n_targets = len(res["targets"])
-    effects = list(spec.effects) + ([cand] if cand[0] != "joint_compliance" else [])
-    pm = _core.PointModel(res["robot"], n_targets, effects, res["t_ref"], True)
-    names = list(pm.names)
-    x = np.zeros(len(names))
-    cal = res["robot"]
-    for i, nme in enumerate(names):
-        if nme.endswith(".compliance"):
-            j = int(nme.split(".")[0][5:])
-            x[i] = _compliance_of(cal, j)
-    for t, off in enumerate(res["targets"]):
-        for k, c in enumerate("xyz"):
-            x[names.index(f"target{t}.{c}")] = off[k]
-    # current effect values
-    pos = {n: i for i, n in enumerate(names)}
-    cur_names = list(res["names"])
-    for nme, val in zip(cur_names, res["x"]):
-        if nme in pos and ("te_" in nme or "backlash" in nme or nme == "thermal_expansion"):
-            x[pos[nme]] = val
+    layout = res.layout
+    extra = list(layout.effect_list) + ([cand] if cand.name != "joint_compliance" else [])
+    pm = _core.PointModel(res.robot, len(res.targets), extra, res.t_ref, True)
+    new = pm.layout.parameters
+    old = {_key(p): p.index for p in layout.parameters}
+    x = np.zeros(len(new))
+    fit_x = np.asarray(res.x)
+    for p in new:
+        # geometry, tool and base are corrections to the calibrated model (zero); compliances,
+        # targets and effect values are absolute
+        if p.kind not in ("joint_geometry", "tool", "base") and _key(p) in old:
+            x[p.index] = fit_x[old[_key(p)]]
     r, J = pm.residuals(list(x), data, True)
-    fixed = dict(zip(cur_names, res["fixed"]))
-    cur_cols = [pos[nme] for nme in cur_names if nme in pos and not fixed[nme]]
-    if cand[0] == "joint_compliance":
-        cand_cols = [pos[f"joint{cand[1]}.compliance"]]
-    else:
-        prefix = "" if cand[0] == "thermal_expansion" else f"joint{cand[1]}."
-        key = {"transmission_error": "te_", "backlash": "backlash", "thermal_expansion": "thermal_expansion"}[cand[0]]
-        cand_cols = [i for i, nme in enumerate(names) if nme.startswith(prefix) and key in nme
-                     and nme not in cur_names]
+    fixed = np.asarray(res.fixed)
+    cur_cols = [p.index for p in new if _key(p) in old and not fixed[old[_key(p)]]]
+    kind = "compliance" if cand.name == "joint_compliance" else cand.name
+    cand_cols = [p.index for p in new if p.kind == kind and p.joint == cand.joint
+                 and (kind == "compliance" or _key(p) not in old)]
     return np.asarray(r), np.asarray(J)[:, cur_cols], np.asarray(J)[:, cand_cols]
-
-
-def _compliance_of(robot: Robot, joint: int) -> float:
-    import json
-
-    return float(json.loads(robot.to_json())["calibrated"]["joints"][joint - 1]["compliance_deg_per_knm"])
 
 
 def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, pose_rows: np.ndarray, folds: list) -> dict:
@@ -153,23 +149,29 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, pose_rows: np.ndarray, f
 
 def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03,
              max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
-             progress: Optional[Callable[[str], None]] = None) -> dict:
+             progress: Optional[Callable[[str], None]] = None, effects: Sequence = (), loss: str = "huber",
+             loss_scale_mm: float = 0.1, orientation_weight: float = 100.0) -> dict:
     """The workflow; returns the diagnosis.json of the contract (plus details for the report).
 
+    ``effects``: the model the diagnosis starts from besides the geometry (Effect objects or texts of
+    ``--effects``); they are no candidates. ``loss``, ``loss_scale_mm``, ``orientation_weight``:
+    identify's options, used in every fit.
     noise_rms_mm: with ``noise_mm`` (the instrument's noise per coordinate, if known) its RMS per
     point; otherwise the final fit's own scatter, an upper bound of the noise. The verdict says "at
     the noise level" when the cross-validated RMS is within 1.3 times the known noise, or, with the
     noise unknown, when no candidate is even significant."""
     say = progress or (lambda s: None)
-    cands, notes = candidates(robot, data)
+    start_effects = ident.check_effects(effects, robot)
+    ident.check_data_for(start_effects, data, robot)
+    cands, notes = candidates(robot, data, start_effects)
     fold_masks = ident.folds(data, folds, seed)
     # fold membership per residual row (3 per point) for the linear scores
-    pose_rows = np.repeat(np.arange(len(data["pose"])), 3)
     row_folds = [np.repeat(m, 3) for m in fold_masks]
-    spec = Spec()
-    say("fitting the geometric model")
+    start = Spec(start_effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
+    spec = start
+    say(f"fitting the starting model ({spec.label()})")
     cur = cv_rms(spec, robot, data, fold_masks)
-    history: list[dict[str, Any]] = [{"model": "geometry", "cv_rms_mm": cur}]
+    history: list[dict[str, Any]] = [{"model": spec.label(), "cv_rms_mm": cur}]
     steps: list[dict[str, Any]] = []
     for _ in range(max_steps):
         res = spec.fit(robot, data)
@@ -179,7 +181,8 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
                 continue
             r, Jc, R = _regressors(robot, res, data, spec, c)
             s = score(r, Jc, R, np.arange(len(r)), row_folds)
-            s["effect"], s["joint"] = c[0], (c[1] if c[1] > 0 else None)
+            s["effect"], s["joint"] = c.name, (c.joint if c.joint > 0 else None)
+            s["_cand"] = c
             scored.append(s)
         scored.sort(key=lambda s: -s["cv_gain"])
         sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
@@ -187,16 +190,16 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
             history[-1]["candidates"] = scored[:8]
             break
         best = sig[0]
-        cand = (best["effect"], best["joint"] or 0)
+        cand = best["_cand"]
         trial = spec.with_(cand)
-        say(f"step {len(steps) + 1}: {_effect_name(cand)} (F = {best['F']:.3g}, cross-validated gain "
+        say(f"step {len(steps) + 1}: {cand.label} (F = {best['F']:.3g}, cross-validated gain "
             f"{best['cv_gain']:.1%}); refitting")
         new = cv_rms(trial, robot, data, fold_masks)
         if new >= cur:
             history[-1]["candidates"] = scored[:8]
-            history[-1]["rejected"] = {"effect": cand[0], "joint": best["joint"], "cv_rms_mm": new}
+            history[-1]["rejected"] = {"effect": cand.name, "joint": best["joint"], "cv_rms_mm": new}
             break
-        steps.append({"effect": cand[0], "joint": best["joint"],
+        steps.append({"effect": cand.name, "joint": best["joint"],
                       "evidence": {"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
                                    "cv_gain_linear": best["cv_gain"],
                                    "runners_up": [{"effect": s["effect"], "joint": s["joint"],
@@ -205,11 +208,13 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
                       "rms_before_mm": cur, "rms_after_mm": new})
         history[-1]["candidates"] = scored[:8]
         spec, cur = trial, new
-        history.append({"model": " + ".join(["geometry"] + [_effect_name(("joint_compliance", j)) for j in spec.compliance]
-                                            + [_effect_name(e) for e in spec.effects]), "cv_rms_mm": cur})
+        history.append({"model": spec.label(), "cv_rms_mm": cur})
+    for h in history:
+        for s in h.get("candidates", []):
+            s.pop("_cand", None)
     final = spec.fit(robot, data)
     e = spec.errors(final, data)
-    n_res, n_par = 3 * len(e), int(np.sum(~np.asarray(final["fixed"])))
+    n_res, n_par = 3 * len(e), int(np.sum(~np.asarray(final.fixed)))
     scatter = math.sqrt(float(np.sum(e ** 2)) / max(1, n_res - n_par)) * math.sqrt(3.0)
     left = [s for s in history[-1].get("candidates", []) if s["p_value"] < alpha]
     if noise_mm is not None:
@@ -221,16 +226,33 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
     if at_noise:
         verdict = "what remains is at the noise level"
     else:
-        gains = ", ".join(f"{_effect_name((s['effect'], s['joint'] or 0))} {s['cv_gain']:.1%}" for s in left[:3])
+        gains = ", ".join(f"{_label(s['effect'], s['joint'])} {s['cv_gain']:.1%}" for s in left[:3])
         verdict = ("what remains is structured but not explained by the library"
                    + (f" (significant candidates gain too little: {gains})" if left else ""))
     say(f"{len(steps)} effect(s) named; cross-validated RMS {cur * 1000:.1f} um, noise estimate "
         f"{noise * 1000:.1f} um: {verdict}")
+    final_model = {"effects": [{"effect": x.name, "joint": x.joint or None, "label": x.label} for x in spec.effects],
+                   "started_from": [x.label for x in start_effects]}
     return {"steps": steps, "final_rms_mm": cur, "noise_rms_mm": noise, "noise_known": noise_mm is not None,
             "fit_scatter_mm": scatter, "verdict": verdict, "notes": notes,
-            "history": history, "folds": folds,
-            "final_model": {"compliance_joints": spec.compliance, "effects": [list(x) for x in spec.effects]},
-            "_final_fit": final, "_spec": spec}
+            "history": history, "folds": folds, "final_model": final_model,
+            "_final_fit": final, "_spec": spec, "_start": start}
+
+
+def final_identification(robot: Robot, data: dict, diag: dict,
+                         tool_targets: Optional[np.ndarray] = None) -> "ident.Identification":
+    """The diagnosed model (every named effect and those it started from), identified on all the data
+    with Ceres as `kincal identify` does (covariance included), ready for model.json; with
+    ``tool_targets`` (the targets' offsets in the tool frame) the TCP is placed as identify's
+    --tool-targets does."""
+    spec: Spec = diag["_spec"]
+    res = ident.identify(robot, data, effects=spec.effects, holdout=0.0, **spec.fit_options)
+    res.validation = {"scheme": f"fitted on every row; cross-validated ({diag['folds']} folds) in the diagnosis",
+                      "held_rows": 0, "fit_rows": int(len(data["pose"])),
+                      "diagnosis_cv_rms_mm": diag["final_rms_mm"]}
+    if tool_targets is not None:
+        res = ident.tool_from_targets(res, tool_targets)
+    return res
 
 
 def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
@@ -247,8 +269,10 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
     return tau, f"gravity torque on joint {joint} (N m)"
 
 
-def write_report(robot: Robot, data: dict, diag: dict, out_dir, title: str = "kincal diagnose") -> list:
-    """Figures and report.html of a diagnosis in out_dir; returns the files written."""
+def write_report(robot: Robot, data: dict, diag: dict, out_dir, title: str = "kincal diagnose",
+                 model_file: Optional[str] = None) -> list:
+    """Figures and report.html of a diagnosis in out_dir; returns the files written. ``model_file``:
+    the name of the final model's JSON written beside it (said in the report)."""
     import html
     from pathlib import Path
 
@@ -270,12 +294,12 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir, title: str = "ki
     plt.close(fig)
     files.append("gap.png")
     # 2. residual maps before (geometry only) and after (final model), in the instrument frame
-    geo = Spec().fit(robot, data)
-    e0 = Spec().errors(geo, data)
+    start: Spec = diag["_start"]
+    e0 = start.errors(start.fit(robot, data), data)
     e1 = diag["_spec"].errors(diag["_final_fit"], data)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
     vmax = float(np.max(e0)) * 1000
-    for ax, e, lab in ((axes[0], e0, "geometric model"), (axes[1], e1, "final model")):
+    for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
         sc = ax.scatter(data["xyz"][:, 0], data["xyz"][:, 1], c=e * 1000, s=8, cmap="viridis", vmin=0, vmax=vmax)
         ax.set_title(f"{lab}: RMS {np.sqrt(np.mean(e ** 2)) * 1000:.1f} um (fitted points)", fontsize=10)
         ax.set_xlabel("x (mm, instrument)")
@@ -286,10 +310,10 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir, title: str = "ki
     plt.close(fig)
     files.append("residual_map.png")
     # 3. residuals against each named effect's variable, before and after it was added
-    spec = Spec()
+    spec = start
     for k, st in enumerate(diag["steps"]):
         before = spec.errors(spec.fit(robot, data), data)
-        spec = spec.with_((st["effect"], st["joint"] or 0))
+        spec = spec.with_(_core.Effect(st["effect"], st["joint"] or 0))
         after = spec.errors(spec.fit(robot, data), data)
         var, lab = _variable(robot, data, st["effect"], st["joint"])
         fig, ax = plt.subplots(figsize=(6.5, 3.4), constrained_layout=True)
@@ -297,18 +321,23 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir, title: str = "ki
         ax.scatter(var, after * 1000, s=6, alpha=0.6, label="after")
         ax.set_xlabel(lab)
         ax.set_ylabel("point error (um)")
-        ax.set_title(f"step {k + 1}: {_effect_name((st['effect'], st['joint'] or 0))}", fontsize=10)
+        ax.set_title(f"step {k + 1}: {_label(st['effect'], st['joint'])}", fontsize=10)
         ax.legend()
         name = f"step{k + 1}.png"
         fig.savefig(out / name, dpi=100)
         plt.close(fig)
         files.append(name)
     rows = "".join(
-        f"<tr><td>{k + 1}</td><td>{html.escape(_effect_name((s['effect'], s['joint'] or 0)))}</td>"
+        f"<tr><td>{k + 1}</td><td>{html.escape(_label(s['effect'], s['joint']))}</td>"
         f"<td>{s['evidence']['F']:.3g}</td><td>{s['evidence']['p_value']:.2g}</td>"
         f"<td>{s['evidence']['cv_gain_linear']:.1%}</td><td>{s['rms_before_mm'] * 1000:.1f}</td>"
         f"<td>{s['rms_after_mm'] * 1000:.1f}</td></tr>" for k, s in enumerate(diag["steps"]))
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in diag["notes"])
+    fm = diag.get("final_model", {})
+    model_note = "" if not model_file else (
+        f"<p><b>Model:</b> {html.escape(model_file)} was written: the final model "
+        f"({html.escape(' + '.join(['geometry'] + [e['label'] for e in fm.get('effects', [])]))}), identified on all "
+        f"the data, ready for <code>kincal compensate --model {html.escape(model_file)}</code>.</p>")
     steps_img = "".join(f'<figure><img src="{f}" alt="{f}"></figure>' for f in files if f.startswith("step"))
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
@@ -327,7 +356,8 @@ refits everything and checks that the cross-validated RMS ({diag['folds']} folds
 <h2>The gap, step by step</h2><figure><img src="gap.png" alt="gap"></figure>
 <h2>Where the model and the measurements disagree</h2><figure><img src="residual_map.png" alt="residual map"></figure>
 <h2>Residuals against each named effect</h2>{steps_img}
-<p>Files: diagnosis.json (the contract's summary), {", ".join(files)}.</p>
+{model_note}
+<p>Files: diagnosis.json (the contract's summary), {", ".join(([model_file] if model_file else []) + files)}.</p>
 </body></html>
 """
     from . import _core as core

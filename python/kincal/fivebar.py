@@ -173,30 +173,53 @@ def error_map_figure(maps: list, path: str, title: str = "five-bar positioning e
 LINKS = ("a", "b", "c", "d")
 
 
-def _basis(effect: str, t1: np.ndarray, t2: np.ndarray, index: int) -> np.ndarray:
-    """Per-point basis functions (n x k) of an effect: link_deflection of a link varies with the
-    pose as p1 cos t1 + p2 sin t1 + p3 cos t2 + p4 sin t2 (mm); transmission_error of actuator j is
-    p1 sin tj + p2 cos tj + p3 sin 2tj + p4 cos 2tj (rad)."""
-    if effect == "link_deflection":
-        return np.c_[np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)]
-    t = t1 if index == 0 else t2
-    return np.c_[np.sin(t), np.cos(t), np.sin(2 * t), np.cos(2 * t)]
+def library() -> list:
+    """The hidden robot's candidate effects, from the registry: every five-bar effect on each link
+    a..d, and every joint-angle effect that needs no extra data (transmission error) on each
+    actuator. Each is a _core.Effect (joint: the link or actuator, from 1)."""
+    out = []
+    for kind in _core.effect_kinds():
+        if kind.domain == "fivebar" and kind.concerns == "link":
+            out += [_core.Effect(kind.name, i + 1) for i in range(len(LINKS))]
+    for kind in _core.effect_kinds():
+        if kind.acts_on == "joint_angle" and not kind.needs and not kind.gravity_loaded_only:
+            out += [_core.Effect(kind.name, j + 1) for j in range(2)]
+    return out
+
+
+def _acts_on(effect) -> str:
+    return _core.effect_kind(effect.name).acts_on
+
+
+def _basis(effect, t1: np.ndarray, t2: np.ndarray) -> np.ndarray:
+    """Per-point basis functions (n x effect.size) of an effect: a link's length varies with the pose
+    as p1 cos t1 + p2 sin t1 + p3 cos t2 + p4 sin t2 (mm); a joint-angle effect of actuator j is the
+    sum over its harmonic orders k of s_k sin(k tj) + c_k cos(k tj) (rad)."""
+    if _acts_on(effect) == "link_length":
+        b = np.c_[np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)]
+    else:
+        t = t1 if effect.joint == 1 else t2
+        b = np.column_stack([f(k * t) for k in effect.harmonics for f in (np.sin, np.cos)])
+    if b.shape[1] != effect.size:
+        raise ValueError(f"{effect.label}: {effect.size} parameters but the five-bar has {b.shape[1]} basis functions")
+    return b
 
 
 def _predict(pts: dict, x: np.ndarray, effects: list) -> np.ndarray:
-    """Model positions (n x 2) for lengths x[:4] and the effects' parameters after them."""
+    """Model positions (n x 2) for lengths x[:4] and the effects' parameters after them (effects:
+    _core.Effect objects, joint = link or actuator from 1)."""
     t1, t2 = np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"])
     n = len(t1)
     L = np.tile(x[:4], (n, 1))
     dt = np.zeros((n, 2))
     k = 4
-    for eff, idx in effects:
-        b = _basis(eff, t1, t2, idx)
-        if eff == "link_deflection":
-            L[:, idx] += b @ x[k:k + 4]
+    for eff in effects:
+        b = _basis(eff, t1, t2)
+        if _acts_on(eff) == "link_length":
+            L[:, eff.joint - 1] += b @ x[k:k + eff.size]
         else:
-            dt[:, idx] += b @ x[k:k + 4]
-        k += 4
+            dt[:, eff.joint - 1] += b @ x[k:k + eff.size]
+        k += eff.size
     out = np.empty((n, 2))
     for i in range(n):
         c = FiveBar(*L[i]).fk(np.degrees(t1[i] + dt[i, 0]), np.degrees(t2[i] + dt[i, 1]))
@@ -211,7 +234,7 @@ def fit_with_effects(pts: dict, effects: list, start: Optional[np.ndarray] = Non
     (scipy's trust-region reflective; a few parameters, central-difference Jacobian)."""
     from scipy.optimize import least_squares
 
-    x0 = np.r_[np.array([150.0, 150, 150, 150]) if start is None else start[:4], np.zeros(4 * len(effects))]
+    x0 = np.r_[np.array([150.0, 150, 150, 150]) if start is None else start[:4], np.zeros(sum(e.size for e in effects))]
     if start is not None and len(start) > 4:
         x0[4:len(start)] = start[4:]
     r = least_squares(lambda x: (_predict(pts, x, effects) - pts["measured"]).ravel(), x0, method="trf",
@@ -240,7 +263,7 @@ def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0
             sq += float(np.sum((_predict(sub(m), x, effects) - pts["measured"][m]) ** 2))
         return math.sqrt(sq / n)
 
-    cands = [("link_deflection", i) for i in range(4)] + [("transmission_error", j) for j in range(2)]
+    cands = library()
     effects: list = []
     cur = cv(effects)
     steps = []
@@ -259,13 +282,15 @@ def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0
         t1, t2 = np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"])
         model = FiveBar(*x[:4])
         scored: list[dict[str, Any]] = []
-        for eff, idx in cands:
-            if (eff, idx) in effects:
+        for eff in cands:
+            if eff in effects:
                 continue
-            b = _basis(eff, t1, t2, idx)
-            R = np.zeros((2 * n, 4))
+            idx = eff.joint - 1
+            b = _basis(eff, t1, t2)
+            k_par = eff.size
+            R = np.zeros((2 * n, k_par))
             for i in range(n):
-                if eff == "link_deflection":
+                if _acts_on(eff) == "link_length":
                     _, jl = _core.fivebar_errors(model, {k: (v[i:i + 1] if isinstance(v, np.ndarray) else v)
                                                          for k, v in pts.items()})
                     d = jl[:, idx]
@@ -279,35 +304,36 @@ def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0
             Rp = R - Q @ (Q.T @ R)
             beta, *_ = np.linalg.lstsq(Rp, r, rcond=None)
             rss0, rss1 = float(r @ r), float(np.sum((r - Rp @ beta) ** 2))
-            dof = 2 * n - Jc.shape[1] - 4
-            F = ((rss0 - rss1) / 4) / (rss1 / dof) if rss1 > 0 and dof > 0 else math.inf
-            p = float(fdist.sf(F, 4, dof)) if math.isfinite(F) else 0.0
+            dof = 2 * n - Jc.shape[1] - k_par
+            F = ((rss0 - rss1) / k_par) / (rss1 / dof) if rss1 > 0 and dof > 0 else math.inf
+            p = float(fdist.sf(F, k_par, dof)) if math.isfinite(F) else 0.0
             before = after = 0.0
             for m in masks:
                 rows = np.repeat(m, 2)
                 bb, *_ = np.linalg.lstsq(Rp[~rows], r[~rows], rcond=None)
                 before += float(r[rows] @ r[rows])
                 after += float(np.sum((r[rows] - Rp[rows] @ bb) ** 2))
-            scored.append({"effect": eff, "index": idx, "F": F, "p_value": p,
+            scored.append({"effect": eff, "F": F, "p_value": p,
                            "cv_gain": 1 - math.sqrt(after / before) if before > 0 else 0.0})
         scored.sort(key=lambda s: -s["cv_gain"])
         sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
         if not sig:
             break
         best = sig[0]
-        trial = effects + [(best["effect"], best["index"])]
+        trial = effects + [best["effect"]]
         new = cv(trial)
         if new >= cur:
             break
-        step = {"effect": best["effect"], "joint": None, "evidence": {"F": best["F"], "p_value": best["p_value"],
-                                                                      "cv_gain_linear": best["cv_gain"]},
+        eff = best["effect"]
+        step = {"effect": eff.name, "joint": None, "evidence": {"F": best["F"], "p_value": best["p_value"],
+                                                                "cv_gain_linear": best["cv_gain"]},
                 "rms_before_mm": cur, "rms_after_mm": new}
-        if best["effect"] == "link_deflection":
-            step["link"] = LINKS[best["index"]]
+        if _core.effect_kind(eff.name).concerns == "link":
+            step["link"] = LINKS[eff.joint - 1]
         else:
-            step["joint"] = best["index"] + 1
+            step["joint"] = eff.joint
         steps.append(step)
-        say(f"step {len(steps)}: {best['effect']} ({step.get('link') or step['joint']}), cross-validated RMS "
+        say(f"step {len(steps)}: {eff.name} ({step.get('link') or step['joint']}), cross-validated RMS "
             f"{cur * 1000:.1f} -> {new * 1000:.1f} um")
         effects, cur = trial, new
     x = fit_with_effects(pts, effects)

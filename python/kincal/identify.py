@@ -21,9 +21,8 @@ from ._core import Robot
 DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
 #: where the simulated laser tracker sees the robot base: x, y, z (mm), a, b, c (deg)
 DEFAULT_INSTRUMENT = (3500.0, -1500.0, -400.0, 35.0, 1.5, -0.8)
-#: the effects identify knows (contract names)
-IDENTIFY_EFFECTS = ("joint_compliance",)
-KNOWN_EFFECTS = ("joint_compliance", "transmission_error", "backlash", "thermal_expansion", "link_deflection")
+#: harmonic orders of transmission_error unless --harmonics says otherwise
+DEFAULT_HARMONICS = (1, 2)
 
 
 def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
@@ -38,9 +37,10 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
              t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None) -> dict:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
     model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
-    ``effects`` hides more effects in the truth: (name, joint from 1 or 0, values) with the values in
-    radians (transmission_error: sin q, cos q, sin 2q, cos 2q amplitudes; backlash: offset per
-    direction sign) or per degree C (thermal_expansion, about t_ref). Every row gets dir1..dirN and
+    ``effects`` hides more effects in the truth: (Effect, values) or (name, joint from 1 or 0, values),
+    the values in the registry's core units (``Effect.units``: radians for transmission_error's sine
+    and cosine amplitudes and backlash's offset per direction sign, 1/degC for thermal_expansion about
+    t_ref). Every row gets dir1..dirN and
     temperature_c (drifting from 18 to 30 C over the campaign). With ``orientation_noise_deg`` the
     tool frame's orientation is measured too (a 6-D probe): columns a, b, c."""
     if poses < 1:
@@ -52,8 +52,96 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
     if not 0.0 <= outlier_fraction <= 1.0:
         raise ValueError(f"the outlier fraction must be in 0..1, not {outlier_fraction}")
     return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets], 0.9,
-                          [(str(n), int(j), [float(v) for v in vals]) for n, j, vals in effects], t_ref,
+                          [_effect_value(e) for e in effects], t_ref,
                           -1.0 if orientation_noise_deg is None else float(orientation_noise_deg))
+
+
+def _effect_value(e: Sequence) -> tuple:
+    """(Effect, values) from (Effect, values) or (name, joint from 1 or 0, values)."""
+    if len(e) == 2 and isinstance(e[0], _core.Effect):
+        return e[0], [float(v) for v in e[1]]
+    name, joint, vals = e
+    return _core.Effect(str(name), int(joint)), [float(v) for v in vals]
+
+
+def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
+    """Joints (from 1) where a joint-wise effect applies: the gravity-loaded ones (from the
+    identification layout) for an effect that needs gravity, every joint otherwise."""
+    if kind.gravity_loaded_only:
+        return list(_core.PointModel(robot, 1).layout.loaded)
+    return list(range(1, robot.dof + 1))
+
+
+def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS,
+                  option: str = "--effects") -> list:
+    """The effects of ``--effects``: comma separated ``NAME`` (every joint where it applies: joint
+    compliance only on the gravity-loaded joints) or ``NAME:J`` (joint J, from 1); ``none`` or an
+    empty text is the geometry alone. ``harmonics``: transmission_error's orders. Errors name the
+    bad item and what the registry knows."""
+    items = [t.strip() for t in (text or "").split(",") if t.strip()]
+    if items == ["none"]:
+        return []
+    serial = [k for k in _core.effect_kinds() if k.domain == "serial"]
+    known = ", ".join(k.name for k in serial)
+    out: list = []
+    for item in items:
+        name, _, joint = item.partition(":")
+        name = name.strip()
+        kind = next((k for k in _core.effect_kinds() if k.name == name), None)
+        if kind is None:
+            raise ValueError(f"{option}: unknown effect '{item}' (known: {known})")
+        if kind.domain != "serial":
+            raise ValueError(f"{option}: '{item}': {name} belongs to the {kind.domain} robot, not to a serial "
+                             f"robot (known here: {known})")
+        if joint.strip():
+            if kind.concerns != "joint":
+                raise ValueError(f"{option}: '{item}': {name} concerns the whole robot, not one joint "
+                                 f"(write {name})")
+            try:
+                j = int(joint)
+            except ValueError:
+                raise ValueError(f"{option}: '{item}': the joint must be a number 1..{robot.dof}") from None
+            if not 1 <= j <= robot.dof:
+                raise ValueError(f"{option}: '{item}': joint {j} is not one of 1..{robot.dof}")
+            if kind.gravity_loaded_only and j not in applicable_joints(robot, kind):
+                raise ValueError(f"{option}: '{item}': gravity does not load joint {j} of {robot.name} "
+                                 f"(loaded: {', '.join(map(str, applicable_joints(robot, kind)))})")
+            joints = [j]
+        else:
+            joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
+        for j in joints:
+            e = _core.Effect(name, j, list(harmonics))
+            try:
+                e.check(robot.dof)
+            except ValueError as err:
+                raise ValueError(f"{option}: '{item}': {err}") from None
+            if e not in out:
+                out.append(e)
+    return out
+
+
+def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
+    """The data columns the effects read (the registry's ``needs``) are present: a clear error names
+    the file and the column otherwise."""
+    src = data.get("source", "<data>")
+    for e in effects:
+        need = _core.effect_kind(e.name).needs
+        if need == "dir" and "dir" not in data:
+            raise ValueError(f"{src}: {e.label} needs the dir1..dir{robot.dof} columns (the sign of each joint's "
+                             "last motion into the pose)")
+        if need == "temperature_c" and "temperature_c" not in data:
+            raise ValueError(f"{src}: {e.label} needs the temperature_c column")
+
+
+def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
+            orientation_weight: float = 100.0, max_iterations: int = 100,
+            fix: Sequence[str] = ()) -> "_core.IdentifyOptions":
+    """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
+    joints on; without any, the compliances stay at their start value)."""
+    effects = list(effects)
+    return _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
+                                 loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
+                                 effects=effects, covariance=covariance, orientation_weight=orientation_weight)
 
 
 def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
@@ -62,10 +150,11 @@ def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bo
     parameters a generic campaign identifies), each step adding the pose that most increases
     log det of the information matrix. Returns the chosen rows."""
     n_targets = int(np.max(candidates["target"])) + 1
-    res = _core.identify(robot, candidates, compliance, "none", 0.1, 0, [], None, False, False)
-    free = ~np.asarray(res["fixed"])
+    res = _core.identify(robot, candidates, _core.IdentifyOptions(compliance=compliance, loss="none", max_iterations=0,
+                                                                  covariance=False))
+    free = ~np.asarray(res.fixed)
     pm = _core.PointModel(robot, n_targets)
-    _, J = pm.residuals(list(res["x"]), candidates, True)
+    _, J = pm.residuals(list(res.x), candidates, True)
     J = np.asarray(J)[:, free]
     J = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
     ids = np.unique(candidates["pose"])
@@ -130,45 +219,48 @@ def _rms(e: np.ndarray) -> float:
 
 @dataclass
 class Identification:
-    """What `kincal identify` found: the calibrated robot, targets, parameters and validation."""
+    """What `kincal identify` found: the calibrated robot (with its identified effects), targets, the
+    core's result (``fit``: an IdentifyResult) and the validation. ``effects``: the effects asked for."""
     robot: Robot
     targets: np.ndarray
-    fit: dict
+    fit: "_core.IdentifyResult"
     effects: list
     validation: dict = field(default_factory=dict)
 
     def parameters(self) -> list:
         f = self.fit
-        return [{"name": n, "unit": u, "value": float(v), "stddev": (None if math.isnan(s) else float(s)),
-                 "fixed": bool(fx), "reason": r}
-                for n, u, v, s, fx, r in zip(f["names"], f["units"], f["x"], f["stddev"], f["fixed"],
-                                             f["fixed_reason"])]
+        return [{"name": p.name, "kind": p.kind, "joint": p.joint or None, "unit": p.unit, "value": float(v),
+                 "stddev": (None if math.isnan(s) else float(s)), "fixed": bool(fx), "reason": r}
+                for p, v, s, fx, r in zip(f.layout.parameters, f.x, f.stddev, f.fixed, f.fixed_reason)]
+
+    def effect_labels(self) -> list:
+        return [e.label for e in self.effects]
 
     def model_json(self) -> str:
         d = json.loads(self.robot.to_json())
         f = self.fit
         d["identification"] = {
-            "effects": self.effects,
-            "targets_mm": self.targets.tolist(),
+            "effects": self.effect_labels(),
+            "targets_mm": np.asarray(self.targets).tolist(),
             "parameters": self.parameters(),
-            "condition_number": f["condition_number"],
-            "observability_index": f["observability_index"],
-            "correlations": [{"a": a, "b": b, "r": r} for a, b, r in f["correlations"]],
-            "iterations": f["iterations"],
-            "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f["rms_mm"], "max_mm": f["max_mm"],
-                    "nominal_rms_mm": f["nominal_rms_mm"], "nominal_max_mm": f["nominal_max_mm"]},
+            "condition_number": f.condition_number,
+            "observability_index": f.observability_index,
+            "correlations": [{"a": a, "b": b, "r": r} for a, b, r in f.correlations],
+            "iterations": f.iterations,
+            "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f.rms_mm, "max_mm": f.max_mm,
+                    "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
         }
         return json.dumps(d, indent=1, sort_keys=True) + "\n"
 
     def summary(self) -> str:
         f, v = self.fit, self.validation
-        lines = [f"identified {sum(not x for x in f['fixed'])} of {len(f['names'])} parameters "
-                 f"({', '.join(['geometry'] + self.effects)}) in {f['iterations']} iterations"]
+        lines = [f"identified {int(np.sum(~np.asarray(f.fixed)))} of {f.layout.size} parameters "
+                 f"({', '.join(['geometry'] + self.effect_labels())}) in {f.iterations} iterations"]
         lines.append("")
         lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'max before':>12}{'max after':>12}")
-        lines.append(f"{'fitted poses':<28}{f['nominal_rms_mm']:>12.4f}{f['rms_mm']:>12.4f}"
-                     f"{f['nominal_max_mm']:>12.4f}{f['max_mm']:>12.4f}")
+        lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}"
+                     f"{f.nominal_max_mm:>12.4f}{f.max_mm:>12.4f}")
         if v.get("held_rows"):
             lines.append(f"{'held-out poses (' + v['scheme'] + ')':<28}{v['before_rms_mm']:>12.4f}{v['after_rms_mm']:>12.4f}"
                          f"{v['before_max_mm']:>12.4f}{v['after_max_mm']:>12.4f}")
@@ -176,15 +268,15 @@ class Identification:
             lines.append(f"{'orientation (deg), held out':<28}{v['before_rms_deg']:>12.4f}{v['after_rms_deg']:>12.4f}"
                          f"{v['before_max_deg']:>12.4f}{v['after_max_deg']:>12.4f}")
         lines.append("")
-        lines.append(f"condition number {f['condition_number']:.4g}, observability index {f['observability_index']:.4g}")
-        fixed = [(n, r) for n, fx, r in zip(f["names"], f["fixed"], f["fixed_reason"]) if fx]
+        lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}")
+        fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
         if fixed:
             lines.append("held at their start value:")
-            for n, r in fixed:
-                lines.append(f"  {n:<22} {r}")
-        if f["correlations"]:
+            for n, why in fixed:
+                lines.append(f"  {n:<22} {why}")
+        if f.correlations:
             lines.append("strong correlations:")
-            for a, b, r in f["correlations"][:20]:
+            for a, b, r in f.correlations[:20]:
                 lines.append(f"  {a:<22} {b:<22} {r:+.3f}")
         lines.append("parameters (value +- standard deviation):")
         for p in self.parameters():
@@ -194,10 +286,9 @@ class Identification:
         return "\n".join(lines)
 
 
-def _fit(robot: Robot, data: dict, effects: Sequence[str], loss: str, loss_scale_mm: float,
-         progress: Optional[Callable[[int, float], None]] = None, orientation_weight: float = 100.0) -> dict:
-    return _core.identify(robot, data, "joint_compliance" in effects, loss, loss_scale_mm, 100, [], progress,
-                          False, True, [], [], orientation_weight)
+def _fit(robot: Robot, data: dict, opts: "_core.IdentifyOptions",
+         progress: Optional[Callable[[int, float], None]] = None) -> "_core.IdentifyResult":
+    return _core.identify(robot, data, opts, progress)
 
 
 def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
@@ -210,62 +301,69 @@ def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
     return out
 
 
-def check_effects(effects: Sequence[str]) -> list:
-    out = []
+def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> list:
+    """Effects as _core.Effect: a text of --effects, or a list of Effect objects and/or texts
+    (``NAME`` or ``NAME:J``), checked against the registry and the robot."""
+    if isinstance(effects, str):
+        return parse_effects(effects, robot, harmonics)
+    out: list = []
     for e in effects:
-        if e not in KNOWN_EFFECTS:
-            raise ValueError(f"unknown effect '{e}' (known: {', '.join(KNOWN_EFFECTS)})")
-        if e not in IDENTIFY_EFFECTS:
-            raise ValueError(f"effect '{e}' is not available in identify (available: {', '.join(IDENTIFY_EFFECTS)})")
-        out.append(e)
+        for x in ([e] if isinstance(e, _core.Effect) else parse_effects(str(e), robot, harmonics)):
+            x.check(robot.dof)
+            if x not in out:
+                out.append(x)
     return out
 
 
-def identify(robot: Robot, data: dict, *, effects: Sequence[str] = ("joint_compliance",), loss: str = "huber",
+def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: str = "huber",
              loss_scale_mm: float = 0.1, holdout: float = 0.25, k_folds: int = 0, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
-             orientation_weight: float = 100.0) -> Identification:
+             orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> Identification:
     """Identify the robot's parameters from measurements.
 
-    Validation: ``k_folds`` > 1 fits k times, each time predicting the fold it did not see;
-    otherwise a share ``holdout`` of the poses is held out. The returned model is fitted on all rows
-    (k-fold) or on the fitted rows (split)."""
-    effects = check_effects(effects)
+    ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
+    ``--effects`` (``"joint_compliance"``, ``"transmission_error:3"``, ``"backlash:2"``,
+    ``"thermal_expansion"``, or one comma-separated text). Validation: ``k_folds`` > 1 fits k times,
+    each time predicting the fold it did not see; otherwise a share ``holdout`` of the poses is held
+    out. The returned model is fitted on all rows (k-fold) or on the fitted rows (split)."""
+    effects = check_effects(effects, robot, harmonics)
+    check_data_for(effects, data, robot)
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
     if k_folds == 1 or k_folds < 0:
         raise ValueError("--folds must be 0 (a split) or at least 2")
     if not 0.0 <= holdout < 1.0:
         raise ValueError(f"--holdout must be in [0, 1), not {holdout}")
+    opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
     val: dict = {}
     if k_folds > 1:
         e_before, e_after = [], []
         for held in folds(data, k_folds, seed):
-            r = _fit(robot, subset(data, ~held), effects, loss, loss_scale_mm, None, orientation_weight)
-            e_after.append(_core.point_errors(r["robot"], r["targets"], subset(data, held)))
-            e_before.append(_core.point_errors(r["nominal_fitted"], r["nominal_targets"], subset(data, held)))
+            r = _fit(robot, subset(data, ~held), opts)
+            e_after.append(_core.point_errors(r.robot, r.targets, subset(data, held)))
+            e_before.append(_core.point_errors(r.nominal_fitted, r.nominal_targets, subset(data, held)))
         fit_mask = np.ones(len(data["pose"]), dtype=bool)
         eb, ea = np.concatenate(e_before), np.concatenate(e_after)
         val = {"scheme": f"{k_folds}-fold", "held_rows": int(len(ea))}
     else:
         fit_mask, held = split_poses(data, holdout, seed)
         val = {"scheme": f"{holdout:.0%} held out", "held_rows": int(held.sum())}
-    r = _fit(robot, subset(data, fit_mask), effects, loss, loss_scale_mm, progress, orientation_weight)
+    r = _fit(robot, subset(data, fit_mask), opts, progress)
     if k_folds <= 1 and val["held_rows"]:
         held_data = subset(data, ~fit_mask)
-        ea = _core.point_errors(r["robot"], r["targets"], held_data)
-        eb = _core.point_errors(r["nominal_fitted"], r["nominal_targets"], held_data)
+        ea = _core.point_errors(r.robot, r.targets, held_data)
+        eb = _core.point_errors(r.nominal_fitted, r.nominal_targets, held_data)
     if val["held_rows"]:
         val.update(before_rms_mm=_rms(eb), after_rms_mm=_rms(ea), before_max_mm=float(np.max(eb)),
                    after_max_mm=float(np.max(ea)))
         if "abc" in data and k_folds <= 1:
             held_data = subset(data, ~fit_mask)
-            ob = orientation_errors_deg(r["nominal_fitted"], held_data)
-            oa = orientation_errors_deg(r["robot"], held_data)
+            ob = orientation_errors_deg(r.nominal_fitted, held_data)
+            oa = orientation_errors_deg(r.robot, held_data)
             val.update(before_rms_deg=_rms(ob), after_rms_deg=_rms(oa), before_max_deg=float(np.max(ob)),
                        after_max_deg=float(np.max(oa)))
     val["fit_rows"] = int(fit_mask.sum())
-    return Identification(robot=r["robot"], targets=np.asarray(r["targets"]), fit=r, effects=list(effects),
+    return Identification(robot=r.robot, targets=np.asarray(r.targets), fit=r, effects=list(effects),
                           validation=val)
 
 
@@ -273,12 +371,14 @@ def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float
     """Accuracy of an identified robot on another measurement series, where the instrument may stand
     elsewhere and the probe may sit differently: only the base frame and the targets are refitted
     (on the calibrated geometry, and on the nominal one for the "before")."""
-    names = list(_core.PointModel(robot, int(np.max(data["target"])) + 1).names)
-    frames_only = [n for n in names if not (n.startswith("base.") or n.startswith("target"))]
-    cal = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, True, False)
-    nom = _core.identify(robot, data, False, loss, loss_scale_mm, 100, frames_only, None, False, False)
-    ea = _core.point_errors(cal["robot"], cal["targets"], data)
-    eb = _core.point_errors(nom["robot"], nom["targets"], data)
+    layout = _core.PointModel(robot, int(np.max(data["target"])) + 1).layout
+    frames_only = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
+    opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=frames_only,
+                                 covariance=False)
+    cal = _core.identify(robot, data, opts, None, True)
+    nom = _core.identify(robot, data, opts, None, False)
+    ea = _core.point_errors(cal.robot, cal.targets, data)
+    eb = _core.point_errors(nom.robot, nom.targets, data)
     return {"rows": int(len(ea)), "before_rms_mm": _rms(eb), "after_rms_mm": _rms(ea),
             "before_max_mm": float(np.max(eb)), "after_max_mm": float(np.max(ea))}
 
@@ -312,9 +412,7 @@ def tool_from_targets(result: Identification, known: np.ndarray) -> Identificati
     tool["xyz_mm"] = new_t.tolist()
     tool["abc_deg"] = _abc_of(new_r)
     robot = Robot.from_json(json.dumps(doc), "<identified>")
-    fit = dict(result.fit)
-    fit["robot"] = robot
-    return Identification(robot=robot, targets=known.copy(), fit=fit, effects=result.effects,
+    return Identification(robot=robot, targets=known.copy(), fit=result.fit, effects=result.effects,
                           validation=result.validation)
 
 

@@ -162,9 +162,9 @@ def test_observability_selection_beats_random_poses():
     assert len(np.unique(chosen["pose"])) == 30
     out = {}
     for name, d in (("random", rand), ("chosen", chosen)):
-        r = _core.identify(robot, d, True, "huber", 0.1, 100, [], None)
-        e = _core.point_errors(r["robot"], r["targets"], held)
-        out[name] = (r["observability_index"], float(np.sqrt(np.mean(e ** 2))))
+        r = _core.identify(robot, d, _core.IdentifyOptions(compliance=True, loss="huber"))
+        e = _core.point_errors(r.robot, r.targets, held)
+        out[name] = (r.observability_index, float(np.sqrt(np.mean(e ** 2))))
     assert out["chosen"][0] > out["random"][0]
     assert out["chosen"][1] < out["random"][1]
 
@@ -179,13 +179,13 @@ def test_numpy_residuals_equal_the_core():
     pm = _core.PointModel(robot, 2)
     x = np.asarray(pm.start(data))
     rng = np.random.default_rng(0)
-    for i, n in enumerate(pm.names):
-        if n.endswith(".compliance"):
-            x[i] = 0.003
-        elif "tilt" in n or n.endswith((".rx", ".ry", ".rz")):
-            x[i] += 1e-3 * rng.normal()
+    for p in pm.layout.parameters:
+        if p.kind == "compliance":
+            x[p.index] = 0.003
+        elif p.unit == "rad":
+            x[p.index] += 1e-3 * rng.normal()
         else:
-            x[i] += rng.normal()
+            x[p.index] += rng.normal()
     r_core = np.asarray(pm.residuals(list(x), data, False)[0])
     r_np = NumpyPointModel(robot, 2).residuals(x, data)
     assert np.max(np.abs(r_core - r_np)) < 1e-9

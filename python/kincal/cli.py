@@ -562,7 +562,8 @@ def cmd_demo(args) -> None:
           f"{summary['identification']['held_out_rms_after_mm']:.3f} mm; diagnosis named "
           + ", ".join(f"{d['effect']}" + (f" (joint {d['joint']})" if d["joint"] else "") for d in summary["diagnosis"])
           + f"; the line on the true robot: uncompensated {summary['position_error_uncompensated_mm']['mean']:.3f} mm, "
-          f"compensated {summary['position_error_compensated_mm']['mean']:.3f} mm (mean); feed violations "
+          f"compensated on the identified model {summary['position_error_compensated_mm']['mean']:.3f} mm, on the "
+          f"diagnosed model {summary['position_error_compensated_diagnosed_mm']['mean']:.4f} mm (mean); feed violations "
           f"{summary['feed_violations']}; five-bar {summary['fivebar_max_error_mm']['fit_and_matrix'] * 1000:.1f} um "
           f"after fit + matrix ({summary['seconds']:.0f} s)", file=sys.stderr)
     print(f"report: {out / 'report.html'}", file=sys.stderr)

@@ -156,7 +156,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
         "position_error_uncompensated_mm": {"mean": float(err_unc.mean()), "max": float(err_unc.max())},
         "position_error_compensated_mm": {"mean": float(err_com.mean()), "max": float(err_com.max())},
         "position_error_compensated_diagnosed_mm": {"mean": float(err_dia.mean()), "max": float(err_dia.max())},
-        "diagnosed_model_effects": [e.label for e, _ in diagnosed.robot.effects],
+        "diagnosed_model_effects": diagnosed.effect_labels(),
         "newton_iterations": {"max": int(np.max(com["iterations"]))},
         "feed_violations": {k: len(v["violations"]) for k, v in fres.items()},
         "time_optimal_s": {k: v["time_optimal"]["time_s"] for k, v in fres.items()},
@@ -176,7 +176,7 @@ def _report(out: Path, res, diag, summary, err_unc, err_com, err_dia, fres, tabl
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(8, 3.4), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(10, 3.4), constrained_layout=True)
     s_mm = np.arange(len(err_unc)) * 5.0
     ax.plot(s_mm, err_unc, label="uncompensated (nominal IK)")
     ax.plot(s_mm, err_com, label="compensated on the identified model (geometry + compliance)")
@@ -184,7 +184,7 @@ def _report(out: Path, res, diag, summary, err_unc, err_com, err_dia, fres, tabl
     ax.set_xlabel("position along the line (mm)")
     ax.set_ylabel("error on the true robot (mm)")
     ax.set_yscale("log")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside the curves, never on them
     fig.savefig(out / "line_errors.png", dpi=100)
     plt.close(fig)
 

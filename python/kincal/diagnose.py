@@ -284,12 +284,21 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir, title: str = "ki
     files = []
     # 1. the gap shrinking step by step
     hist = diag["history"]
-    fig, ax = plt.subplots(figsize=(7, 3.6), constrained_layout=True)
-    ax.bar(range(len(hist)), [h["cv_rms_mm"] * 1000 for h in hist], color="tab:blue")
-    ax.axhline(diag["noise_rms_mm"] * 1000, color="k", ls="--", label="noise estimate")
-    ax.set_xticks(range(len(hist)), [h["model"].replace(" + ", "\n+ ") for h in hist], fontsize=7)
-    ax.set_ylabel("cross-validated RMS (um)")
-    ax.legend()
+    # one horizontal bar per step, labelled by the effect that step added (the model is cumulative):
+    # long labels never overlap
+    fig, ax = plt.subplots(figsize=(8, 1.2 + 0.45 * len(hist)), constrained_layout=True)
+    labels = [h["model"].split(" + ")[-1] if k else "geometry" for k, h in enumerate(hist)]
+    labels = [lab if k == 0 else "+ " + lab for k, lab in enumerate(labels)]
+    y = np.arange(len(hist))[::-1]
+    vals = [h["cv_rms_mm"] * 1000 for h in hist]
+    ax.barh(y, vals, color="tab:blue")
+    for yy, v in zip(y, vals):
+        ax.text(v, yy, f" {v:.1f}", va="center", fontsize=8)
+    ax.axvline(diag["noise_rms_mm"] * 1000, color="k", ls="--", label="noise estimate")
+    ax.set_yticks(y, labels, fontsize=8)
+    ax.set_xlabel("cross-validated RMS (um), each step adds one effect to the model above it")
+    ax.set_xlim(0, max(vals) * 1.15)
+    ax.legend(loc="lower right", fontsize=8)
     fig.savefig(out / "gap.png", dpi=100)
     plt.close(fig)
     files.append("gap.png")

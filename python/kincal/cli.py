@@ -72,9 +72,9 @@ def _effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional
     """What the model's effects read from a joint file: dir1..dirN (backlash) and temperature_c
     (thermal expansion, unless --temperature); a missing column is an error naming it."""
     out: dict = {}
+    if robot.needs_temperature and temperature is not None:
+        out["temperature_c"] = np.full(n, float(temperature))
     if not (robot.needs_dir or (robot.needs_temperature and temperature is None)):
-        if robot.needs_temperature:
-            out["temperature_c"] = np.full(n, float(temperature))
         return out
     header: list = []
     if path.lower().endswith(".csv"):
@@ -92,10 +92,8 @@ def _effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional
             raise ValueError(f"{path}: row {bad[0][0] + 1}: column '{names[bad[0][1]]}': "
                              f"{d[bad[0][0], bad[0][1]]:g} is not +1 or -1")
         out["dir"] = d
-    if robot.needs_temperature:
-        if temperature is not None:
-            out["temperature_c"] = np.full(n, float(temperature))
-        elif "temperature_c" not in header:
+    if robot.needs_temperature and temperature is None:
+        if "temperature_c" not in header:
             raise ValueError(f"{path}:1: missing column 'temperature_c': the model has thermal expansion "
                              "(or give --temperature C)")
         else:

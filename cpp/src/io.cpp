@@ -234,6 +234,23 @@ std::string limit_violation(const Model& m, const Q6& q) {
   return "outside the joint limits";
 }
 
+// A converged compensation inside the limits is the answer; otherwise err says why not.
+bool accept(const Model& m, const CompensationResult& r, Q6& q_out, int& iterations, double& residual,
+            std::string& err) {
+  if (r.status != CompStatus::Converged) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " (after %d iterations, |F| = %.3g)", r.iterations, r.residual);
+    err = std::string("compensation failed: ") + to_string(r.status) + buf;
+    return false;
+  }
+  err = limit_violation(m, r.q_deg);
+  if (!err.empty()) return false;
+  q_out = r.q_deg;
+  iterations = r.iterations;
+  residual = r.residual;
+  return true;
+}
+
 // Newton on the calibrated model from one nominal IK solution q0 (corrected once, by default).
 // Returns false with the cause in err.
 bool compensate_from(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Eigen::Isometry3d& target,
@@ -252,22 +269,11 @@ bool compensate_from(const Robot& robot, const ProgramOptions& opt, const Pose6&
     if (k2 >= 0) q0 = s2.sol[k2].q_deg;
   }
   const CompensationResult r = compensate(cal, pose, q0, opt.comp, ctx);
-  if (r.status != CompStatus::Converged) {
-    if (approximate_start) {
-      err = "pose out of reach of the robot (beyond the nominal reach, and the model does not reach it either)";
-      return false;
-    }
-    char buf[160];
-    std::snprintf(buf, sizeof buf, " (after %d iterations, |F| = %.3g)", r.iterations, r.residual);
-    err = std::string("compensation failed: ") + to_string(r.status) + buf;
+  if (r.status != CompStatus::Converged && approximate_start) {
+    err = "pose out of reach of the robot (beyond the nominal reach, and the model does not reach it either)";
     return false;
   }
-  err = limit_violation(cal, r.q_deg);
-  if (!err.empty()) return false;
-  q_out = r.q_deg;
-  iterations = r.iterations;
-  residual = r.residual;
-  return true;
+  return accept(cal, r, q_out, iterations, residual, err);
 }
 
 }  // namespace
@@ -352,18 +358,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
     if (numeric_ik(target_model, pose, ref, qn, opt.comp, 48, c)) r = compensate(target_model, pose, qn, opt.comp, c);
     if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
   }
-  if (r.status != CompStatus::Converged) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, " (after %d iterations, |F| = %.3g)", r.iterations, r.residual);
-    err = std::string("compensation failed: ") + to_string(r.status) + buf;
-    return false;
-  }
-  err = limit_violation(target_model, r.q_deg);
-  if (!err.empty()) return false;
-  q_out = r.q_deg;
-  iterations = r.iterations;
-  residual = r.residual;
-  return true;
+  return accept(target_model, r, q_out, iterations, residual, err);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -149,6 +149,12 @@ def test_demo(tmp_path):
     assert s["position_error_uncompensated_mm"]["mean"] > 2.0
     assert s["position_error_compensated_mm"]["mean"] < 0.1 * s["position_error_uncompensated_mm"]["mean"]
     assert {"effect": "backlash", "joint": 2} in [{"effect": x["effect"], "joint": x["joint"]} for x in s["diagnosis"]]
+    # the closed loop (issue 13): the line compensated on the diagnosed model (the backlash included),
+    # run on the true robot with its backlash acting, within 0.05 mm on average
+    assert "backlash(joint 2)" in s["diagnosed_model_effects"]
+    assert s["position_error_compensated_diagnosed_mm"]["mean"] <= 0.05
+    assert s["position_error_compensated_diagnosed_mm"]["mean"] < s["position_error_compensated_mm"]["mean"] / 3
+    assert (d / "diagnosis" / "model.json").exists()
     assert s["fivebar_max_error_mm"]["fit_and_matrix"] < 0.030
     assert s["feed_violations"] == {"program": 0, "compare": 0}
     assert s["seconds"] < 180

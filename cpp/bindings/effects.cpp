@@ -4,9 +4,9 @@
 
 #include <pybind11/operators.h>
 
-#include "kincal/effects.hpp"
-#include "kincal/identify.hpp"
-#include "kincal/model.hpp"
+#include "kincal/effects/effects.hpp"
+#include "kincal/identify/identify.hpp"
+#include "kincal/model/model.hpp"
 
 using namespace kincal;
 

@@ -2,8 +2,8 @@
 // as dicts of numpy arrays: id, theta1_deg, theta2_deg, desired (n x 2), measured (n x 2), line.
 #include "common.hpp"
 
-#include "kincal/fivebar.hpp"
-#include "kincal/model.hpp"
+#include "kincal/fivebar/fivebar.hpp"
+#include "kincal/model/model.hpp"
 
 using namespace kincal;
 

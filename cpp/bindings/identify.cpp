@@ -7,22 +7,21 @@
 #include <optional>
 #include <tuple>
 
-#include "kincal/identify.hpp"
-#include "kincal/model.hpp"
+#include "kincal/identify/identify.hpp"
+#include "kincal/model/model.hpp"
 
 using namespace kincal;
 
 namespace {
 
-using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 py::dict to_dict(const MeasurementSet& m, int dof) {
   const size_t n = m.rows.size();
   Eigen::VectorXi pose(n), target(n), line(n);
-  RowMat q(n, dof), xyz(n, 3);
+  RowMatrix q(n, dof), xyz(n, 3);
   Eigen::VectorXd pay(n), temp(n);
   const bool dir = n > 0 && m.rows[0].dir.size() == dof;
-  RowMat dirs(dir ? n : 0, dof);
+  RowMatrix dirs(dir ? n : 0, dof);
   for (size_t i = 0; i < n; ++i) {
     temp[i] = m.rows[i].temperature_c;
     if (dir) dirs.row(i) = m.rows[i].dir.transpose();
@@ -44,7 +43,7 @@ py::dict to_dict(const MeasurementSet& m, int dof) {
   d["source"] = m.source;
   if (!std::isnan(temp.sum())) d["temperature_c"] = temp;
   if (m.orientation) {
-    RowMat abc(n, 3);
+    RowMatrix abc(n, 3);
     for (size_t i = 0; i < n; ++i) abc.row(i) = m.rows[i].abc.transpose();
     d["abc"] = abc;
   }
@@ -54,8 +53,8 @@ py::dict to_dict(const MeasurementSet& m, int dof) {
 
 MeasurementSet from_dict(const py::dict& d, int dof) {
   const auto pose = d["pose"].cast<Eigen::VectorXi>();
-  const auto q = d["q_deg"].cast<RowMat>();
-  const auto xyz = d["xyz"].cast<RowMat>();
+  const auto q = d["q_deg"].cast<RowMatrix>();
+  const auto xyz = d["xyz"].cast<RowMatrix>();
   const size_t n = pose.size();
   const Eigen::VectorXi target =
       d.contains("target") ? d["target"].cast<Eigen::VectorXi>() : Eigen::VectorXi::Zero(n).eval();
@@ -90,13 +89,13 @@ MeasurementSet from_dict(const py::dict& d, int dof) {
     for (size_t i = 0; i < n; ++i) m.rows[i].temperature_c = t[i];
   }
   if (d.contains("abc")) {
-    const auto a = d["abc"].cast<RowMat>();
+    const auto a = d["abc"].cast<RowMatrix>();
     if (static_cast<size_t>(a.rows()) != n || a.cols() != 3) throw InputError(m.source + ": abc of a different shape");
     for (size_t i = 0; i < n; ++i) m.rows[i].has_abc = true, m.rows[i].abc = a.row(i).transpose();
     m.orientation = true;
   }
   if (d.contains("dir")) {
-    const auto dd = d["dir"].cast<RowMat>();
+    const auto dd = d["dir"].cast<RowMatrix>();
     if (static_cast<size_t>(dd.rows()) != n || dd.cols() != dof) throw InputError(m.source + ": dir of a different shape");
     for (size_t i = 0; i < n; ++i) m.rows[i].dir = dd.row(i).transpose();
   }
@@ -121,14 +120,14 @@ py::list effect_values_to(const std::vector<EffectValue>& e) {
   return l;
 }
 
-std::vector<Vec3> targets_from(const RowMat& t) {
+std::vector<Vec3> targets_from(const RowMatrix& t) {
   std::vector<Vec3> v;
   for (int i = 0; i < t.rows(); ++i) v.emplace_back(t(i, 0), t(i, 1), t(i, 2));
   return v;
 }
 
-RowMat targets_to(const std::vector<Vec3>& v) {
-  RowMat t(v.size(), 3);
+RowMatrix targets_to(const std::vector<Vec3>& v) {
+  RowMatrix t(v.size(), 3);
   for (size_t i = 0; i < v.size(); ++i) t.row(i) = v[i].transpose();
   return t;
 }
@@ -229,7 +228,7 @@ void define_identify(py::module_& m) {
   m.def(
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
-         const RowMat& targets, double limit_margin, const std::vector<std::pair<Effect, std::vector<double>>>& effects,
+         const RowMatrix& targets, double limit_margin, const std::vector<std::pair<Effect, std::vector<double>>>& effects,
          double t_ref, double orientation_noise_deg) {
         SimulationOptions o;
         o.orientation_noise_deg = orientation_noise_deg;
@@ -252,7 +251,7 @@ void define_identify(py::module_& m) {
       "units) hidden in the truth");
   m.def(
       "point_errors",
-      [](const Robot& r, const RowMat& targets, const py::dict& d) {
+      [](const Robot& r, const RowMatrix& targets, const py::dict& d) {
         const auto e = point_errors(*r.calibrated, targets_from(targets), from_dict(d, r.calibrated->dof()));
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
@@ -456,7 +455,7 @@ void define_identify(py::module_& m) {
             p.set_params(x);
             const int P = p.layout().size, RS = data.orientation ? 6 : 3;
             Eigen::VectorXd r(RS * data.rows.size());
-            RowMat J(jac ? RS * data.rows.size() : 0, P);
+            RowMatrix J(jac ? RS * data.rows.size() : 0, P);
             std::vector<double> full(6 * static_cast<size_t>(P));
             for (size_t i = 0; i < data.rows.size(); ++i) {
               row_residuals(p, data.rows[i], weight, RS == 6, r.data() + RS * i, jac ? full.data() : nullptr);

@@ -1,8 +1,8 @@
 #include "common.hpp"
 
-#include "kincal/ik.hpp"
-#include "kincal/io.hpp"
-#include "kincal/kinematics.hpp"
+#include "kincal/ik/ik.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
@@ -13,11 +13,10 @@ using namespace kincal;
 
 namespace {
 
-using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 const Model& pick(const Robot& r, bool calibrated) { return calibrated ? *r.calibrated : *r.nominal; }
 
-void check_q(const Model& m, const Rows& q) {
+void check_q(const Model& m, const RowMatrix& q) {
   if (q.cols() != m.dof())
     throw InputError("joint angles have " + std::to_string(q.cols()) + " columns, the robot has " +
                      std::to_string(m.dof()) + " joints");
@@ -25,7 +24,7 @@ void check_q(const Model& m, const Rows& q) {
 }
 
 // The effects' context of row i: its directions (when given) and temperature (when given).
-EffectContext context_of(const Model& m, const std::optional<Rows>& dir, const std::optional<Eigen::VectorXd>& temp,
+EffectContext context_of(const Model& m, const std::optional<RowMatrix>& dir, const std::optional<Eigen::VectorXd>& temp,
                          Eigen::Index i) {
   EffectContext c;
   if (dir) c.dir = dir->row(i).transpose();
@@ -34,7 +33,7 @@ EffectContext context_of(const Model& m, const std::optional<Rows>& dir, const s
   return c;
 }
 
-void check_context_arrays(const Model& m, const Rows& q, const std::optional<Rows>& dir,
+void check_context_arrays(const Model& m, const RowMatrix& q, const std::optional<RowMatrix>& dir,
                           const std::optional<Eigen::VectorXd>& temp) {
   if (dir && (dir->rows() != q.rows() || dir->cols() != m.dof()))
     throw InputError("dir needs one row of " + std::to_string(m.dof()) + " signs per configuration");
@@ -52,12 +51,12 @@ void define_kinematics(py::module_& m) {
       py::arg("rotation"), "KUKA ABC angles (deg) of a rotation matrix (the inverse of abc_to_rotation)");
   m.def(
       "fk",
-      [](const Robot& r, const Rows& q_deg, bool calibrated, bool instrument, const std::optional<Rows>& dir,
+      [](const Robot& r, const RowMatrix& q_deg, bool calibrated, bool instrument, const std::optional<RowMatrix>& dir,
          const std::optional<Eigen::VectorXd>& temperature_c) {
         const Model& md = pick(r, calibrated);
         check_q(md, q_deg);
         check_context_arrays(md, q_deg, dir, temperature_c);
-        Rows out(q_deg.rows(), 6);
+        RowMatrix out(q_deg.rows(), 6);
         for (Eigen::Index i = 0; i < q_deg.rows(); ++i) {
           const VecQ q = q_deg.row(i).transpose() * kDeg;
           Eigen::Isometry3d t = fk_model(md, q, context_of(md, dir, temperature_c, i));
@@ -73,12 +72,12 @@ void define_kinematics(py::module_& m) {
       "acting: dir (N x dof signs, backlash) and temperature_c (N, thermal expansion) when it needs them");
   m.def(
       "motion_directions",
-      [](const Rows& q_deg, const std::vector<double>& initial) {
+      [](const RowMatrix& q_deg, const std::vector<double>& initial) {
         if (q_deg.cols() != 6) throw InputError("motion_directions: joint programs of 6 joints");
-        std::vector<Eigen::Matrix<double, 6, 1>> q(q_deg.rows());
+        std::vector<Vec6> q(q_deg.rows());
         for (Eigen::Index i = 0; i < q_deg.rows(); ++i) q[i] = q_deg.row(i).transpose();
         const auto d = motion_directions(q, initial);
-        Rows out(q_deg.rows(), 6);
+        RowMatrix out(q_deg.rows(), 6);
         for (Eigen::Index i = 0; i < q_deg.rows(); ++i) out.row(i) = d[i].transpose();
         return out;
       },
@@ -144,7 +143,7 @@ void define_kinematics(py::module_& m) {
       py::arg("robot"), py::arg("q_deg"), py::arg("calibrated") = true, "KDL's own FK (reference)");
   m.def(
       "ik_all",
-      [](const Robot& r, const Eigen::Matrix<double, 6, 1>& pose, py::object ref) {
+      [](const Robot& r, const Vec6& pose, py::object ref) {
         const Model& md = *r.nominal;
         if (!md.ik_structure().spherical_wrist_parallel_23)
           throw InputError("robot '" + md.spec().name + "' has no closed-form IK: " + md.ik_structure().reason);

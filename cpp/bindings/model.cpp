@@ -1,7 +1,7 @@
 #include "common.hpp"
 
-#include "kincal/identify.hpp"
-#include "kincal/model.hpp"
+#include "kincal/identify/identify.hpp"
+#include "kincal/model/model.hpp"
 
 #include <array>
 #include <optional>

@@ -1,6 +1,6 @@
 #include "common.hpp"
 
-#include "kincal/model.hpp"
+#include "kincal/model/model.hpp"
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "kincal C++ core (private: use the kincal package)";

@@ -1,8 +1,8 @@
 #include "common.hpp"
 
-#include "kincal/bench.hpp"
-#include "kincal/feed.hpp"
-#include "kincal/io.hpp"
+#include "bench.hpp"
+#include "kincal/feed/feed.hpp"
+#include "kincal/compensation/program.hpp"
 
 #include <optional>
 
@@ -10,7 +10,6 @@ using namespace kincal;
 
 namespace {
 
-using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 ProgramOptions options(bool compensate, bool instrument, bool fd, double delta, double epsilon, int max_iter,
                        bool corrected_start, const std::string& residual, std::optional<double> temperature_c,
@@ -34,13 +33,13 @@ ProgramOptions options(bool compensate, bool instrument, bool fd, double delta, 
 }
 
 py::dict result_dict(const ProgramResult& r) {
-  Rows q(static_cast<Eigen::Index>(r.q_deg.size()), 6);
+  RowMatrix q(static_cast<Eigen::Index>(r.q_deg.size()), 6);
   for (size_t i = 0; i < r.q_deg.size(); ++i) q.row(static_cast<Eigen::Index>(i)) = r.q_deg[i].transpose();
   py::dict d;
   d["q_deg"] = q;
   d["iterations"] = r.iterations;
   d["residual"] = r.residual;
-  Rows dir(static_cast<Eigen::Index>(r.dir.size()), 6);
+  RowMatrix dir(static_cast<Eigen::Index>(r.dir.size()), 6);
   for (size_t i = 0; i < r.dir.size(); ++i) dir.row(static_cast<Eigen::Index>(i)) = r.dir[i].transpose();
   d["dir"] = dir;
   d["warnings"] = r.warnings;
@@ -63,7 +62,7 @@ py::dict result_dict(const ProgramResult& r) {
 void define_programs(py::module_& m) {
   m.def(
       "compensate_poses",
-      [](const Robot& r, const Rows& poses, KINCAL_COMP_PARAMS, const std::optional<Eigen::VectorXd>& temps) {
+      [](const Robot& r, const RowMatrix& poses, KINCAL_COMP_PARAMS, const std::optional<Eigen::VectorXd>& temps) {
         if (poses.cols() != 6) throw InputError("poses need 6 columns x,y,z,a,b,c");
         std::vector<double> tv;
         if (temps) {
@@ -98,7 +97,7 @@ void define_programs(py::module_& m) {
       "read_pose_program",
       [](const std::string& path) {
         const PoseProgram p = read_pose_program(path);
-        Rows out(static_cast<Eigen::Index>(p.poses.size()), 6);
+        RowMatrix out(static_cast<Eigen::Index>(p.poses.size()), 6);
         for (size_t i = 0; i < p.poses.size(); ++i)
           out.row(static_cast<Eigen::Index>(i)) << p.poses[i].xyz.transpose(), p.poses[i].abc.transpose();
         return std::make_pair(out, p.pose_line);
@@ -108,7 +107,7 @@ void define_programs(py::module_& m) {
       "read_joint_program",
       [](const std::string& path, int dof) {
         const JointProgram p = read_joint_program(path, dof);
-        Rows out(static_cast<Eigen::Index>(p.q.size()), dof);
+        RowMatrix out(static_cast<Eigen::Index>(p.q.size()), dof);
         for (size_t i = 0; i < p.q.size(); ++i)
           for (int j = 0; j < dof; ++j) out(static_cast<Eigen::Index>(i), j) = p.q[i][static_cast<size_t>(j)];
         return std::make_pair(out, p.line);
@@ -116,7 +115,7 @@ void define_programs(py::module_& m) {
       py::arg("path"), py::arg("dof"), "Joint program (CSV q1..qN or G-code A1=..) in degrees");
   m.def(
       "time_optimal_feed",
-      [](const Eigen::VectorXd& s, const RowsX& d1, const RowsX& d2, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
+      [](const Eigen::VectorXd& s, const RowMatrix& d1, const RowMatrix& d2, const Eigen::VectorXd& v, const Eigen::VectorXd& a,
          const Eigen::VectorXd& cap) {
         double t = 0;
         Eigen::VectorXd sd = time_optimal_feed(s, d1, d2, v, a, cap, t);

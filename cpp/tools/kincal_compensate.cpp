@@ -8,8 +8,8 @@
 // M is a built-in robot name (kr500) or a model JSON written by kincal. Output equals
 // `kincal compensate` (both run this library). Errors: one line "file:line: cause", exit 1, and no
 // output file.
-#include "kincal/fivebar.hpp"
-#include "kincal/io.hpp"
+#include "kincal/fivebar/fivebar.hpp"
+#include "kincal/compensation/program.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -4,10 +4,10 @@
 // seeded generator; a reader may reject an input only with InputError. Any other exception, a
 // sanitizer report (the process aborts) or an input slower than 1 s is a failure.
 //   KINCAL_FUZZ_SECONDS (default 10), KINCAL_FUZZ_SEED (default 1)
-#include "kincal/fivebar.hpp"
-#include "kincal/identify.hpp"
-#include "kincal/io.hpp"
-#include "kincal/model.hpp"
+#include "kincal/fivebar/fivebar.hpp"
+#include "kincal/identify/identify.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/model/model.hpp"
 
 #include <chrono>
 #include <cstdio>

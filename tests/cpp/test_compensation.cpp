@@ -1,6 +1,6 @@
-#include "kincal/compensation.hpp"
-#include "kincal/io.hpp"
-#include "kincal/solve6.hpp"
+#include "kincal/compensation/pose.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/core/solve6.hpp"
 
 #include <Eigen/LU>
 
@@ -12,7 +12,6 @@ using namespace kincal;
 
 namespace {
 
-using Q6 = Eigen::Matrix<double, 6, 1>;
 
 struct Stats {
   int poses = 0, within5 = 0, failed = 0;
@@ -34,11 +33,11 @@ Stats run(bool finite_difference, bool corrected_start, double min_sing_deg, int
   std::mt19937_64 rng(31);
   Stats st;
   while (st.poses < n) {
-    const Q6 q = test::random_q(*nom, rng, 1.0);
+    const Vec6 q = test::random_q(*nom, rng, 1.0);
     if (test::singularity_distance_deg(*nom, q) < min_sing_deg) continue;
     const Pose6 target = iso_to_pose(fk_compliant(*cal, VecQ(q * kDeg)));
     ++st.poses;
-    Q6 out;
+    Vec6 out;
     int it;
     double res;
     std::string err;
@@ -83,10 +82,10 @@ TEST(Compensation, PaperStartAwayFromSingularities) {
 TEST(Compensation, NominalModelNeedsNoIteration) {
   auto nom = std::make_shared<Model>(kr500_spec());
   const Robot robot{nom, nom};
-  Q6 q;
+  Vec6 q;
   q << 10, -70, 95, 20, 40, -10;
   const Pose6 target = iso_to_pose(fk(*nom, VecQ(q * kDeg)));
-  Q6 out;
+  Vec6 out;
   int it;
   double res;
   std::string err;
@@ -98,7 +97,7 @@ TEST(Compensation, NominalModelNeedsNoIteration) {
 TEST(Compensation, FiniteDifferenceAndAnalyticAgree) {
   const Model cal(perturbed_spec(kr500_spec(), 6, 1.0, 0.05, 0.003));
   const Model nom(kr500_spec());
-  Q6 q;
+  Vec6 q;
   q << -30, -50, 70, 100, -60, 45;
   const Pose6 target = iso_to_pose(fk(nom, VecQ(q * kDeg)));
   CompensationOptions a, f;
@@ -119,15 +118,15 @@ TEST(Compensation, AnalyticJacobianMatchesFiniteDifferences) {
   for (double compliance : {0.0, 0.003}) {
     const Model cal(perturbed_spec(kr500_spec(), 7, 1.0, 0.05, compliance));
     for (int i = 0; i < 200; ++i) {
-      const Q6 q = test::random_q(cal, rng, 1.0);
-      Q6 qt = q;
+      const Vec6 q = test::random_q(cal, rng, 1.0);
+      Vec6 qt = q;
       qt[0] += 3;  // a desired pose near, not at, the current one
       const Pose6 desired = iso_to_pose(fk_compliant(cal, VecQ(qt * kDeg)));
       if (std::abs(desired.abc[1]) > 80) continue;  // ABC rates near their singularity
       const Mat6 j = pose_deviation_jacobian(cal, q, desired);
       const double h = 1e-5;  // degrees
       for (int k = 0; k < 6; ++k) {
-        Q6 qp = q, qm = q;
+        Vec6 qp = q, qm = q;
         qp[k] += h;
         qm[k] -= h;
         const Vec6 col = (pose_deviation(cal, qp, desired) - pose_deviation(cal, qm, desired)) / (2 * h);

@@ -1,11 +1,11 @@
 // The effects a model carries, through every consumer: the registry, model JSON version 2, FK and
 // its Jacobian, Newton compensation (FK(compensate(p)) = p with every effect), programs (backlash
 // directions from the commanded motion, temperature), B = +-90 deg poses and branch changes.
-#include "kincal/compensation.hpp"
-#include "kincal/effects.hpp"
-#include "kincal/identify.hpp"
-#include "kincal/io.hpp"
-#include "kincal/kinematics.hpp"
+#include "kincal/compensation/pose.hpp"
+#include "kincal/effects/effects.hpp"
+#include "kincal/identify/identify.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -18,7 +18,6 @@ using namespace kincal;
 
 namespace {
 
-using Q6 = Eigen::Matrix<double, 6, 1>;
 
 // Truth of these tests: kr500 with 1 mm / 0.05 deg geometric errors and compliance 0.003 deg/kNm
 // (seed 11), transmission error on joints 2 and 3 (harmonics 1, 2 and, on joint 3, 3), backlash
@@ -133,7 +132,7 @@ TEST(Effects, JacobiansMatchFiniteDifferences) {
   std::mt19937_64 rng(41);
   double worst = 0, worst_f = 0;
   for (int i = 0; i < 200; ++i) {
-    const Q6 q = test::random_q(m, rng, 1.0);
+    const Vec6 q = test::random_q(m, rng, 1.0);
     const EffectContext c = random_context(rng);
     Eigen::Isometry3d t;
     Jac j;
@@ -151,13 +150,13 @@ TEST(Effects, JacobiansMatchFiniteDifferences) {
       worst = std::max(worst, (dw - j.col(k).tail<3>()).norm());
     }
     for (Residual res : {Residual::RotationVector, Residual::Abc}) {
-      Q6 qt = q;
+      Vec6 qt = q;
       qt[0] += 2, qt[4] += 1;  // a desired pose near, not at, the current one
       const Pose6 desired = iso_to_pose(fk_model(m, qt * kDeg, c));
       if (res == Residual::Abc && std::abs(desired.abc[1]) > 80) continue;
       const Mat6 jf = pose_deviation_jacobian(m, q, desired, res, c);
       for (int k = 0; k < 6; ++k) {
-        Q6 qp = q, qm = q;
+        Vec6 qp = q, qm = q;
         qp[k] += 1e-5, qm[k] -= 1e-5;
         const Vec6 col = (pose_deviation(m, qp, desired, res, c) - pose_deviation(m, qm, desired, res, c)) / 2e-5;
         worst_f = std::max(worst_f, (col - jf.col(k)).cwiseAbs().maxCoeff() / std::max(1.0, col.cwiseAbs().maxCoeff()));
@@ -182,12 +181,12 @@ TEST(Effects, CompensationInvertsEveryEffect) {
   int n = 0, ok = 0;
   double worst_mm = 0, worst_deg = 0;
   while (n < test::count(2000)) {
-    const Q6 q = test::random_q(*nom, rng, 2.0);
+    const Vec6 q = test::random_q(*nom, rng, 2.0);
     if (test::singularity_distance_deg(*nom, q) < 1.0) continue;
     const EffectContext c = random_context(rng);
     const Eigen::Isometry3d want = fk_model(*cal, q * kDeg, c);
     ++n;
-    Q6 out;
+    Vec6 out;
     int it;
     double r;
     bool changed;
@@ -216,12 +215,12 @@ TEST(Effects, PosesAtBPlusMinus90Compensate) {
   std::mt19937_64 rng(44);
   int done = 0, paper_stopped = 0;
   while (done < 20) {
-    const Q6 q = test::random_q(*nom, rng, 10.0);
+    const Vec6 q = test::random_q(*nom, rng, 10.0);
     if (test::singularity_distance_deg(*nom, q) < 5.0) continue;
     Pose6 p = iso_to_pose(fk(*nom, q * kDeg));
     if (std::abs(p.abc[1]) < 80) continue;
     p.abc[1] = p.abc[1] > 0 ? 90.0 : -90.0;
-    Q6 out;
+    Vec6 out;
     int it;
     double r;
     bool changed;
@@ -254,7 +253,7 @@ TEST(Effects, BranchChangesToStayWithinLimits) {
   co.epsilon = 1e-20;
   int tried = 0;
   for (int i = 0; i < 4000 && tried < 20; ++i) {
-    Q6 q = test::random_q(*nom, rng, 5.0);
+    Vec6 q = test::random_q(*nom, rng, 5.0);
     const int j = 1 + i % 2;
     const auto& js = nom->spec().joints[j];
     q[j] = i % 4 < 2 ? js.upper_deg - 0.05 : js.lower_deg + 0.05;
@@ -271,7 +270,7 @@ TEST(Effects, BranchChangesToStayWithinLimits) {
     }
     if (!other) continue;
     ++tried;
-    Q6 out;
+    Vec6 out;
     int it;
     double r;
     bool changed;
@@ -292,7 +291,7 @@ TEST(Effects, BranchChangesToStayWithinLimits) {
 
 // Backlash directions in programs: the sign of each joint's change, held while it stands still.
 TEST(Effects, MotionDirections) {
-  std::vector<Q6> q(5, Q6::Zero());
+  std::vector<Vec6> q(5, Vec6::Zero());
   q[1][0] = 1, q[2][0] = 1, q[3][0] = 0.5, q[4][0] = 0.5 + 1e-9;
   q[1][1] = -1;
   const auto d = motion_directions(q, {});
@@ -332,7 +331,7 @@ TEST(Effects, ProgramWithBacklashRunsToTheDesiredPoses) {
     EffectContext c;
     c.dir = dirs[i];
     c.temperature_c = 27.5;
-    EXPECT_EQ(Q6(c.dir), res.dir[i]);
+    EXPECT_EQ(Vec6(c.dir), res.dir[i]);
     if (i > 0) reversals += (dirs[i] - dirs[i - 1]).cwiseAbs().sum() > 0;
     const Eigen::Isometry3d got = fk_model(*cal, res.q_deg[i] * kDeg, c);
     worst = std::max(worst, (got.translation() - poses[i].xyz).norm());

@@ -1,7 +1,7 @@
 // The hot paths' sine, cosine and arctangent (fastmath.hpp) against long-double libm on millions of
 // arguments: within 4 ulp of the true value (libm's double versions are within 1), and the special
 // values handed to libm.
-#include "kincal/fastmath.hpp"
+#include "kincal/core/fastmath.hpp"
 
 #include "test_util.hpp"
 

@@ -1,7 +1,7 @@
 // Five-bar hidden robot: kinematics round trips and derivatives, the paper's Table I picks, the
 // error matrix's interpolation, and the corrector's allocation-free loop.
-#include "kincal/fivebar.hpp"
-#include "kincal/model.hpp"
+#include "kincal/fivebar/fivebar.hpp"
+#include "kincal/model/model.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Identification: the analytic Jacobian against finite differences, completeness of the model
 // (noise-free data fitted exactly), and the noise floor reached on a simulated kr500 campaign.
-#include "kincal/identify.hpp"
-#include "kincal/kinematics.hpp"
+#include "kincal/identify/identify.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>

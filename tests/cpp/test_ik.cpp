@@ -1,5 +1,5 @@
-#include "kincal/ik.hpp"
-#include "kincal/kinematics.hpp"
+#include "kincal/ik/ik.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include "test_util.hpp"
 
@@ -10,7 +10,7 @@ using namespace kincal;
 namespace {
 
 // Checks that every solution reproduces the pose and that the generating configuration is among them.
-void check_round_trip(const Model& m, const Eigen::Matrix<double, 6, 1>& q, double& worst_p, double& worst_r) {
+void check_round_trip(const Model& m, const Vec6& q, double& worst_p, double& worst_r) {
   const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
   const IkSolutions s = ik_all(m, t, q.data());
   ASSERT_EQ(s.status, IkStatus::Ok);
@@ -89,7 +89,7 @@ TEST(Ik, AnyOffsetsRoundTrip) {
     inexact23 += m.ik_structure().k.sigma23 == 0;
     ++robots;
     for (int i = 0; i < 50; ++i) {
-      Eigen::Matrix<double, 6, 1> q;
+      Vec6 q;
       for (int j = 0; j < 6; ++j) q[j] = std::uniform_real_distribution<double>(-180, 180)(rng);
       check_round_trip(m, q, wp, wr);
     }
@@ -109,7 +109,7 @@ TEST(Ik, OutOfReachAndSingularPosesGiveClearAnswers) {
   EXPECT_EQ(s.status, IkStatus::OutOfReach);
   EXPECT_EQ(s.count, 0);
   // the wrist singularity q5 = 0: solutions exist, are finite, reproduce the pose and are flagged
-  Eigen::Matrix<double, 6, 1> q;
+  Vec6 q;
   q << 10, -80, 100, 30, 0, -20;
   const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
   const IkSolutions w = ik_all(m, t, q.data());
@@ -127,7 +127,7 @@ TEST(Ik, OutOfReachAndSingularPosesGiveClearAnswers) {
 
 TEST(Ik, NearestSolutionFollowsTheReference) {
   const Model m(kr500_spec());
-  Eigen::Matrix<double, 6, 1> q;
+  Vec6 q;
   q << 20, -60, 80, 40, 50, -30;
   const IkSolutions s = ik_all(m, fk(m, VecQ(q * kDeg)), q.data());
   const int k = ik_nearest(m, s, q.data());

@@ -1,4 +1,4 @@
-#include "kincal/io.hpp"
+#include "kincal/compensation/program.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "kincal/kinematics.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include "test_util.hpp"
 

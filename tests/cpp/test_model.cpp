@@ -1,4 +1,4 @@
-#include "kincal/model.hpp"
+#include "kincal/model/model.hpp"
 #include <random>
 #include <kdl/chain.hpp>
 

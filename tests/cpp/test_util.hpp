@@ -1,8 +1,8 @@
 // Shared helpers of the C++ tests: seeded random configurations, the test count CI can raise.
 #pragma once
 
-#include "kincal/kinematics.hpp"
-#include "kincal/model.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/model.hpp"
 
 #include <cstdlib>
 #include <random>
@@ -15,8 +15,8 @@ inline int count(int dflt) {
   return e ? std::max(1, std::atoi(e)) : dflt;
 }
 
-inline Eigen::Matrix<double, 6, 1> random_q(const Model& m, std::mt19937_64& rng, double margin_deg = 0) {
-  Eigen::Matrix<double, 6, 1> q;
+inline Vec6 random_q(const Model& m, std::mt19937_64& rng, double margin_deg = 0) {
+  Vec6 q;
   for (int j = 0; j < 6; ++j) {
     const auto& js = m.spec().joints[j];
     q[j] = std::uniform_real_distribution<double>(js.lower_deg + margin_deg, js.upper_deg - margin_deg)(rng);
@@ -31,7 +31,7 @@ inline double rot_dist(const Mat3& a, const Mat3& b) {
 
 /// The kr500's distance (deg) from its singularities: wrist (q5 = 0), elbow (arm stretched),
 /// shoulder (wrist centre on axis 1, measured as the angle it subtends at 1300 mm).
-inline double singularity_distance_deg(const Model& m, const Eigen::Matrix<double, 6, 1>& q) {
+inline double singularity_distance_deg(const Model& m, const Vec6& q) {
   const double elbow = std::atan2(55.0, 1025.0) / kDeg;  // q3 where axes 2, 3 and the wrist centre line up
   VecQ qq = q * kDeg;
   qq[3] = qq[4] = qq[5] = 0;

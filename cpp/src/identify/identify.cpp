@@ -1,9 +1,9 @@
 // kincal: measurement files, the campaign simulator and Ceres identification.
 // With fivebar_fit.cpp one of the two translation units that include Ceres (builds stay quick).
-#include "kincal/identify.hpp"
+#include "kincal/identify/identify.hpp"
 
-#include "kincal/io.hpp"
-#include "kincal/kinematics.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <ceres/ceres.h>
 

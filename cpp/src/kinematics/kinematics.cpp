@@ -1,8 +1,8 @@
-#include "kincal/kinematics.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <cmath>
 
-#include "kincal/fastmath.hpp"
+#include "kincal/core/fastmath.hpp"
 
 namespace kincal {
 

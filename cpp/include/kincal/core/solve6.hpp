@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "kincal/model.hpp"
+#include "kincal/model/model.hpp"
 
 namespace kincal {
 

@@ -1,8 +1,8 @@
 // kincal: hidden-robot kinematics, synthesis, the error matrix and the over-constrained truth.
-#include "kincal/fivebar.hpp"
+#include "kincal/fivebar/fivebar.hpp"
 
-#include "kincal/io.hpp"
-#include "kincal/model.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/model/model.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 // kincal: nonlinear least-squares fit of the hidden robot's four lengths with Ceres (beyond the
 // paper's linear per-dyad synthesis: the distance between model and measured position itself).
-#include "kincal/fivebar.hpp"
-#include "kincal/model.hpp"
+#include "kincal/fivebar/fivebar.hpp"
+#include "kincal/model/model.hpp"
 
 #include <ceres/ceres.h>
 

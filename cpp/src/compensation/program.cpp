@@ -1,6 +1,6 @@
-#include "kincal/io.hpp"
+#include "kincal/compensation/program.hpp"
 
-#include "kincal/kinematics.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <algorithm>
 #include <array>
@@ -18,7 +18,6 @@ namespace kincal {
 
 namespace {
 
-using Q6 = Eigen::Matrix<double, 6, 1>;
 
 std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -182,7 +181,7 @@ size_t cut_spans(const char* s, size_t n, const WordSpan* spans, int count, char
   return len;
 }
 
-size_t format_joints(char* out, size_t cap, const Q6& q, bool csv) {
+size_t format_joints(char* out, size_t cap, const Vec6& q, bool csv) {
   size_t len = 0;
   for (int j = 0; j < 6; ++j) {
     const int w = csv ? std::snprintf(out + len, cap - len, j ? ",%.10f" : "%.10f", q[j])
@@ -194,7 +193,7 @@ size_t format_joints(char* out, size_t cap, const Q6& q, bool csv) {
 }
 
 // A joint G-code line: the cut line with the joint words at insert_at. No allocation.
-size_t emit_gcode_line(const char* cut, size_t n, size_t insert_at, const Q6& q, char* out, size_t cap) {
+size_t emit_gcode_line(const char* cut, size_t n, size_t insert_at, const Vec6& q, char* out, size_t cap) {
   if (insert_at >= cap) throw InputError("output line too long");
   std::memcpy(out, cut, insert_at);
   size_t len = insert_at;
@@ -208,8 +207,8 @@ size_t emit_gcode_line(const char* cut, size_t n, size_t insert_at, const Q6& q,
   return len + (n - insert_at);
 }
 
-Q6 home_of(const Model& m) {
-  Q6 q = Q6::Zero();
+Vec6 home_of(const Model& m) {
+  Vec6 q = Vec6::Zero();
   if (m.spec().home_deg.size() == 6)
     for (int j = 0; j < 6; ++j) q[j] = m.spec().home_deg[j];
   return q;
@@ -220,7 +219,7 @@ Q6 home_of(const Model& m) {
 namespace {
 
 // The limit a compensated solution violates, as a message; empty when inside the limits.
-std::string limit_violation(const Model& m, const Q6& q) {
+std::string limit_violation(const Model& m, const Vec6& q) {
   if (m.within_limits_deg(q)) return {};
   for (int j = 0; j < 6; ++j) {
     const auto& js = m.spec().joints[j];
@@ -235,7 +234,7 @@ std::string limit_violation(const Model& m, const Q6& q) {
 }
 
 // A converged compensation inside the limits is the answer; otherwise err says why not.
-bool accept(const Model& m, const CompensationResult& r, Q6& q_out, int& iterations, double& residual,
+bool accept(const Model& m, const CompensationResult& r, Vec6& q_out, int& iterations, double& residual,
             std::string& err) {
   if (r.status != CompStatus::Converged) {
     char buf[160];
@@ -254,7 +253,7 @@ bool accept(const Model& m, const CompensationResult& r, Q6& q_out, int& iterati
 // Newton on the calibrated model from one nominal IK solution q0 (corrected once, by default).
 // Returns false with the cause in err.
 bool compensate_from(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Eigen::Isometry3d& target,
-                     Q6 q0, bool approximate_start, const EffectContext& ctx, Q6& q_out, int& iterations,
+                     Vec6 q0, bool approximate_start, const EffectContext& ctx, Vec6& q_out, int& iterations,
                      double& residual, std::string& err) {
   const Model& nom = *robot.nominal;
   const Model& cal = *robot.calibrated;
@@ -278,7 +277,7 @@ bool compensate_from(const Robot& robot, const ProgramOptions& opt, const Pose6&
 
 }  // namespace
 
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Q6& ref, Q6& q_out,
+bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref, Vec6& q_out,
                 int& iterations, double& residual, std::string& err) {
   bool changed;
   return solve_pose(robot, opt, pose, ref, EffectContext(), q_out, iterations, residual, changed, err);
@@ -287,8 +286,8 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
 // Nominal IK start (nearest ref) and Newton compensation of one pose; the other branches, nearest
 // first, when the nearest one's compensated solution is not inside the limits. Returns false with
 // the cause in err; allocates nothing when the nearest branch succeeds.
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose_in, const Q6& ref,
-                const EffectContext& ctx, Q6& q_out, int& iterations, double& residual, bool& branch_changed,
+bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose_in, const Vec6& ref,
+                const EffectContext& ctx, Vec6& q_out, int& iterations, double& residual, bool& branch_changed,
                 std::string& err) {
   const Model& nom = *robot.nominal;
   const Model& cal = *robot.calibrated;
@@ -328,7 +327,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
     // the nearest branch does not give a compensated solution inside the limits: the others, nearest
     // first (a nominal solution a little outside the limits may come inside once compensated)
     const std::string first_err = k >= 0 ? err : "no inverse-kinematics solution within the joint limits";
-    const Q6 tried = k >= 0 ? s.sol[k].q_deg : Q6::Constant(1e300);
+    const Vec6 tried = k >= 0 ? s.sol[k].q_deg : Vec6::Constant(1e300);
     if (!all) s = ik_all(nom, target, ref.data(), false, false);
     std::array<int, 8> order;
     std::array<double, 8> dist;
@@ -354,7 +353,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
   if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
   if (r.status != CompStatus::Converged || !target_model.within_limits_deg(r.q_deg)) {
     // no closed form to start from: a numerical IK from the reference, home and seeded starts
-    Q6 qn;
+    Vec6 qn;
     if (numeric_ik(target_model, pose, ref, qn, opt.comp, 48, c)) r = compensate(target_model, pose, qn, opt.comp, c);
     if (r.status == CompStatus::Converged) r.q_deg = wrap_near(target_model, r.q_deg, ref);
   }
@@ -565,10 +564,10 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   }
 }
 
-std::vector<Q6> motion_directions(const std::vector<Q6>& q, const std::vector<double>& initial) {
-  Q6 d = Q6::Ones();
+std::vector<Vec6> motion_directions(const std::vector<Vec6>& q, const std::vector<double>& initial) {
+  Vec6 d = Vec6::Ones();
   if (initial.size() == 6) {
-    d = Eigen::Map<const Q6>(initial.data());
+    d = Eigen::Map<const Vec6>(initial.data());
   } else if (initial.size() == 1) {
     d.setConstant(initial[0]);
   } else {  // the direction of each joint's first motion
@@ -581,7 +580,7 @@ std::vector<Q6> motion_directions(const std::vector<Q6>& q, const std::vector<do
         }
       }
   }
-  std::vector<Q6> out(q.size());
+  std::vector<Vec6> out(q.size());
   for (size_t i = 0; i < q.size(); ++i) {
     for (int j = 0; j < 6 && i > 0; ++j) {
       const double delta = q[i][j] - q[i - 1][j];
@@ -594,19 +593,19 @@ std::vector<Q6> motion_directions(const std::vector<Q6>& q, const std::vector<do
 
 namespace {
 
-Q6 initial_direction(const std::vector<double>& v) {
-  if (v.size() == 1) return Q6::Constant(v[0]);
+Vec6 initial_direction(const std::vector<double>& v) {
+  if (v.size() == 1) return Vec6::Constant(v[0]);
   if (v.size() != 6) throw InputError("--initial-direction needs one sign for every joint, or one for all");
   for (double x : v)
     if (x != 1.0 && x != -1.0) throw InputError("--initial-direction: the directions must be +1 or -1");
-  return Eigen::Map<const Q6>(v.data());
+  return Eigen::Map<const Vec6>(v.data());
 }
 
 // One pose of a program in order: solved with the directions the joints have (held from the
 // previous pose), then, with backlash, again with the directions of its own motion when that motion
 // turns a joint around. ctx.dir holds the directions into the pose on return; prev the pose.
-bool program_step(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, bool first, Q6& prev,
-                  EffectContext& ctx, Q6& q, int& it, double& r, bool& changed, std::string& err) {
+bool program_step(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, bool first, Vec6& prev,
+                  EffectContext& ctx, Vec6& q, int& it, double& r, bool& changed, std::string& err) {
   if (!solve_pose(robot, opt, pose, prev, ctx, q, it, r, changed, err)) return false;
   if (!first && opt.compensate && robot.calibrated->needs_dir()) {
     VecQ turned = ctx.dir;
@@ -618,7 +617,7 @@ bool program_step(const Robot& robot, const ProgramOptions& opt, const Pose6& po
     if (any) {
       EffectContext c2 = ctx;
       c2.dir = turned;
-      Q6 q2;
+      Vec6 q2;
       int it2;
       double r2;
       bool changed2;
@@ -652,14 +651,14 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
       if (!std::isfinite(temps[i]))
         throw InputError(where_i(i) + ": the model has thermal expansion: give the temperature (--temperature C, or "
                                       "a temperature_c column)");
-  auto run = [&](const Q6& dir0) {
+  auto run = [&](const Vec6& dir0) {
     ProgramResult res;
-    Q6 prev = home_of(*robot.nominal);
+    Vec6 prev = home_of(*robot.nominal);
     EffectContext ctx;
     if (needs_dir) ctx.dir = dir0;
     std::string err;
     for (size_t i = 0; i < poses.size(); ++i) {
-      Q6 q;
+      Vec6 q;
       int it;
       double r;
       bool changed;
@@ -672,7 +671,7 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
         res.warnings.push_back(w);
       }
       res.q_deg.push_back(q);
-      res.dir.push_back(needs_dir ? Q6(ctx.dir) : Q6::Zero());
+      res.dir.push_back(needs_dir ? Vec6(ctx.dir) : Vec6::Zero());
       res.iterations.push_back(it);
       res.residual.push_back(r);
       res.max_iterations = std::max(res.max_iterations, it);
@@ -680,10 +679,10 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
     }
     return res;
   };
-  if (!needs_dir) return run(Q6::Ones());
+  if (!needs_dir) return run(Vec6::Ones());
   if (!opt.initial_direction.empty()) return run(initial_direction(opt.initial_direction));
   // the direction of the first motion: from a first pass that assumes +1, then the program again
-  const ProgramResult first = run(Q6::Ones());
+  const ProgramResult first = run(Vec6::Ones());
   return run(motion_directions(first.q_deg, {})[0]);
 }
 
@@ -692,14 +691,14 @@ std::string format_joint_program(const PoseProgram& in, const ProgramResult& res
   char buf[512];
   if (csv) {
     out = "q1,q2,q3,q4,q5,q6\n";
-    for (const Q6& q : res.q_deg) {
+    for (const Vec6& q : res.q_deg) {
       out.append(buf, format_joints(buf, sizeof buf, q, true));
       out += '\n';
     }
     return out;
   }
   if (!in.gcode) {
-    for (const Q6& q : res.q_deg) {
+    for (const Vec6& q : res.q_deg) {
       out += "G1 ";
       out.append(buf, format_joints(buf, sizeof buf, q, false));
       out += '\n';
@@ -744,8 +743,8 @@ StreamCompensator::StreamCompensator(Robot robot, ProgramOptions opt) : robot_(s
   warning_.reserve(512);
 }
 
-Q6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
-  Q6 q;
+Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
+  Vec6 q;
   int it;
   double r;
   bool changed;
@@ -841,7 +840,7 @@ size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap
   for (int k = 0; k < 6; ++k)
     if (!modal_set_[k])
       fail_at("stdin", line_no_, std::string("pose word ") + kPoseLetters[k] + " not set yet on the first motion line");
-  const Q6 q = solve(modal_, std::numeric_limits<double>::quiet_NaN());
+  const Vec6 q = solve(modal_, std::numeric_limits<double>::quiet_NaN());
   char cut[4096];
   size_t insert_at;
   const size_t cn = cut_spans(s, n, spans, cnt, cut, sizeof cut, insert_at, "stdin", line_no_);

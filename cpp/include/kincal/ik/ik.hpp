@@ -6,14 +6,14 @@
 // orientation gives q4, q5 (subproblem 2) and q6 (subproblem 1). Up to 2 x 2 x 2 = 8 solutions.
 #pragma once
 
-#include "kincal/model.hpp"
+#include "kincal/model/model.hpp"
 
 namespace kincal {
 
 enum class IkStatus { Ok, OutOfReach, Unsupported };
 
 struct IkSolution {
-  Eigen::Matrix<double, 6, 1> q_deg;  ///< joint angles in degrees (within limits when possible)
+  Vec6 q_deg;  ///< joint angles in degrees (within limits when possible)
   bool within_limits = false;
   bool wrist_singular = false;        ///< axes 4 and 6 aligned: q4 + q6 is fixed, q4 is arbitrary
   bool shoulder_singular = false;     ///< wrist centre on axis 1: q1 is arbitrary

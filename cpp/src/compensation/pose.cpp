@@ -1,15 +1,15 @@
-#include "kincal/compensation.hpp"
+#include "kincal/compensation/pose.hpp"
 
 #include <random>
 #include <vector>
 
-#include "kincal/kinematics.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/LU>
 #include <cmath>
 
-#include "kincal/fastmath.hpp"
-#include "kincal/solve6.hpp"
+#include "kincal/core/fastmath.hpp"
+#include "kincal/core/solve6.hpp"
 
 namespace kincal {
 
@@ -26,7 +26,6 @@ const char* to_string(CompStatus s) {
 
 namespace {
 
-using Q6 = Eigen::Matrix<double, 6, 1>;
 
 inline double wrap180(double a) {  // to [-180, 180] without std::remainder (slow)
   if (a > 180.0 || a < -180.0) a -= 360.0 * std::floor((a + 180.0) / 360.0);
@@ -107,11 +106,11 @@ inline AbcTrig abc_trig(const Mat3& r) {
   return tr;
 }
 
-inline VecQ to_rad(const Q6& q) { return q * kDeg; }
+inline VecQ to_rad(const Vec6& q) { return q * kDeg; }
 
 }  // namespace
 
-Vec6 pose_deviation(const Model& cal, const Q6& q_deg, const Pose6& desired, Residual residual,
+Vec6 pose_deviation(const Model& cal, const Vec6& q_deg, const Pose6& desired, Residual residual,
                     const EffectContext& ctx) {
   return deviation_of(fk_model(cal, to_rad(q_deg), ctx), desired, residual);
 }
@@ -145,7 +144,7 @@ struct DeviationEvaluator {
     if (!abc) rd_t = abc_to_rotation(d.abc).transpose();
   }
 
-  Vec6 deviation_at(const Q6& q_deg) {
+  Vec6 deviation_at(const Vec6& q_deg) {
     const VecQ qr = q_deg * kDeg;
     fk_frames(cal, effects ? joint_angles(cal, qr, ctx, &dqd) : qr, frames);
     const Vec3 pos = scale * frames.tool.translation();
@@ -204,10 +203,10 @@ struct DeviationEvaluator {
   }
 };
 
-CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Q6& q0_deg,
+CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
                                        const CompensationOptions& opt, const EffectContext& ctx) {
   CompensationResult res;
-  Q6 q = q0_deg;
+  Vec6 q = q0_deg;
   DeviationEvaluator ev(cal, desired, ctx, opt.residual);
   Mat6r jf;
   Mat3 e;
@@ -236,7 +235,7 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
 
 }  // namespace
 
-Mat6 pose_deviation_jacobian(const Model& cal, const Q6& q_deg, const Pose6& desired, Residual residual,
+Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& desired, Residual residual,
                              const EffectContext& ctx) {
   if (cal.dof() != 6) throw std::invalid_argument("pose_deviation_jacobian needs a 6-joint robot");
   check_context(cal, ctx, "");
@@ -248,7 +247,7 @@ Mat6 pose_deviation_jacobian(const Model& cal, const Q6& q_deg, const Pose6& des
   return jf;
 }
 
-CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& q0_deg, const CompensationOptions& opt,
+CompensationResult compensate(const Model& cal, const Pose6& desired, const Vec6& q0_deg, const CompensationOptions& opt,
                               const EffectContext& ctx) {
   CompensationResult res;
   res.q_deg = q0_deg;
@@ -259,7 +258,7 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
   if (cal.needs_dir() || cal.needs_temperature()) check_context(cal, ctx, "");
   if (!opt.finite_difference) return compensate_analytic(cal, desired, q0_deg, opt, ctx);
   // the paper's iteration with its finite-difference Jacobian (eq. 7)
-  Q6 q = q0_deg;
+  Vec6 q = q0_deg;
   Mat6r jf;
   for (int it = 0;; ++it) {
     Vec6 f = deviation_of(fk_model(cal, to_rad(q), ctx), desired, opt.residual);
@@ -278,7 +277,7 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
     }
     // eq. 7: column i = (F(q + delta e_i) - F(q)) / delta
     for (int i = 0; i < 6; ++i) {
-      Q6 qi = q;
+      Vec6 qi = q;
       qi[i] += opt.delta;
       Vec6 fi = deviation_of(fk_model(cal, to_rad(qi), ctx), desired, opt.residual);
       jf.col(i) = (fi - f) / opt.delta;
@@ -292,8 +291,8 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Q6& 
   }
 }
 
-Q6 wrap_near(const Model& m, const Q6& q, const Q6& ref) {
-  Q6 out = q;
+Vec6 wrap_near(const Model& m, const Vec6& q, const Vec6& ref) {
+  Vec6 out = q;
   for (int j = 0; j < 6; ++j) {
     const auto& js = m.spec().joints[j];
     // the same joint position (360 degree periodic) nearest the reference, inside the limits if any is
@@ -316,12 +315,12 @@ Q6 wrap_near(const Model& m, const Q6& q, const Q6& ref) {
 namespace {
 
 /// Damped least squares from q (deg) toward the desired pose; true when it gets within 1e-6 mm/rad.
-bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q, const EffectContext& ctx) {
+bool dls(const Model& m, const Eigen::Isometry3d& target, Vec6& q, const EffectContext& ctx) {
   Eigen::Isometry3d t;
   Jac jg;
   double lambda = 1e-2;
   const double w = 1000.0;  // mm per rad of orientation error
-  auto error = [&](const Q6& qq, Vec6& e) {
+  auto error = [&](const Vec6& qq, Vec6& e) {
     const Eigen::Isometry3d tt = fk_model(m, to_rad(qq), ctx);
     const Eigen::AngleAxisd aa(tt.linear() * target.linear().transpose());
     e.head<3>() = tt.translation() - target.translation();
@@ -344,7 +343,7 @@ bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q, const EffectCon
       Vec6 step = a.ldlt().solve(g);           // radians
       const double mx = step.cwiseAbs().maxCoeff();
       if (mx > 0.3) step *= 0.3 / mx;           // at most about 17 degrees per step
-      const Q6 qn = q - step / kDeg;
+      const Vec6 qn = q - step / kDeg;
       Vec6 en;
       const double errn = error(qn, en);
       if (errn < err) {
@@ -364,14 +363,14 @@ bool dls(const Model& m, const Eigen::Isometry3d& target, Q6& q, const EffectCon
 
 }  // namespace
 
-bool numeric_ik(const Model& m, const Pose6& desired, const Q6& ref, Q6& q_out, const CompensationOptions& opt,
+bool numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref, Vec6& q_out, const CompensationOptions& opt,
                 int starts, const EffectContext& ctx) {
   const Eigen::Isometry3d target = pose_to_iso(desired);
-  std::vector<Q6> seeds = {ref};
-  if (m.spec().home_deg.size() == 6) seeds.push_back(Eigen::Map<const Q6>(m.spec().home_deg.data()));
+  std::vector<Vec6> seeds = {ref};
+  if (m.spec().home_deg.size() == 6) seeds.push_back(Eigen::Map<const Vec6>(m.spec().home_deg.data()));
   std::mt19937_64 rng(12345);
   for (int k = 0; k < starts; ++k) {
-    Q6 s;
+    Vec6 s;
     for (int j = 0; j < 6; ++j) {
       const auto& js = m.spec().joints[j];
       s[j] = std::uniform_real_distribution<double>(std::max(js.lower_deg, -180.0), std::min(js.upper_deg, 180.0))(rng);
@@ -381,11 +380,11 @@ bool numeric_ik(const Model& m, const Pose6& desired, const Q6& ref, Q6& q_out, 
   bool found = false;
   double best = 0;
   for (size_t k = 0; k < seeds.size(); ++k) {
-    Q6 q = seeds[k];
+    Vec6 q = seeds[k];
     if (!dls(m, target, q, ctx)) continue;
     const CompensationResult r = compensate(m, desired, q, opt, ctx);
     if (r.status != CompStatus::Converged) continue;
-    const Q6 qq = wrap_near(m, r.q_deg, ref);
+    const Vec6 qq = wrap_near(m, r.q_deg, ref);
     if (!m.within_limits_deg(qq)) continue;
     const double d = (qq - ref).cwiseAbs().maxCoeff();
     if (!found || d < best) {

@@ -1,10 +1,10 @@
-#include "kincal/effects.hpp"
+#include "kincal/effects/effects.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "kincal/fastmath.hpp"
-#include "kincal/model.hpp"
+#include "kincal/core/fastmath.hpp"
+#include "kincal/model/model.hpp"
 
 namespace kincal {
 

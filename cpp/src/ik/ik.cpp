@@ -1,13 +1,13 @@
-#include "kincal/ik.hpp"
+#include "kincal/ik/ik.hpp"
 
-#include "kincal/kinematics.hpp"
+#include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <cmath>
 
-#include "kincal/fastmath.hpp"
+#include "kincal/core/fastmath.hpp"
 
 namespace kincal {
 

@@ -3,8 +3,8 @@
 // Nothing here allocates: every buffer has a fixed maximum size.
 #pragma once
 
-#include "kincal/fastmath.hpp"
-#include "kincal/model.hpp"
+#include "kincal/core/fastmath.hpp"
+#include "kincal/model/model.hpp"
 
 #include <limits>
 #include <string>

@@ -2,10 +2,10 @@
 // Every reader error is an InputError "file:line: cause"; writers never leave a partial file.
 #pragma once
 
-#include "kincal/compensation.hpp"
-#include "kincal/ik.hpp"
-#include "kincal/kinematics.hpp"
-#include "kincal/model.hpp"
+#include "kincal/compensation/pose.hpp"
+#include "kincal/ik/ik.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/model.hpp"
 
 #include <limits>
 #include <string>
@@ -82,18 +82,18 @@ struct ProgramOptions {
 /// other branches are tried nearest first, and the first whose compensated solution is inside the
 /// limits is taken (branch_changed). Returns false with the cause in err; allocates nothing when
 /// the nearest branch succeeds.
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Eigen::Matrix<double, 6, 1>& ref,
-                const EffectContext& ctx, Eigen::Matrix<double, 6, 1>& q_out, int& iterations, double& residual,
+bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
+                const EffectContext& ctx, Vec6& q_out, int& iterations, double& residual,
                 bool& branch_changed, std::string& err);
 /// The same without effects context (a model without backlash or thermal expansion).
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Eigen::Matrix<double, 6, 1>& ref,
-                Eigen::Matrix<double, 6, 1>& q_out, int& iterations, double& residual, std::string& err);
+bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
+                Vec6& q_out, int& iterations, double& residual, std::string& err);
 
 struct ProgramResult {
-  std::vector<Eigen::Matrix<double, 6, 1>> q_deg;
+  std::vector<Vec6> q_deg;
   std::vector<int> iterations;
   std::vector<double> residual;
-  std::vector<Eigen::Matrix<double, 6, 1>> dir;  ///< backlash: each joint's direction into each pose
+  std::vector<Vec6> dir;  ///< backlash: each joint's direction into each pose
   std::vector<std::string> warnings;             ///< "file:line: cause", e.g. branch changes
   int max_iterations = 0;
   double max_residual = 0;
@@ -105,7 +105,7 @@ constexpr double kStillDeg = 1e-7;
 /// The direction of motion of every joint into every pose of a joint program: the sign of its
 /// change from the previous pose, held while it stands still; the first pose's from initial (+-1
 /// per joint; empty: the direction of each joint's first motion, +1 for a joint that never moves).
-std::vector<Eigen::Matrix<double, 6, 1>> motion_directions(const std::vector<Eigen::Matrix<double, 6, 1>>& q_deg,
+std::vector<Vec6> motion_directions(const std::vector<Vec6>& q_deg,
                                                            const std::vector<double>& initial);
 
 /// IK + compensation of every pose in order, keeping the branch continuous (each pose starts from
@@ -140,7 +140,7 @@ class StreamCompensator {
   ProgramOptions opt_;
   int line_no_ = 0;
   bool first_ = true;
-  Eigen::Matrix<double, 6, 1> prev_;
+  Vec6 prev_;
   EffectContext ctx_;
   int csv_temperature_col_ = -1;
   std::string warning_;
@@ -150,7 +150,7 @@ class StreamCompensator {
   // G-code modal state
   Pose6 modal_;
   bool modal_set_[6] = {false, false, false, false, false, false};
-  Eigen::Matrix<double, 6, 1> solve(const Pose6& p, double temperature_c);
+  Vec6 solve(const Pose6& p, double temperature_c);
 };
 
 }  // namespace kincal

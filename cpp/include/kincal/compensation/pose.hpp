@@ -11,8 +11,8 @@
 // error, backlash, thermal expansion) mapped to the residual's rates.
 #pragma once
 
-#include "kincal/kinematics.hpp"
-#include "kincal/model.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/model.hpp"
 
 namespace kincal {
 
@@ -34,7 +34,7 @@ enum class CompStatus { Converged, NotConverged, SingularJacobian, OrientationSi
 const char* to_string(CompStatus s);
 
 struct CompensationResult {
-  Eigen::Matrix<double, 6, 1> q_deg;
+  Vec6 q_deg;
   int iterations = 0;        ///< Newton updates made
   double residual = 0;       ///< |F| at q_deg (mm and degrees mixed as in eq. 9)
   double position_error_mm = 0, orientation_error_deg = 0;  ///< |dXYZ| and |dABC| at q_deg
@@ -43,29 +43,29 @@ struct CompensationResult {
 
 /// The pose deviation F of the calibrated model (every effect acting in the context ctx) at q_deg
 /// from the desired pose (xyz, abc): mm, and degrees of the chosen residual.
-Vec6 pose_deviation(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired,
+Vec6 pose_deviation(const Model& cal, const Vec6& q_deg, const Pose6& desired,
                     Residual residual = Residual::RotationVector, const EffectContext& ctx = EffectContext());
 
 /// The analytic Jacobian of pose_deviation with respect to q_deg, as the default compensation uses
 /// it: rows mm and degrees, columns per degree (with the ABC residual singular at B = +-90 deg).
-Mat6 pose_deviation_jacobian(const Model& cal, const Eigen::Matrix<double, 6, 1>& q_deg, const Pose6& desired,
+Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& desired,
                              Residual residual = Residual::RotationVector, const EffectContext& ctx = EffectContext());
 
 /// Newton compensation from the start q0_deg (normally the nominal IK solution), every effect of
 /// the model acting in the context ctx (InputError when the context lacks what the model needs).
-CompensationResult compensate(const Model& cal, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& q0_deg,
+CompensationResult compensate(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
                               const CompensationOptions& opt = {}, const EffectContext& ctx = EffectContext());
 
 /// Each joint moved by whole turns to the position nearest the reference, inside its limits when one is.
-Eigen::Matrix<double, 6, 1> wrap_near(const Model& m, const Eigen::Matrix<double, 6, 1>& q_deg,
-                                      const Eigen::Matrix<double, 6, 1>& ref_deg);
+Vec6 wrap_near(const Model& m, const Vec6& q_deg,
+                                      const Vec6& ref_deg);
 
 /// Numerical inverse kinematics for robots without a closed form (e.g. the UR10): damped least
 /// squares (Levenberg-Marquardt) on position and rotation-vector error from the reference, then from
 /// home and from seeded starts inside the joint limits; the converged solution within the limits
 /// nearest the reference (largest joint difference), polished by compensate(). false when none.
-bool numeric_ik(const Model& m, const Pose6& desired, const Eigen::Matrix<double, 6, 1>& ref_deg,
-                Eigen::Matrix<double, 6, 1>& q_deg, const CompensationOptions& opt, int starts = 48,
+bool numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref_deg,
+                Vec6& q_deg, const CompensationOptions& opt, int starts = 48,
                 const EffectContext& ctx = EffectContext());
 
 }  // namespace kincal

@@ -1,6 +1,6 @@
-#include "kincal/feed.hpp"
+#include "kincal/feed/feed.hpp"
 
-#include "kincal/model.hpp"
+#include "kincal/model/model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 namespace kincal {
 
-Eigen::VectorXd time_optimal_feed(const Eigen::VectorXd& s, const RowsX& d1, const RowsX& d2, const Eigen::VectorXd& v,
+Eigen::VectorXd time_optimal_feed(const Eigen::VectorXd& s, const RowMatrix& d1, const RowMatrix& d2, const Eigen::VectorXd& v,
                                   const Eigen::VectorXd& a, const Eigen::VectorXd& cap, double& time) {
   const Eigen::Index n = s.size(), dof = d1.cols();
   if (d1.rows() != n || d2.rows() != n || d2.cols() != dof || v.size() != dof || a.size() != dof ||

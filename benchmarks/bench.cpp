@@ -1,11 +1,11 @@
-#include "kincal/bench.hpp"
+#include "bench.hpp"
 
-#include "kincal/compensation.hpp"
-#include "kincal/fivebar.hpp"
-#include "kincal/ik.hpp"
-#include "kincal/io.hpp"
-#include "kincal/kinematics.hpp"
-#include "kincal/model.hpp"
+#include "kincal/compensation/pose.hpp"
+#include "kincal/fivebar/fivebar.hpp"
+#include "kincal/ik/ik.hpp"
+#include "kincal/compensation/program.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/model.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_nr.hpp>
@@ -22,7 +22,6 @@ namespace kincal {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Q6 = Eigen::Matrix<double, 6, 1>;
 
 volatile double g_sink = 0;
 
@@ -64,7 +63,7 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
   // random configurations inside the limits, more than 1 degree from the wrist singularity
   std::vector<VecQ> qs;
   std::vector<Pose6> poses;
-  std::vector<Q6> qref;
+  std::vector<Vec6> qref;
   while (static_cast<int>(qs.size()) < n) {
     VecQ q(6);
     for (int j = 0; j < 6; ++j) {
@@ -111,7 +110,7 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
                    }));
   // Compensation (the and the paper's): Newton on the calibrated model from the nominal IK
   // solution nearest the reference, the start KDL's NR gets below
-  std::vector<Q6> start(n);
+  std::vector<Vec6> start(n);
   for (int i = 0; i < n; ++i) {
     const IkSolutions s = ik_all(nom, targets[i], qref[i].data());
     const int k = ik_nearest(nom, s, qref[i].data());
@@ -160,7 +159,7 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
   auto nomp = std::make_shared<Model>(kr500_spec());
   const Robot rob{nomp, std::make_shared<Model>(cal.spec())};
   struct R {
-    Q6 q_deg;
+    Vec6 q_deg;
     bool ok;
   };
   auto program_pose = [&](const Robot& rb, int i) {

@@ -22,7 +22,7 @@
 // held at their start value.
 #pragma once
 
-#include "kincal/model.hpp"
+#include "kincal/model/model.hpp"
 
 #include <array>
 #include <functional>

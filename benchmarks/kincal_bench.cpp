@@ -1,5 +1,5 @@
 // kincal-bench: the C++ benchmarks as one JSON object (kincal bench adds the Python baselines).
-#include "kincal/bench.hpp"
+#include "bench.hpp"
 
 #include <cstdio>
 #include <cstdlib>

@@ -19,5 +19,6 @@ fi
 .venv/bin/pip install -q --no-deps cmeel-toppra
 .venv/bin/pip install -q --no-build-isolation .
 PEERS="$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/cmeel.prefix"
-cmake -S . -B build/cpp -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PEERS" >/dev/null
+PYBIND11="$(.venv/bin/python -m pybind11 --cmakedir)"
+cmake -S . -B build/cpp -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PEERS;$PYBIND11" >/dev/null
 cmake --build build/cpp -j2

@@ -154,7 +154,7 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
                      const auto r = compensate(cal, poses[i], start[i], fd);
                      g_sink = g_sink + r.q_deg[0];
                    }, 5));
-  // The whole per-pose path of `kincal compensate` (io.hpp solve_pose): nominal IK of the branch
+  // The whole per-pose path of `kincal compensate` (compensation/program.hpp solve_pose): nominal IK of the branch
   // nearest the reference, the corrected start (a second IK), Newton, the joint-limit check
   auto nomp = std::make_shared<Model>(kr500_spec());
   const Robot rob{nomp, std::make_shared<Model>(cal.spec())};
@@ -163,13 +163,9 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
     bool ok;
   };
   auto program_pose = [&](const Robot& rb, int i) {
-    thread_local std::string err;  // written only on failure; one per batch thread
     ProgramOptions po;
-    R r;
-    int it;
-    double res;
-    r.ok = solve_pose(rb, po, poses[i], qref[i], r.q_deg, it, res, err);
-    return r;
+    const PoseSolution s = solve_pose(rb, po, poses[i], qref[i]);
+    return R{s.q_deg, s.ok()};
   };
   int program_failed = 0;
   out.emplace_back("program_pose_ns", time_ns(n, [&](int i) {

@@ -8,7 +8,10 @@ PYBIND11_MODULE(_core, m) {
   define_effects(m);
   define_model(m);
   define_kinematics(m);
-  define_programs(m);
+  define_compensation(m);
+  define_io(m);
+  define_feed(m);
+  define_bench(m);
   define_identify(m);
   define_fivebar(m);
 }

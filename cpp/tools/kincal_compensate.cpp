@@ -10,6 +10,9 @@
 // output file.
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/compensation/program.hpp"
+#include "kincal/compensation/stream.hpp"
+#include "kincal/io/csv.hpp"
+#include "kincal/io/file.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -6,7 +6,7 @@
 //   KINCAL_FUZZ_SECONDS (default 10), KINCAL_FUZZ_SEED (default 1)
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/identify/identify.hpp"
-#include "kincal/compensation/program.hpp"
+#include "kincal/io/programs.hpp"
 #include "kincal/model/model.hpp"
 
 #include <chrono>
@@ -65,10 +65,10 @@ int main() {
     const auto a = std::chrono::steady_clock::now();
     try {
       switch (sd.kind) {
-        case 0: parse_pose_program(s, "fuzz.csv", false); break;
-        case 1: parse_pose_program(s, "fuzz.gcode", true); break;
-        case 2: parse_joint_program(s, "fuzz.csv", false, 6); break;
-        case 3: parse_joint_program(s, "fuzz.gcode", true, 6); break;
+        case 0: parse_pose_program(s, "fuzz.csv", ProgramFormat::Csv); break;
+        case 1: parse_pose_program(s, "fuzz.gcode", ProgramFormat::Gcode); break;
+        case 2: parse_joint_program(s, "fuzz.csv", ProgramFormat::Csv, 6); break;
+        case 3: parse_joint_program(s, "fuzz.gcode", ProgramFormat::Gcode, 6); break;
         case 4: parse_measurements(s, "fuzz.csv", 6); break;
         case 5: robot_from_json(s, "fuzz.json"); break;
         case 6: fivebar_from_json(s, "fuzz.json"); break;

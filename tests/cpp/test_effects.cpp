@@ -5,6 +5,7 @@
 #include "kincal/effects/effects.hpp"
 #include "kincal/identify/identify.hpp"
 #include "kincal/compensation/program.hpp"
+#include "kincal/compensation/stream.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <cstdio>
@@ -186,14 +187,10 @@ TEST(Effects, CompensationInvertsEveryEffect) {
     const EffectContext c = random_context(rng);
     const Eigen::Isometry3d want = fk_model(*cal, q * kDeg, c);
     ++n;
-    Vec6 out;
-    int it;
-    double r;
-    bool changed;
-    std::string err;
-    if (!solve_pose(robot, opt, iso_to_pose(want), q, c, out, it, r, changed, err)) continue;
+    const PoseSolution s = solve_pose(robot, opt, iso_to_pose(want), q, c);
+    if (!s.ok()) continue;
     ++ok;
-    const Eigen::Isometry3d got = fk_model(*cal, out * kDeg, c);
+    const Eigen::Isometry3d got = fk_model(*cal, s.q_deg * kDeg, c);
     worst_mm = std::max(worst_mm, (got.translation() - want.translation()).norm());
     worst_deg = std::max(worst_deg, rot_deg(got.linear(), want.linear()));
   }
@@ -220,21 +217,17 @@ TEST(Effects, PosesAtBPlusMinus90Compensate) {
     Pose6 p = iso_to_pose(fk(*nom, q * kDeg));
     if (std::abs(p.abc[1]) < 80) continue;
     p.abc[1] = p.abc[1] > 0 ? 90.0 : -90.0;
-    Vec6 out;
-    int it;
-    double r;
-    bool changed;
-    std::string err;
     ProgramOptions opt;
     opt.comp.epsilon = 1e-20;
-    ASSERT_TRUE(solve_pose(robot, opt, p, q, c, out, it, r, changed, err)) << err;
-    const Eigen::Isometry3d got = fk_model(*cal, out * kDeg, c);
+    const PoseSolution s = solve_pose(robot, opt, p, q, c);
+    ASSERT_TRUE(s.ok()) << s.error;
+    const Eigen::Isometry3d got = fk_model(*cal, s.q_deg * kDeg, c);
     EXPECT_LT((got.translation() - p.xyz).norm(), 1e-9);
     EXPECT_LT(rot_deg(got.linear(), abc_to_rotation(p.abc)), 1e-9);
     ProgramOptions paper = opt;
     paper.comp.residual = Residual::Abc;
     // the ABC rates are singular there: the paper's Newton stops at the singularity or wanders off
-    if (!solve_pose(robot, paper, p, q, c, out, it, r, changed, err)) ++paper_stopped;
+    if (!solve_pose(robot, paper, p, q, c).ok()) ++paper_stopped;
     ++done;
   }
   std::printf("20 poses at B = +-90 deg compensated; the ABC residual failed on %d\n", paper_stopped);
@@ -270,18 +263,14 @@ TEST(Effects, BranchChangesToStayWithinLimits) {
     }
     if (!other) continue;
     ++tried;
-    Vec6 out;
-    int it;
-    double r;
-    bool changed;
-    std::string err;
     ProgramOptions opt;
     opt.comp.epsilon = 1e-20;
     opt.corrected_start = false;  // Newton from the nearest branch itself, as "alone"
-    ASSERT_TRUE(solve_pose(robot, opt, p, q, EffectContext(), out, it, r, changed, err)) << err;
-    EXPECT_TRUE(changed);
-    EXPECT_TRUE(cal->within_limits_deg(out));
-    const Eigen::Isometry3d got = fk_compliant(*cal, out * kDeg);
+    const PoseSolution s = solve_pose(robot, opt, p, q, EffectContext());
+    ASSERT_TRUE(s.ok()) << s.error;
+    EXPECT_TRUE(s.branch_changed());
+    EXPECT_TRUE(cal->within_limits_deg(s.q_deg));
+    const Eigen::Isometry3d got = fk_compliant(*cal, s.q_deg * kDeg);
     EXPECT_LT((got.translation() - p.xyz).norm(), 1e-9);
     // with --keep-branch the program stops at that pose instead
   }

@@ -363,8 +363,8 @@ bool dls(const Model& m, const Eigen::Isometry3d& target, Vec6& q, const EffectC
 
 }  // namespace
 
-bool numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref, Vec6& q_out, const CompensationOptions& opt,
-                int starts, const EffectContext& ctx) {
+std::optional<Vec6> numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref, const CompensationOptions& opt,
+                               int starts, const EffectContext& ctx) {
   const Eigen::Isometry3d target = pose_to_iso(desired);
   std::vector<Vec6> seeds = {ref};
   if (m.spec().home_deg.size() == 6) seeds.push_back(Eigen::Map<const Vec6>(m.spec().home_deg.data()));
@@ -377,7 +377,7 @@ bool numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref, Vec6& q_o
     }
     seeds.push_back(s);
   }
-  bool found = false;
+  std::optional<Vec6> found;
   double best = 0;
   for (size_t k = 0; k < seeds.size(); ++k) {
     Vec6 q = seeds[k];
@@ -389,8 +389,7 @@ bool numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref, Vec6& q_o
     const double d = (qq - ref).cwiseAbs().maxCoeff();
     if (!found || d < best) {
       best = d;
-      q_out = qq;
-      found = true;
+      found = qq;
     }
     if (k == 0) break;  // converged from the reference itself: the continuous branch
   }

@@ -1,7 +1,7 @@
 // kincal: hidden-robot kinematics, synthesis, the error matrix and the over-constrained truth.
 #include "kincal/fivebar/fivebar.hpp"
 
-#include "kincal/compensation/program.hpp"
+#include "kincal/io/csv.hpp"
 #include "kincal/model/model.hpp"
 
 #include <nlohmann/json.hpp>

@@ -2,7 +2,7 @@
 // With fivebar_fit.cpp one of the two translation units that include Ceres (builds stay quick).
 #include "kincal/identify/identify.hpp"
 
-#include "kincal/compensation/program.hpp"
+#include "kincal/io/csv.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <ceres/ceres.h>

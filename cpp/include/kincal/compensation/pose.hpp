@@ -14,6 +14,8 @@
 #include "kincal/kinematics/kinematics.hpp"
 #include "kincal/model/model.hpp"
 
+#include <optional>
+
 namespace kincal {
 
 /// The orientation part of Newton's residual F.
@@ -57,15 +59,14 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Vec6
                               const CompensationOptions& opt = {}, const EffectContext& ctx = EffectContext());
 
 /// Each joint moved by whole turns to the position nearest the reference, inside its limits when one is.
-Vec6 wrap_near(const Model& m, const Vec6& q_deg,
-                                      const Vec6& ref_deg);
+Vec6 wrap_near(const Model& m, const Vec6& q_deg, const Vec6& ref_deg);
 
 /// Numerical inverse kinematics for robots without a closed form (e.g. the UR10): damped least
 /// squares (Levenberg-Marquardt) on position and rotation-vector error from the reference, then from
 /// home and from seeded starts inside the joint limits; the converged solution within the limits
-/// nearest the reference (largest joint difference), polished by compensate(). false when none.
-bool numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref_deg,
-                Vec6& q_deg, const CompensationOptions& opt, int starts = 48,
-                const EffectContext& ctx = EffectContext());
+/// nearest the reference (largest joint difference), polished by compensate(). Empty when none.
+std::optional<Vec6> numeric_ik(const Model& m, const Pose6& desired, const Vec6& ref_deg,
+                               const CompensationOptions& opt, int starts = 48,
+                               const EffectContext& ctx = EffectContext());
 
 }  // namespace kincal

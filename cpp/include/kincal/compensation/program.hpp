@@ -1,5 +1,8 @@
-// kincal: CSV and G-code programs, compensation of whole programs, and the streaming corrector.
-// Every reader error is an InputError "file:line: cause"; writers never leave a partial file.
+// kincal: compensation of whole programs (Samak's pipeline, pose after pose): nominal IK nearest the
+// previous pose, the corrected start, Newton on the calibrated model, the joint limits and branch
+// changes, backlash directions of the commanded motion, thermal expansion per pose; and the pose
+// program file in, joint program file out. The file formats are in kincal/io/programs.hpp, the
+// streaming corrector in kincal/compensation/stream.hpp.
 #pragma once
 
 #include "kincal/compensation/pose.hpp"
@@ -12,53 +15,6 @@
 #include <vector>
 
 namespace kincal {
-
-/// A CSV file: header and string cells, with the line number of every row.
-struct CsvTable {
-  std::string source;
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> cells;
-  std::vector<int> line;
-  int find(const std::string& name) const;      ///< column index or -1
-  int require(const std::string& name) const;   ///< column index or InputError
-  double number(size_t row, int col) const;     ///< finite number or InputError naming file:line
-  std::string where(size_t row) const { return source + ":" + std::to_string(line[row]); }
-};
-CsvTable read_csv(const std::string& path);
-CsvTable parse_csv(const std::string& text, const std::string& source);
-
-/// A program of tool poses (CSV x,y,z,a,b,c or G-code X Y Z A B C words, modal).
-struct PoseProgram {
-  std::string source;
-  bool gcode = false;
-  std::vector<Pose6> poses;
-  std::vector<int> pose_line;  ///< line number of every pose
-  std::vector<double> temperature_c;  ///< CSV: the temperature_c column per pose, when present
-  // G-code only: every input line with its pose words cut out, where to put the joint words, and
-  // which pose it carries (-1: passes through unchanged)
-  struct Line {
-    std::string text;
-    size_t insert_at = 0;
-    int pose = -1;
-  };
-  std::vector<Line> lines;
-};
-PoseProgram read_pose_program(const std::string& path);
-PoseProgram parse_pose_program(const std::string& text, const std::string& source, bool gcode);
-
-/// A joint program (CSV q1..qN or G-code A1=.. words, modal), angles in degrees.
-struct JointProgram {
-  std::string source;
-  int dof = 0;
-  std::vector<std::vector<double>> q;
-  std::vector<int> line;
-};
-JointProgram read_joint_program(const std::string& path, int dof);
-JointProgram parse_joint_program(const std::string& text, const std::string& source, bool gcode, int dof);
-
-/// Write text to path atomically (a temporary file beside it, renamed when complete).
-void write_file_atomic(const std::string& path, const std::string& text);
-bool is_csv_path(const std::string& path);
 
 struct ProgramOptions {
   bool compensate = true;      ///< false: the nominal IK program (uncompensated)
@@ -76,18 +32,31 @@ struct ProgramOptions {
   CompensationOptions comp;
 };
 
+/// How solve_pose ended.
+enum class PoseStatus {
+  Solved,         ///< on the branch nearest the reference
+  BranchChanged,  ///< on another branch: the nearest one's solution is outside the limits (error says why)
+  Failed          ///< no solution: error says why
+};
+
+/// The joint angles of one pose, or why there are none.
+struct PoseSolution {
+  PoseStatus status = PoseStatus::Failed;
+  Vec6 q_deg = Vec6::Zero();
+  int iterations = 0;   ///< Newton updates made
+  double residual = 0;  ///< |F| at q_deg
+  std::string error;    ///< Failed: the cause; BranchChanged: why the nearest branch did not do
+  bool ok() const { return status != PoseStatus::Failed; }
+  bool branch_changed() const { return status == PoseStatus::BranchChanged; }
+};
+
 /// One pose: nominal IK nearest ref (a pose a little beyond nominal reach starts from the nearest
 /// configuration), then Newton on the calibrated model with its effects acting in ctx. When the
 /// compensated solution of that branch is outside the joint limits (or does not converge), the
 /// other branches are tried nearest first, and the first whose compensated solution is inside the
-/// limits is taken (branch_changed). Returns false with the cause in err; allocates nothing when
-/// the nearest branch succeeds.
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
-                const EffectContext& ctx, Vec6& q_out, int& iterations, double& residual,
-                bool& branch_changed, std::string& err);
-/// The same without effects context (a model without backlash or thermal expansion).
-bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
-                Vec6& q_out, int& iterations, double& residual, std::string& err);
+/// limits is taken (BranchChanged). Allocates nothing when the nearest branch succeeds.
+PoseSolution solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
+                        const EffectContext& ctx = EffectContext());
 
 struct ProgramResult {
   std::vector<Vec6> q_deg;
@@ -105,8 +74,35 @@ constexpr double kStillDeg = 1e-7;
 /// The direction of motion of every joint into every pose of a joint program: the sign of its
 /// change from the previous pose, held while it stands still; the first pose's from initial (+-1
 /// per joint; empty: the direction of each joint's first motion, +1 for a joint that never moves).
-std::vector<Vec6> motion_directions(const std::vector<Vec6>& q_deg,
-                                                           const std::vector<double>& initial);
+std::vector<Vec6> motion_directions(const std::vector<Vec6>& q_deg, const std::vector<double>& initial);
+
+/// Each joint's direction into the first pose from ProgramOptions::initial_direction (one sign for
+/// every joint, or one for all); InputError when it is neither or a sign is not +-1.
+Vec6 initial_directions(const std::vector<double>& v);
+
+/// A program compensated pose after pose, in order (compensate_poses and StreamCompensator): the
+/// reference of the next pose (the last result; the robot's home first) and the effect context
+/// (backlash: the joints' directions of motion into the last pose; the temperature).
+struct ProgramCursor {
+  /// At the robot's home, the directions dir0 into the first pose when the model has backlash.
+  ProgramCursor(const Robot& robot, const ProgramOptions& opt, const Vec6& dir0);
+  Vec6 prev;
+  EffectContext ctx;
+  bool first = true;
+};
+
+/// The next pose of a program (ctx.temperature_c set by the caller): solved with the directions the
+/// joints have (held from the previous pose), then, with backlash, again with the directions of its
+/// own motion when that motion turns a joint around. On success the cursor moves to the pose
+/// (ctx.dir: the directions into it). Allocates nothing when the nearest branch succeeds.
+PoseSolution next_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, ProgramCursor& cursor);
+
+/// The warning (or, with keep_branch, the error) of a branch change: "branch changed: ..., cause".
+std::string branch_change_message(const std::string& cause);
+
+/// The error of a model with thermal expansion given no temperature.
+inline constexpr const char* kNeedsTemperature =
+    "the model has thermal expansion: give the temperature (--temperature C, or a temperature_c column)";
 
 /// IK + compensation of every pose in order, keeping the branch continuous (each pose starts from
 /// the IK solution nearest the previous result; the first from the robot's home). Backlash: every
@@ -121,36 +117,5 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
 /// file's extension). Nothing is written when any pose fails.
 ProgramResult compensate_program_file(const Robot& robot, const std::string& in_path, const std::string& out_path,
                                       const ProgramOptions& opt);
-
-/// Format a joint program as text: CSV (q1..q6) or G-code (the input's lines with A1=.. words).
-std::string format_joint_program(const PoseProgram& in, const ProgramResult& res, bool csv);
-
-/// The controller-PC corrector: one pose line in, one joint line out, no allocation per line.
-class StreamCompensator {
- public:
-  StreamCompensator(Robot robot, ProgramOptions opt);
-  /// Processes one input line (without its newline); writes the output line (without newline) to
-  /// out and returns its length. Throws InputError "stdin:N: cause" on bad input.
-  size_t process(const char* line, size_t len, char* out, size_t cap);
-  /// A warning about the last line processed (a branch change), or empty.
-  const std::string& warning() const { return warning_; }
-
- private:
-  Robot robot_;
-  ProgramOptions opt_;
-  int line_no_ = 0;
-  bool first_ = true;
-  Vec6 prev_;
-  EffectContext ctx_;
-  int csv_temperature_col_ = -1;
-  std::string warning_;
-  // CSV state
-  bool csv_header_seen_ = false;
-  int csv_cols_[6] = {0, 1, 2, 3, 4, 5};
-  // G-code modal state
-  Pose6 modal_;
-  bool modal_set_[6] = {false, false, false, false, false, false};
-  Vec6 solve(const Pose6& p, double temperature_c);
-};
 
 }  // namespace kincal

@@ -1,16 +1,21 @@
+// The streaming corrector: equal to the file compensation line for line, and no allocation per line
+// (with every effect too).
 #include "kincal/compensation/program.hpp"
+#include "kincal/compensation/stream.hpp"
+
+#include "test_files.hpp"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
-#include <functional>
-#include <cstdio>
 #include <fstream>
 #include <new>
 #include <sstream>
 
 using namespace kincal;
+using test::kr500_calibrated;
+using test::tmp;
 
 // Counts heap allocations (for every test of this program), to show real-time loops make none.
 std::atomic<long> g_allocs{0};
@@ -21,97 +26,6 @@ void* operator new(std::size_t n) {
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-
-namespace {
-
-Robot kr500_calibrated() {
-  auto nom = std::make_shared<Model>(kr500_spec());
-  return Robot{nom, std::make_shared<Model>(perturbed_spec(kr500_spec(), 9, 1.0, 0.05, 0.003))};
-}
-
-std::string tmp(const std::string& name, const std::string& text) {
-  const std::string p = ::testing::TempDir() + name;
-  std::ofstream(p) << text;
-  return p;
-}
-
-bool exists(const std::string& p) { return std::ifstream(p).good(); }
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-const char* kGcode =
-    "; tape course 1\n"
-    "N10 G90 (absolute)\n"
-    "N20 G1 X2000 Y-100 Z500 A180 B0 C180 F3000 ; first pose\n"
-    "N30 G1 Y-95\n"
-    "N40 X2005 Y-90 M7\n"
-    "N50 M30\n";
-
-}  // namespace
-
-TEST(Io, GcodeWordsAreReplacedAndEverythingElsePassesThrough) {
-  const Robot r = kr500_calibrated();
-  const std::string in = tmp("p.gcode", kGcode), out = ::testing::TempDir() + "q.gcode";
-  const ProgramResult res = compensate_program_file(r, in, out, ProgramOptions{});
-  ASSERT_EQ(res.q_deg.size(), 3u);
-  std::ifstream f(out);
-  std::vector<std::string> lines;
-  for (std::string l; std::getline(f, l);) lines.push_back(l);
-  ASSERT_EQ(lines.size(), 6u);
-  EXPECT_EQ(lines[0], "; tape course 1");
-  EXPECT_EQ(lines[1], "N10 G90 (absolute)");
-  EXPECT_EQ(lines[2].rfind("N20 G1 A1=", 0), 0u) << lines[2];
-  EXPECT_NE(lines[2].find(" A6="), std::string::npos);
-  EXPECT_NE(lines[2].find(" F3000 ; first pose"), std::string::npos) << lines[2];
-  EXPECT_EQ(lines[2].find('X'), std::string::npos);
-  EXPECT_NE(lines[4].find(" M7"), std::string::npos);
-  EXPECT_EQ(lines[5], "N50 M30");
-  // modal words: the second pose kept X, Z, A, B, C of the first
-  const PoseProgram p = read_pose_program(in);
-  EXPECT_EQ(p.poses[1].xyz, Vec3(2000, -95, 500));
-  EXPECT_EQ(p.poses[2].xyz, Vec3(2005, -90, 500));
-  // the joint program reads back to the same angles (10 decimals)
-  const JointProgram jp = read_joint_program(out, 6);
-  ASSERT_EQ(jp.q.size(), 3u);
-  for (int j = 0; j < 6; ++j) EXPECT_NEAR(jp.q[1][j], res.q_deg[1][j], 1e-10);
-}
-
-TEST(Io, BadInputNamesFileLineAndCauseAndWritesNothing) {
-  const Robot r = kr500_calibrated();
-  const std::string out = ::testing::TempDir() + "never.csv";
-  std::remove(out.c_str());
-  struct Case {
-    const char* name;
-    const char* text;
-    const char* expect;
-  } cases[] = {
-      {"b1.gcode", "G1 X1.2.3 Y0 Z0 A0 B0 C0\n", "b1.gcode:1: broken number in word X"},
-      {"b2.gcode", "G1 X2000 Y0 Z500\n", "b2.gcode:1: pose word(s) A B C not set yet"},
-      {"b3.gcode", "G1 X2000 Y0 Z500 A180 B0 C180\nG1 Y-\n", "b3.gcode:2: broken number in word Y"},
-      {"b4.gcode", "G1 A1=10 A2=0\n", "b4.gcode:1: joint word A1= in a pose program"},
-      {"b5.csv", "x,y,z,a,b,c\n2000,0,500,180,0,180\n2000,abc,500,180,0,180\n", "b5.csv:3: column 'y': 'abc' is not a number"},
-      {"b6.csv", "x,y,z,a,b,c\n2000,nan,500,180,0,180\n", "b6.csv:2: column 'y': 'nan' is not a finite number"},
-      {"b7.csv", "x,y,z,a,b\n2000,0,500,180,0\n", "b7.csv:1: missing column 'c'"},
-      {"b8.csv", "x,y,z,a,b,c\n2000,0,500,180,0\n", "b8.csv:2: 5 fields, the header has 6"},
-      {"b9.csv", "x,y,z,a,b,c\n2000,0,500,180,0,180\n9000,0,500,180,0,180\n", "b9.csv:3: pose out of reach"},
-      {"b10.csv", "", "b10.csv: empty file"},
-  };
-  for (const Case& c : cases) {
-    const std::string in = tmp(c.name, c.text);
-    const std::string e = error_of([&] { compensate_program_file(r, in, out, ProgramOptions{}); });
-    EXPECT_NE(e.find(c.expect), std::string::npos) << c.name << ": " << e;
-    EXPECT_FALSE(exists(out)) << c.name;
-  }
-  EXPECT_NE(error_of([&] { read_pose_program(::testing::TempDir() + "missing.csv"); }).find("cannot open"),
-            std::string::npos);
-}
 
 TEST(Io, StreamEqualsFileAndAllocatesNothingPerLine) {
   const Robot r = kr500_calibrated();
@@ -204,4 +118,25 @@ TEST(Io, StreamWithEveryEffectAllocatesNothingPerLine) {
   int turns = 0;
   for (size_t i = 1; i < res.dir.size(); ++i) turns += res.dir[i] != res.dir[i - 1];
   EXPECT_GE(turns, 1);  // the program does reverse its axes
+}
+
+// solve_pose, the per-pose path of programs and of the stream, allocates nothing when the branch
+// nearest the reference gives the answer.
+TEST(Io, SolvePoseAllocatesNothingOnTheNearestBranch) {
+  const Robot r = kr500_calibrated();
+  Vec6 q;
+  q << 10, -70, 95, 20, 40, -10;
+  std::vector<Pose6> poses;
+  for (int i = 0; i < 50; ++i) {
+    Vec6 qi = q;
+    qi[0] += 0.5 * i, qi[2] -= 0.2 * i;
+    poses.push_back(iso_to_pose(fk_compliant(*r.calibrated, VecQ(qi * kDeg))));
+  }
+  const ProgramOptions opt;
+  ASSERT_EQ(solve_pose(r, opt, poses[0], q).status, PoseStatus::Solved);
+  int solved = 0;
+  const long before = g_allocs.load();
+  for (const Pose6& p : poses) solved += solve_pose(r, opt, p, q).status == PoseStatus::Solved;
+  EXPECT_EQ(g_allocs.load() - before, 0);
+  EXPECT_EQ(solved, 50);
 }

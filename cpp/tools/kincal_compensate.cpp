@@ -10,6 +10,7 @@
 // output file.
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/compensation/program.hpp"
+#include "kincal/io/model_json.hpp"
 
 #include <CLI/CLI.hpp>
 

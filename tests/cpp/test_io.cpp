@@ -1,4 +1,5 @@
 #include "kincal/compensation/program.hpp"
+#include "kincal/model/robots.hpp"
 
 #include <gtest/gtest.h>
 

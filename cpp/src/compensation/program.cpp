@@ -300,7 +300,7 @@ bool solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose
   }
   Pose6 pose = pose_in;
   if (opt.instrument_frame) pose = iso_to_pose(cal.base_in_instrument().inverse() * pose_to_iso(pose_in));
-  if (nom.ik_structure().spherical_wrist_parallel_23) {
+  if (robot.ik().structure().spherical_wrist_parallel_23) {
     const Eigen::Isometry3d target = pose_to_iso(pose);
     // the branch nearest the reference first; all branches when it is out of limits
     IkSolutions s = ik_all(nom, target, ref.data(), false, true);

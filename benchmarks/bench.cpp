@@ -6,6 +6,7 @@
 #include "kincal/compensation/program.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 #include "kincal/model/model.hpp"
+#include "kincal/model/robots.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_nr.hpp>
@@ -104,16 +105,17 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
   // IK, all solutions
   std::vector<Eigen::Isometry3d> targets;
   for (const auto& p : poses) targets.push_back(pose_to_iso(p));
+  const IkSolver ik(nom);  // built once, as a Robot holds it
   out.emplace_back("ik_all_ns", time_ns(n, [&](int i) {
-                     const IkSolutions s = ik_all(nom, targets[i], qref[i].data());
+                     const IkSolutions s = ik.solve(targets[i], IkOptions(qref[i]));
                      g_sink = g_sink + s.count;
                    }));
   // Compensation (the and the paper's): Newton on the calibrated model from the nominal IK
   // solution nearest the reference, the start KDL's NR gets below
   std::vector<Vec6> start(n);
   for (int i = 0; i < n; ++i) {
-    const IkSolutions s = ik_all(nom, targets[i], qref[i].data());
-    const int k = ik_nearest(nom, s, qref[i].data());
+    const IkSolutions s = ik.solve(targets[i], IkOptions(qref[i]));
+    const int k = s.nearest(qref[i].data());
     start[i] = k >= 0 ? s.sol[k].q_deg : qref[i];
   }
   CompensationOptions an, fd;

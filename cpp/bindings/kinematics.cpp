@@ -14,13 +14,15 @@ using namespace kincal;
 namespace {
 
 
-const Model& pick(const Robot& r, bool calibrated) { return calibrated ? *r.calibrated : *r.nominal; }
-
-void check_q(const Model& m, const RowMatrix& q) {
+// The calibrated or nominal model of r, once the joint angles q (rows of dof columns) are checked
+// against it.
+const Model& checked_model(const Robot& r, bool calibrated, const RowMatrix& q) {
+  const Model& m = calibrated ? *r.calibrated : *r.nominal;
   if (q.cols() != m.dof())
     throw InputError("joint angles have " + std::to_string(q.cols()) + " columns, the robot has " +
                      std::to_string(m.dof()) + " joints");
   if (!q.allFinite()) throw InputError("joint angles contain NaN or infinite values");
+  return m;
 }
 
 // The effects' context of row i: its directions (when given) and temperature (when given).
@@ -53,8 +55,7 @@ void define_kinematics(py::module_& m) {
       "fk",
       [](const Robot& r, const RowMatrix& q_deg, bool calibrated, bool instrument, const std::optional<RowMatrix>& dir,
          const std::optional<Eigen::VectorXd>& temperature_c) {
-        const Model& md = pick(r, calibrated);
-        check_q(md, q_deg);
+        const Model& md = checked_model(r, calibrated, q_deg);
         check_context_arrays(md, q_deg, dir, temperature_c);
         RowMatrix out(q_deg.rows(), 6);
         for (Eigen::Index i = 0; i < q_deg.rows(); ++i) {
@@ -87,8 +88,7 @@ void define_kinematics(py::module_& m) {
   m.def(
       "fk_matrix",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
-        const Model& md = pick(r, calibrated);
-        check_q(md, q_deg.transpose());
+        const Model& md = checked_model(r, calibrated, q_deg.transpose());
         const VecQ q = q_deg * kDeg;
         return Eigen::Matrix4d(fk_compliant(md, q).matrix());
       },
@@ -97,8 +97,7 @@ void define_kinematics(py::module_& m) {
       "jacobian",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated, const std::optional<Eigen::VectorXd>& dir,
          std::optional<double> temperature_c) {
-        const Model& md = pick(r, calibrated);
-        check_q(md, q_deg.transpose());
+        const Model& md = checked_model(r, calibrated, q_deg.transpose());
         EffectContext c;
         if (dir) c.dir = *dir;
         if (temperature_c) c.temperature_c = *temperature_c;
@@ -114,8 +113,7 @@ void define_kinematics(py::module_& m) {
   m.def(
       "gravity_torque",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
-        const Model& md = pick(r, calibrated);
-        check_q(md, q_deg.transpose());
+        const Model& md = checked_model(r, calibrated, q_deg.transpose());
         VecQ tau;
         MatQ d;
         gravity_torque(md, VecQ(q_deg * kDeg), tau, &d);
@@ -126,8 +124,7 @@ void define_kinematics(py::module_& m) {
   m.def(
       "kdl_fk",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
-        const Model& md = pick(r, calibrated);
-        check_q(md, q_deg.transpose());
+        const Model& md = checked_model(r, calibrated, q_deg.transpose());
         KDL::ChainFkSolverPos_recursive s(md.kdl_chain());
         KDL::JntArray q(md.dof());
         for (int i = 0; i < md.dof(); ++i) q(i) = q_deg[i] * kDeg;
@@ -144,14 +141,14 @@ void define_kinematics(py::module_& m) {
   m.def(
       "ik_all",
       [](const Robot& r, const Vec6& pose, py::object ref) {
-        const Model& md = *r.nominal;
-        if (!md.ik_structure().spherical_wrist_parallel_23)
-          throw InputError("robot '" + md.spec().name + "' has no closed-form IK: " + md.ik_structure().reason);
+        const IkSolver& ik = r.ik();
+        if (!ik.structure().spherical_wrist_parallel_23)
+          throw InputError("robot '" + r.nominal->spec().name + "' has no closed-form IK: " + ik.structure().reason);
         if (!pose.allFinite()) throw InputError("pose contains NaN or infinite values");
         std::vector<double> rv;
         if (!ref.is_none()) rv = ref.cast<std::vector<double>>();
-        const IkSolutions s =
-            ik_all(md, pose_to_iso(Pose6{pose.head<3>(), pose.tail<3>()}), rv.size() == 6 ? rv.data() : nullptr);
+        const IkSolutions s = ik.solve(pose_to_iso(Pose6{pose.head<3>(), pose.tail<3>()}),
+                                       IkOptions(rv.size() == 6 ? rv.data() : nullptr));
         py::list out;
         for (int i = 0; i < s.count; ++i) {
           py::dict d;

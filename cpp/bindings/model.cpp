@@ -1,7 +1,10 @@
 #include "common.hpp"
 
 #include "kincal/identify/identify.hpp"
+#include "kincal/ik/ik.hpp"
+#include "kincal/io/model_json.hpp"
 #include "kincal/model/model.hpp"
+#include "kincal/model/robots.hpp"
 
 #include <array>
 #include <optional>
@@ -19,8 +22,8 @@ void define_model(py::module_& m) {
       .def_property_readonly("compliance_count", [](const Robot& r) { return r.nominal->compliance_count(); })
       .def_property_readonly("geometric_parameter_count", [](const Robot& r) { return 4 * r.nominal->dof() + 6; })
       .def_property_readonly("closed_form_ik",
-                             [](const Robot& r) { return r.nominal->ik_structure().spherical_wrist_parallel_23; })
-      .def_property_readonly("ik_reason", [](const Robot& r) { return r.nominal->ik_structure().reason; })
+                             [](const Robot& r) { return r.ik().structure().spherical_wrist_parallel_23; })
+      .def_property_readonly("ik_reason", [](const Robot& r) { return r.ik().structure().reason; })
       .def_property_readonly("home_deg", [](const Robot& r) { return r.nominal->spec().home_deg; })
       .def_property_readonly("limits_deg",
                              [](const Robot& r) {

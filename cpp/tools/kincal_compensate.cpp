@@ -13,6 +13,7 @@
 #include "kincal/compensation/stream.hpp"
 #include "kincal/io/csv.hpp"
 #include "kincal/io/file.hpp"
+#include "kincal/io/model_json.hpp"
 
 #include <CLI/CLI.hpp>
 

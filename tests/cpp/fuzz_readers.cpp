@@ -7,7 +7,7 @@
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/identify/identify.hpp"
 #include "kincal/io/programs.hpp"
-#include "kincal/model/model.hpp"
+#include "kincal/io/model_json.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -3,6 +3,8 @@
 // directions from the commanded motion, temperature), B = +-90 deg poses and branch changes.
 #include "kincal/compensation/pose.hpp"
 #include "kincal/effects/effects.hpp"
+#include "kincal/ik/ik.hpp"
+#include "kincal/io/model_json.hpp"
 #include "kincal/identify/identify.hpp"
 #include "kincal/compensation/program.hpp"
 #include "kincal/compensation/stream.hpp"
@@ -255,7 +257,7 @@ TEST(Effects, BranchChangesToStayWithinLimits) {
     // the nearest branch alone leaves the limits; some other branch does not
     const CompensationResult alone = compensate(*cal, p, q, co);
     if (alone.status != CompStatus::Converged || cal->within_limits_deg(alone.q_deg)) continue;
-    const IkSolutions all = ik_all(*nom, pose_to_iso(p), q.data());
+    const IkSolutions all = robot.ik().solve(pose_to_iso(p), IkOptions(q));
     bool other = false;
     for (int k = 0; k < all.count; ++k) {
       const CompensationResult r = compensate(*cal, p, all.sol[k].q_deg, co);

@@ -1,5 +1,6 @@
 #include "kincal/ik/ik.hpp"
 #include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/robots.hpp"
 
 #include "test_util.hpp"
 
@@ -10,9 +11,9 @@ using namespace kincal;
 namespace {
 
 // Checks that every solution reproduces the pose and that the generating configuration is among them.
-void check_round_trip(const Model& m, const Vec6& q, double& worst_p, double& worst_r) {
+void check_round_trip(const Model& m, const IkSolver& ik, const Vec6& q, double& worst_p, double& worst_r) {
   const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
-  const IkSolutions s = ik_all(m, t, q.data());
+  const IkSolutions s = ik.solve(t, IkOptions(q));
   ASSERT_EQ(s.status, IkStatus::Ok);
   ASSERT_GE(s.count, 1);
   ASSERT_LE(s.count, 8);
@@ -70,9 +71,10 @@ ModelSpec random_robot(std::mt19937_64& rng, bool orthogonal_wrist = false, bool
 
 TEST(Ik, Kr500AllSolutionsRoundTrip) {
   const Model m(kr500_spec());
+  const IkSolver ik(m);
   std::mt19937_64 rng(21);
   double wp = 0, wr = 0;
-  for (int i = 0, n = test::count(5000); i < n; ++i) check_round_trip(m, test::random_q(m, rng), wp, wr);
+  for (int i = 0, n = test::count(5000); i < n; ++i) check_round_trip(m, ik, test::random_q(m, rng), wp, wr);
   EXPECT_LT(wp, 1e-9);  // mm
   EXPECT_LT(wr, 1e-9);  // rad
 }
@@ -84,14 +86,15 @@ TEST(Ik, AnyOffsetsRoundTrip) {
   for (int r = 0; r < 200; ++r) {
     const bool orthogonal = r % 2 == 1;  // half with the flip-symmetric wrist, half with any wrist
     const Model m(random_robot(rng, orthogonal, r % 4 >= 2));
-    ASSERT_TRUE(m.ik_structure().spherical_wrist_parallel_23) << m.ik_structure().reason;
-    ASSERT_EQ(m.ik_structure().wrist_flip, orthogonal);
-    inexact23 += m.ik_structure().k.sigma23 == 0;
+    const IkSolver ik(m);
+    ASSERT_TRUE(ik.structure().spherical_wrist_parallel_23) << ik.structure().reason;
+    ASSERT_EQ(ik.structure().wrist_flip, orthogonal);
+    inexact23 += ik.constants().sigma23 == 0;
     ++robots;
     for (int i = 0; i < 50; ++i) {
       Vec6 q;
       for (int j = 0; j < 6; ++j) q[j] = std::uniform_real_distribution<double>(-180, 180)(rng);
-      check_round_trip(m, q, wp, wr);
+      check_round_trip(m, ik, q, wp, wr);
     }
   }
   EXPECT_EQ(robots, 200);
@@ -103,16 +106,17 @@ TEST(Ik, AnyOffsetsRoundTrip) {
 
 TEST(Ik, OutOfReachAndSingularPosesGiveClearAnswers) {
   const Model m(kr500_spec());
+  const IkSolver ik(m);
   Eigen::Isometry3d far = Eigen::Isometry3d::Identity();
   far.translation() = Vec3(9000, 0, 1000);
-  const IkSolutions s = ik_all(m, far);
+  const IkSolutions s = ik.solve(far);
   EXPECT_EQ(s.status, IkStatus::OutOfReach);
   EXPECT_EQ(s.count, 0);
   // the wrist singularity q5 = 0: solutions exist, are finite, reproduce the pose and are flagged
   Vec6 q;
   q << 10, -80, 100, 30, 0, -20;
   const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
-  const IkSolutions w = ik_all(m, t, q.data());
+  const IkSolutions w = ik.solve(t, IkOptions(q));
   ASSERT_EQ(w.status, IkStatus::Ok);
   int flagged = 0;
   for (int i = 0; i < w.count; ++i) {
@@ -129,8 +133,8 @@ TEST(Ik, NearestSolutionFollowsTheReference) {
   const Model m(kr500_spec());
   Vec6 q;
   q << 20, -60, 80, 40, 50, -30;
-  const IkSolutions s = ik_all(m, fk(m, VecQ(q * kDeg)), q.data());
-  const int k = ik_nearest(m, s, q.data());
+  const IkSolutions s = IkSolver(m).solve(fk(m, VecQ(q * kDeg)), IkOptions(q));
+  const int k = s.nearest(q.data());
   ASSERT_GE(k, 0);
   EXPECT_LT((s.sol[k].q_deg - q).norm(), 1e-9);
 }

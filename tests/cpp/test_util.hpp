@@ -1,8 +1,10 @@
 // Shared helpers of the C++ tests: seeded random configurations, the test count CI can raise.
 #pragma once
 
+#include "kincal/ik/ik.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 #include "kincal/model/model.hpp"
+#include "kincal/model/robots.hpp"
 
 #include <cstdlib>
 #include <random>
@@ -35,7 +37,7 @@ inline double singularity_distance_deg(const Model& m, const Vec6& q) {
   const double elbow = std::atan2(55.0, 1025.0) / kDeg;  // q3 where axes 2, 3 and the wrist centre line up
   VecQ qq = q * kDeg;
   qq[3] = qq[4] = qq[5] = 0;
-  const Vec3 wc = fk(m, qq) * (m.tool().inverse() * m.ik_structure().wrist_center);
+  const Vec3 wc = fk(m, qq) * (m.tool().inverse() * IkSolver(m).structure().wrist_center);
   const double shoulder = std::asin(std::min(1.0, std::hypot(wc[0], wc[1]) / 1300.0)) / kDeg;
   return std::min({std::abs(q[4]), std::abs(q[2] - elbow), shoulder});
 }

@@ -156,7 +156,7 @@ PoseSolution solve_pose(const Robot& robot, const ProgramOptions& opt, const Pos
   if (robot.nominal->dof() != 6) return failed("programs need a 6-joint robot");
   Pose6 pose = pose_in;
   if (opt.instrument_frame) pose = iso_to_pose(robot.calibrated->base_in_instrument().inverse() * pose_to_iso(pose_in));
-  if (robot.nominal->ik_structure().spherical_wrist_parallel_23) return solve_closed_form(robot, opt, pose, ref, ctx);
+  if (robot.ik().structure().spherical_wrist_parallel_23) return solve_closed_form(robot, opt, pose, ref, ctx);
   return solve_numeric(robot, opt, pose, ref, ctx);
 }
 

@@ -13,10 +13,13 @@ namespace kincal {
 
 namespace {
 
-// Subproblems at tangency: values a hair outside [-1, 1] are one solution, beyond is none, unless
-// the nearest configuration is asked for.
-thread_local bool t_clamp = false;   // ik_all(..., nearest_if_unreachable) is running
-thread_local bool t_clamped = false;  // a subproblem was clamped to tangency
+// The per-call state of the subproblems: values a hair outside [-1, 1] are tangency (one
+// solution), beyond is none, unless the nearest configuration is asked for (clamp); clamped records
+// that a subproblem of the current branch was clamped to tangency.
+struct Tangency {
+  bool clamp = false;    // solve(..., OutOfReach::Nearest) is running
+  bool clamped = false;  // a subproblem was clamped to tangency
+};
 
 // Near the wrist singularity SP2 loses half the digits (q5 comes from a square root of a
 // difference): two Gauss-Newton steps with a pseudo-inverse restore the orientation to round-off.
@@ -78,13 +81,13 @@ inline Vec3 rotv(const Vec3& k, double c, double s, const Vec3& v) {
 
 // the cosine of a subproblem's angle: a hair outside [-1, 1] is tangency (one solution), beyond is
 // none (false) unless the nearest configuration is asked for
-inline bool cos_of(double x, double& out, bool& tangent) {
+inline bool cos_of(double x, double& out, bool& tangent, Tangency& tg) {
   constexpr double tol = 1e-10;
   tangent = false;
   if (!std::isfinite(x)) return false;
   if (x > 1 + tol || x < -1 - tol) {
-    if (!t_clamp) return false;
-    t_clamped = true;
+    if (!tg.clamp) return false;
+    tg.clamped = true;
   }
   if (x >= 1 - 1e-14 || x <= -1 + 1e-14) {
     tangent = true;
@@ -102,14 +105,14 @@ inline Angle sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
 }
 
 // SP2 of the wrist: (theta1, theta2) with rot(k1, theta1) rot(k2, theta2) u = v for the model's
-// k1 = w4, k2 = w5, u = w6 (IkStructure::Constants), v given. Returns the count (0, 1 or 2); with
+// k1 = w4, k2 = w5, u = w6 (IkSolver::Constants), v given. Returns the count (0, 1 or 2); with
 // first_only, only the first of two solutions is written (the caller knows the second).
 // c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|; c = a k1 + b k2 +- g n.
 // Both subproblem-1 solutions are linear in +-g: theta2 takes u to c about k2, theta1 takes c to v
 // about k1; with up, vp the parts of u, v normal to k2, k1 and m = k1 x n, the projections reduce to
 // dot products of v with k1, k2, n and m (the terms with a vector twice in a triple product vanish).
-int sub2_wrist(const IkStructure::Constants& k, const Vec3& k1, const Vec3& k2, const Vec3& v, Angle t1[2],
-               Angle t2[2], bool first_only) {
+int sub2_wrist(const IkSolver::Constants& k, const Vec3& k1, const Vec3& k2, const Vec3& v, Angle t1[2],
+               Angle t2[2], bool first_only, Tangency& tg) {
   const double k1v = k1.dot(v), k2v = k2.dot(v), nv = k.n.dot(v), mv = k.m.dot(v);
   const double alpha = (k.k12 * k.k2u - k1v) * k.inv_den;
   const double beta = (k.k12 * k1v - k.k2u) * k.inv_den;
@@ -117,8 +120,8 @@ int sub2_wrist(const IkStructure::Constants& k, const Vec3& k1, const Vec3& k2, 
   const double scale = std::max(1.0, k.u2);
   if (!std::isfinite(g2)) return 0;
   if (g2 < -1e-10 * scale) {
-    if (!t_clamp) return 0;
-    t_clamped = true;
+    if (!tg.clamp) return 0;
+    tg.clamped = true;
   }
   const double g = g2 > 0 ? std::sqrt(g2) : 0.0;
   const int count = g > 0 ? 2 : 1;
@@ -132,22 +135,22 @@ int sub2_wrist(const IkStructure::Constants& k, const Vec3& k1, const Vec3& k2, 
   return count;
 }
 
-// SP3 of the elbow: q3 with |rot(w3, q3)(pw - p3) - (p2 - p3)| = d (IkStructure::Constants).
+// SP3 of the elbow: q3 with |rot(w3, q3)(pw - p3) - (p2 - p3)| = d (IkSolver::Constants).
 // Returns the count (0, 1 or 2).
-int sub3_elbow(const IkStructure::Constants& k, double d, Angle t[2]) {
+int sub3_elbow(const IkSolver::Constants& k, double d, Angle t[2], Tangency& tg) {
   const double dp2 = d * d - k.elbow_dz * k.elbow_dz;
   const double nu = k.elbow_nu, nv = k.elbow_nv;
   if (nu < 1e-12 || nv < 1e-12) return 0;
   double ca;
   bool tangent;
-  if (!cos_of((nu * nu + nv * nv - dp2) * k.elbow_inv_2nunv, ca, tangent)) return 0;
+  if (!cos_of((nu * nu + nv * nv - dp2) * k.elbow_inv_2nunv, ca, tangent, tg)) return 0;
   plus_minus(Angle{k.elbow_q, k.elbow_c, k.elbow_s}, ca, t[1], t[0]);
   if (tangent) return 1;
   return 2;
 }
 
 // SP4: theta with h . rot(k, theta) u = d. Returns the count (0, 1 or 2).
-int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2]) {
+int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2], Tangency& tg) {
   // h . (k (k.u) + cos t (u - k (k.u)) + sin t (k x u)) = d
   const double A = h.dot(u - k * k.dot(u));
   const double B = h.dot(k.cross(u));
@@ -158,18 +161,17 @@ int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2]) {
   const Angle phi{fastmath::atan2(B, A), A * inv_r, B * inv_r};
   double ca;
   bool tangent;
-  if (!cos_of(C * inv_r, ca, tangent)) return 0;
+  if (!cos_of(C * inv_r, ca, tangent, tg)) return 0;
   plus_minus(phi, ca, t[0], t[1]);
   if (tangent) return 1;
   return 2;
 }
 
-}  // namespace
+bool parallel(const Vec3& a, const Vec3& b, double tol) { return a.cross(b).norm() < tol; }
 
-void fill_ik_constants(IkStructure& st, const Vec3* w, const Vec3* p) {
-  const Vec3& c = st.wrist_center;
-  st.wrist_flip = std::abs(w[3].dot(w[4])) < 1e-12 && std::abs(w[4].dot(w[5])) < 1e-12 && w[3].cross(w[5]).norm() < 1e-12;
-  IkStructure::Constants& k = st.k;
+// The closed form's constants for a model of the class, from its unit axes w, axis points p and
+// wrist centre c.
+void fill_constants(IkSolver::Constants& k, const Vec3* w, const Vec3* p, const Vec3& c) {
   k.v6 = w[5].unitOrthogonal();
   k.sigma23 = w[2] == w[1] ? 1.0 : (w[2] == -w[1] ? -1.0 : 0.0);
   {  // elbow (sub3_elbow): |rot(w3, q3) u - v| = d, u = pw - p3, v = p2 - p3; up, vp their parts normal to w3
@@ -205,9 +207,54 @@ void fill_ik_constants(IkStructure& st, const Vec3* w, const Vec3* p) {
   }
 }
 
-IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg,
-                   bool nearest_if_unreachable, bool nearest_branch) {
-  const bool greedy = nearest_branch && ref_deg != nullptr;
+}  // namespace
+
+IkSolver::IkSolver(const Model& m) {
+  const int n = m.dof();
+  w_.fill(Vec3::Zero());
+  p_.fill(Vec3::Zero());
+  for (int j = 0; j < std::min(n, 6); ++j) {
+    w_[j] = m.axis(j);
+    p_[j] = m.point(j);
+    lo_[j] = m.spec().joints[j].lower_deg - 1e-9;
+    hi_[j] = m.spec().joints[j].upper_deg + 1e-9;
+  }
+  tool_ = m.tool();
+  // The structure: 6 joints, axes 2 and 3 parallel, axes 4, 5, 6 meeting in one point.
+  if (n != 6) {
+    st_.reason = "closed-form IK needs 6 joints";
+  } else if (!parallel(w_[1], w_[2], 1e-9)) {
+    st_.reason = "axes 2 and 3 are not parallel";
+  } else if (parallel(w_[0], w_[1], 1e-6)) {
+    st_.reason = "axes 1 and 2 are parallel";
+  } else if (parallel(w_[2], w_[3], 1e-6) || parallel(w_[3], w_[4], 1e-6) || parallel(w_[4], w_[5], 1e-6)) {
+    st_.reason = "consecutive wrist axes are parallel";
+  } else {
+    Mat3 a = Mat3::Zero();
+    Vec3 b = Vec3::Zero();
+    for (int j = 3; j < 6; ++j) {
+      const Mat3 pr = Mat3::Identity() - w_[j] * w_[j].transpose();
+      a += pr;
+      b += pr * p_[j];
+    }
+    const Vec3 c = a.ldlt().solve(b);
+    double dmax = 0;
+    for (int j = 3; j < 6; ++j) dmax = std::max(dmax, ((Mat3::Identity() - w_[j] * w_[j].transpose()) * (c - p_[j])).norm());
+    if (dmax > 1e-6) {
+      st_.reason = "axes 4, 5 and 6 do not meet in one point (off by " + std::to_string(dmax) + " mm)";
+    } else {
+      st_.spherical_wrist_parallel_23 = true;
+      st_.wrist_center = c;
+      st_.wrist_flip = std::abs(w_[3].dot(w_[4])) < 1e-12 && std::abs(w_[4].dot(w_[5])) < 1e-12 &&
+                       w_[3].cross(w_[5]).norm() < 1e-12;
+      fill_constants(k_, w_.data(), p_.data(), c);
+    }
+  }
+}
+
+IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& opt) const {
+  const double* ref_deg = opt.reference_deg;
+  const bool greedy = opt.branches == Branches::NearestReference && ref_deg != nullptr;
   // index of the candidate nearest the reference angle (deg), comparing modulo 360
   auto nearer = [&](const Angle* cand, int n, int joint) {
     if (!greedy || n < 2) return 0;
@@ -215,34 +262,29 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     return std::abs(wrap(cand[1].q - r)) < std::abs(wrap(cand[0].q - r)) ? 1 : 0;
   };
   IkSolutions out;
-  t_clamp = nearest_if_unreachable;
-  t_clamped = false;
-  struct Reset {
-    ~Reset() { t_clamp = false; }
-  } reset;
-  const IkStructure& st = m.ik_structure();
-  if (!st.spherical_wrist_parallel_23) {
+  Tangency tg;
+  tg.clamp = opt.out_of_reach == OutOfReach::Nearest;
+  if (!st_.spherical_wrist_parallel_23) {
     out.status = IkStatus::Unsupported;
     return out;
   }
-  const Vec3& pw = st.wrist_center;
+  const Vec3& pw = st_.wrist_center;
   // G = T M^-1 = e^{xi1 q1} ... e^{xi6 q6}; the wrist centre maps to p = G pw.
-  const Mat3 gr = target.linear() * m.tool().linear().transpose();
-  const Vec3 gt = target.translation() - gr * m.tool().translation();
+  const Mat3 gr = target.linear() * tool_.linear().transpose();
+  const Vec3 gt = target.translation() - gr * tool_.translation();
   const Vec3 p = gr * pw + gt;
-  const Vec3 &w1 = m.axis(0), &w2 = m.axis(1), &w3 = m.axis(2), &w4 = m.axis(3), &w5 = m.axis(4),
-             &w6 = m.axis(5);
-  const Vec3 &p1 = m.point(0), &p2 = m.point(1), &p3 = m.point(2);
+  const Vec3 &w1 = w_[0], &w2 = w_[1], &w3 = w_[2], &w4 = w_[3], &w5 = w_[4], &w6 = w_[5];
+  const Vec3 &p1 = p_[0], &p2 = p_[1], &p3 = p_[2];
   // The wrist rotation R456 = (R1 R2 R3)^T G is needed only applied to w6 (for q4, q5) and to a
   // vector v normal to w6 (for q6): both are carried through the rotations as vectors.
-  const IkStructure::Constants& kc = st.k;
+  const Constants& kc = k_;
   const Vec3& v6 = kc.v6;
   const Vec3 gw6 = gr * w6, gv6 = gr * v6;
 
   // q1: rotations about axes 2 and 3 keep the component along w2, so w2 . rot(w1, -q1)(p - p1)
   // must equal w2 . (pw - p1).
   Angle t1[2];
-  const int n1 = sub4(w2, w1, p - p1, w2.dot(pw - p1), t1);
+  const int n1 = sub4(w2, w1, p - p1, w2.dot(pw - p1), t1, tg);
   bool shoulder = false;
   Angle q1s[2];
   int nq1 = 0;
@@ -260,16 +302,16 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
     for (int i = 0; i < n1; ++i) q1s[i] = negated(t1[i]);
     nq1 = n1;
   }
-  const bool clamped1 = t_clamped;  // q1 itself came from a tangency
+  const bool clamped1 = tg.clamped;  // q1 itself came from a tangency
   const int b1 = nearer(q1s, nq1, 0);
   for (int i1 = greedy ? b1 : 0; i1 < (greedy ? std::min(b1 + 1, nq1) : nq1); ++i1) {
     const Angle& a1 = q1s[i1];
     const Vec3 pp = rotv(w1, a1.c, -a1.s, p - p1) + p1;  // e^{-xi1 q1} p
     const Vec3 w6_1 = rotv(w1, a1.c, -a1.s, gw6), v6_1 = rotv(w1, a1.c, -a1.s, gv6);
     Angle t3[2];
-    t_clamped = clamped1;
-    const int n3 = sub3_elbow(kc, (pp - p2).norm(), t3);
-    const bool clamped3 = t_clamped;  // flags of this shoulder and elbow branch only
+    tg.clamped = clamped1;
+    const int n3 = sub3_elbow(kc, (pp - p2).norm(), t3, tg);
+    const bool clamped3 = tg.clamped;  // flags of this shoulder and elbow branch only
     const int b3 = nearer(t3, n3, 2);
     for (int i3 = greedy ? b3 : 0; i3 < (greedy ? std::min(b3 + 1, n3) : n3); ++i3) {
       const Angle& a3 = t3[i3];
@@ -286,9 +328,9 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
         v6_456 = rotv(w3, a3.c, -a3.s, rotv(w2, a2.c, -a2.s, v6_1));
       }
       Angle t4[2], t5[2];
-      t_clamped = clamped3;
-      const bool flip = st.wrist_flip;
-      const int n45 = sub2_wrist(kc, w4, w5, w6_456, t4, t5, flip);
+      tg.clamped = clamped3;
+      const bool flip = st_.wrist_flip;
+      const int n45 = sub2_wrist(kc, w4, w5, w6_456, t4, t5, flip, tg);
       if (flip && n45 == 2) {  // the other wrist: (q4 + pi, -q5, q6 + pi)
         t4[1] = Angle{t4[0].q + kPi, -t4[0].c, -t4[0].s};
         t5[1] = negated(t5[0]);
@@ -320,17 +362,12 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
         for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) * (180 / kPi);
         s.wrist_singular = wrist < 1e-7;
         s.shoulder_singular = shoulder;
-        s.approximate = t_clamped;
+        s.approximate = tg.clamped;
         ++out.count;
       }
     }
   }
   // shift by 360 deg into the limits, nearest the reference
-  double lo[6], hi[6];
-  for (int j = 0; j < 6; ++j) {
-    lo[j] = m.spec().joints[j].lower_deg - 1e-9;
-    hi[j] = m.spec().joints[j].upper_deg + 1e-9;
-  }
   for (int i = 0; i < out.count; ++i) {
     IkSolution& s = out.sol[i];
     bool ok = true;
@@ -340,7 +377,7 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       const double q = s.q_deg[j], ref = ref_deg ? ref_deg[j] : 0.0;
       const double kn = std::min(2.0, std::max(-2.0, fastmath::round_nearest((ref - q) * (1.0 / 360))));
       const double c = q + 360.0 * kn;
-      if (c >= lo[j] && c <= hi[j]) {
+      if (c >= lo_[j] && c <= hi_[j]) {
         s.q_deg[j] = c;
         continue;
       }
@@ -348,7 +385,7 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
       bool found = false;
       for (int k = -2; k <= 2; ++k) {
         const double ck = q + 360.0 * k;
-        if (ck < lo[j] || ck > hi[j]) continue;
+        if (ck < lo_[j] || ck > hi_[j]) continue;
         if (!found || std::abs(ck - ref) < std::abs(best - ref)) best = ck;
         found = true;
       }
@@ -361,15 +398,14 @@ IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double
   return out;
 }
 
-int ik_nearest(const Model& m, const IkSolutions& s, const double* ref_deg) {
-  (void)m;
+int IkSolutions::nearest(const double* ref_deg) const {
   int best = -1;
   double bestd = 0;
-  for (int i = 0; i < s.count; ++i) {
-    if (!s.sol[i].within_limits) continue;
+  for (int i = 0; i < count; ++i) {
+    if (!sol[i].within_limits) continue;
     double d = 0;
     for (int j = 0; j < 6; ++j) {
-      const double e = s.sol[i].q_deg[j] - (ref_deg ? ref_deg[j] : 0.0);
+      const double e = sol[i].q_deg[j] - (ref_deg ? ref_deg[j] : 0.0);
       d += e * e;
     }
     if (best < 0 || d < bestd) {
@@ -379,5 +415,15 @@ int ik_nearest(const Model& m, const IkSolutions& s, const double* ref_deg) {
   }
   return best;
 }
+
+// TRANSITIONAL: removed at merge
+IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg, bool nearest_if_unreachable,
+                   bool nearest_branch) {
+  return IkSolver(m).solve(target, IkOptions(ref_deg, nearest_branch ? Branches::NearestReference : Branches::All,
+                                             nearest_if_unreachable ? OutOfReach::Nearest : OutOfReach::NoSolution));
+}
+
+// TRANSITIONAL: removed at merge
+int ik_nearest(const Model&, const IkSolutions& s, const double* ref_deg) { return s.nearest(ref_deg); }
 
 }  // namespace kincal

@@ -1,12 +1,20 @@
-// kincal: closed-form inverse kinematics by Paden-Kahan subproblems.
+// kincal: closed-form inverse kinematics by Paden-Kahan subproblems, as a solver built from a Model.
 //
 // For 6R robots whose axes 2 and 3 are parallel and whose axes 4, 5, 6 meet in one point (KUKA,
 // FANUC, ABB class), with any offsets. The wrist centre fixes q1 (subproblem 4: its component along
 // the parallel axes), q3 (subproblem 3: its distance from axis 2) and q2 (subproblem 1); the wrist
 // orientation gives q4, q5 (subproblem 2) and q6 (subproblem 1). Up to 2 x 2 x 2 = 8 solutions.
+//
+// The Model stays an immutable description; the IkSolver is built from it once (the structure check
+// and the closed form's constants) and then solves any number of targets. It copies what it reads
+// of the model, so it does not refer to the Model after construction; solve() is const and keeps
+// its per-call state on the stack (one solver may serve several threads).
 #pragma once
 
 #include "kincal/model/model.hpp"
+
+#include <array>
+#include <string>
 
 namespace kincal {
 
@@ -24,23 +32,95 @@ struct IkSolutions {
   IkStatus status = IkStatus::OutOfReach;
   int count = 0;
   std::array<IkSolution, 8> sol;
+
+  /// The solution within limits nearest (Euclidean norm in joint space, deg) to ref_deg (6 angles;
+  /// null: zero); -1 when none.
+  int nearest(const double* ref_deg) const;
 };
 
-/// Fills the closed form's geometry constants of st (wrist_flip, Constants) for a 6R model of the
-/// class (st.wrist_center set), from its unit axes w and axis points p (the Model does this).
-void fill_ik_constants(IkStructure& st, const Vec3* w, const Vec3* p);
+/// What IkSolver::solve does with a target out of reach.
+enum class OutOfReach {
+  NoSolution,  ///< status OutOfReach, no solution
+  /// the configurations nearest to it (subproblems at tangency), flagged approximate: a start for
+  /// Newton on a calibrated robot, which may reach a little beyond the nominal one
+  Nearest,
+};
 
-/// All closed-form solutions of the nominal model for the tool pose T (base frame, mm).
-/// Each angle is shifted by multiples of 360 deg to the value nearest ref_deg (or 0) that lies
-/// within the joint limits, when one does. Never NaN.
-/// With nearest_if_unreachable, a pose just out of reach (as a calibrated robot may reach) gives the
-/// configurations nearest to it (subproblems at tangency), flagged approximate: a start for Newton.
-/// With nearest_branch (and ref_deg), only the branch nearest the reference is computed, choosing
-/// shoulder, elbow and wrist in turn: about a quarter of the work, for programs and compensation.
+/// Which solutions IkSolver::solve computes.
+enum class Branches {
+  All,  ///< every solution (up to 8)
+  /// only the branch nearest the reference, choosing shoulder, elbow and wrist in turn: about a
+  /// quarter of the work, for programs and compensation (All when there is no reference)
+  NearestReference,
+};
+
+/// The options of one IkSolver::solve call.
+struct IkOptions {
+  /// 6 angles (deg) the solutions are shifted near by multiples of 360 deg; null: zero. Must stay
+  /// valid for the call.
+  const double* reference_deg = nullptr;
+  Branches branches = Branches::All;
+  OutOfReach out_of_reach = OutOfReach::NoSolution;
+
+  IkOptions() = default;
+  explicit IkOptions(const double* reference, Branches b = Branches::All, OutOfReach r = OutOfReach::NoSolution)
+      : reference_deg(reference), branches(b), out_of_reach(r) {}
+  explicit IkOptions(const Vec6& reference, Branches b = Branches::All, OutOfReach r = OutOfReach::NoSolution)
+      : IkOptions(reference.data(), b, r) {}
+};
+
+/// Which closed-form inverse kinematics applies to a model.
+struct IkStructure {
+  bool spherical_wrist_parallel_23 = false;  ///< axes 4,5,6 meet, axes 2,3 parallel (KUKA class)
+  std::string reason;                        ///< why not, when not
+  Vec3 wrist_center = Vec3::Zero();
+  /// axis 5 normal to axes 4 and 6, which are parallel at zero: the second wrist solution of every
+  /// arm solution is (q4 + 180, -q5, q6 + 180) (KUKA, ABB, FANUC wrists)
+  bool wrist_flip = false;
+};
+
+/// The closed-form IK of one model: its structure, its constants, and the solve.
+class IkSolver {
+ public:
+  /// Constants of the closed form, fixed by the geometry: the elbow's subproblem 3 about axis 3
+  /// (u = wrist centre - p3, v = p2 - p3: only the distance d changes) and the wrist's subproblem 2
+  /// (k1 = axis 4, k2 = axis 5, u = axis 6: only v changes).
+  struct Constants {
+    Vec3 v6 = Vec3::UnitX();  ///< a unit vector normal to axis 6
+    double sigma23 = 0;       ///< +-1 when axis 3 is exactly (to the bit) +-axis 2, else 0
+    double elbow_q = 0, elbow_c = 1, elbow_s = 0;  ///< angle from u to v about axis 3 (projections)
+    double elbow_nu = 0, elbow_nv = 0, elbow_dz = 0;  ///< |u|, |v| normal to axis 3; (u - v) along it
+    double elbow_inv_2nunv = 0;                         ///< 1 / (2 |u| |v|)
+    Vec3 n = Vec3::Zero(), m = Vec3::Zero();  ///< k1 x k2, k1 x n
+    double k12 = 0, inv_den = -1, k2u = 0, u2 = 1, inv_n2 = 1;  ///< k1.k2, 1/(k12^2 - 1), k2.u, |u|^2, 1/|n|^2
+    double a1 = 0, a2 = 0, b1 = 0, x21 = 0, y21 = 0;  ///< up.k1, up.k2, k2.(up x k1), up.n, k2.(up x n)
+  };
+
+  /// Checks the model's structure and, for a model of the class, computes the constants. A model
+  /// outside the class gives a solver whose solve() answers Unsupported (structure().reason says why).
+  explicit IkSolver(const Model& m);
+
+  const IkStructure& structure() const { return st_; }
+  const Constants& constants() const { return k_; }
+
+  /// All closed-form solutions (or the nearest branch, see IkOptions) for the tool pose target (base
+  /// frame, mm). Each angle is shifted by multiples of 360 deg to the value nearest the reference (or
+  /// 0) that lies within the joint limits, when one does. Never NaN.
+  IkSolutions solve(const Eigen::Isometry3d& target, const IkOptions& opt = IkOptions()) const;
+
+ private:
+  IkStructure st_;
+  Constants k_;
+  std::array<Vec3, 6> w_, p_;          ///< unit axes and axis points of the model
+  Eigen::Isometry3d tool_;             ///< tool frame at the zero configuration
+  std::array<double, 6> lo_{}, hi_{};  ///< joint limits (deg) widened by 1e-9
+};
+
+// TRANSITIONAL: removed at merge. The former free functions, for the callers not yet moved to
+// IkSolver (compensation, kincal-compensate); each ik_all call builds a solver from the model.
 IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg = nullptr,
                    bool nearest_if_unreachable = false, bool nearest_branch = false);
-
-/// The solution within limits nearest (max-norm in joint space) to ref_deg; -1 when none.
+// TRANSITIONAL: removed at merge (use IkSolutions::nearest).
 int ik_nearest(const Model& m, const IkSolutions& s, const double* ref_deg);
 
 }  // namespace kincal

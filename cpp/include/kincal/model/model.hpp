@@ -8,6 +8,8 @@
 //
 // The Model never changes after construction. It owns an equivalent KDL::Chain (the reference for
 // every test) and a compiled evaluator (local frames along each joint axis) used by the hot paths.
+// What is computed from a model lives beside it: the inverse kinematics in ik/ik.hpp (IkSolver),
+// the built-in robots in model/robots.hpp, the model JSON in io/model_json.hpp.
 #pragma once
 
 #include <Eigen/Core>
@@ -55,29 +57,6 @@ struct ModelSpec {
   double t_ref_c = 20.0;           ///< reference temperature of thermal_expansion (deg C)
 };
 
-/// Which closed-form inverse kinematics applies to a model.
-struct IkStructure {
-  bool spherical_wrist_parallel_23 = false;  ///< axes 4,5,6 meet, axes 2,3 parallel (KUKA class)
-  std::string reason;                        ///< why not, when not
-  Vec3 wrist_center = Vec3::Zero();
-  /// axis 5 normal to axes 4 and 6, which are parallel at zero: the second wrist solution of every
-  /// arm solution is (q4 + 180, -q5, q6 + 180) (KUKA, ABB, FANUC wrists)
-  bool wrist_flip = false;
-  /// Constants of the closed form (ik.cpp), fixed by the geometry: the elbow's subproblem 3 about
-  /// axis 3 (u = wrist centre - p3, v = p2 - p3: only the distance d changes) and the wrist's
-  /// subproblem 2 (k1 = axis 4, k2 = axis 5, u = axis 6: only v changes).
-  struct Constants {
-    Vec3 v6 = Vec3::UnitX();  ///< a unit vector normal to axis 6
-    double sigma23 = 0;       ///< +-1 when axis 3 is exactly (to the bit) +-axis 2, else 0
-    double elbow_q = 0, elbow_c = 1, elbow_s = 0;  ///< angle from u to v about axis 3 (projections)
-    double elbow_nu = 0, elbow_nv = 0, elbow_dz = 0;  ///< |u|, |v| normal to axis 3; (u - v) along it
-    double elbow_inv_2nunv = 0;                         ///< 1 / (2 |u| |v|)
-    Vec3 n = Vec3::Zero(), m = Vec3::Zero();  ///< k1 x k2, k1 x n
-    double k12 = 0, inv_den = -1, k2u = 0, u2 = 1, inv_n2 = 1;  ///< k1.k2, 1/(k12^2 - 1), k2.u, |u|^2, 1/|n|^2
-    double a1 = 0, a2 = 0, b1 = 0, x21 = 0, y21 = 0;  ///< up.k1, up.k2, k2.(up x k1), up.n, k2.(up x n)
-  } k;
-};
-
 class Model {
  public:
   explicit Model(ModelSpec spec);
@@ -88,7 +67,6 @@ class Model {
   const ModelSpec& spec() const { return spec_; }
   int dof() const { return n_; }
   const KDL::Chain& kdl_chain() const { return *chain_; }
-  const IkStructure& ik_structure() const { return ik_; }
   /// true for a joint that carries a compliance parameter (its axis is not fixed along gravity)
   bool gravity_loaded(int j) const { return loaded_[j]; }
   int compliance_count() const;
@@ -129,7 +107,6 @@ class Model {
   ModelSpec spec_;
   int n_ = 0;
   std::unique_ptr<KDL::Chain> chain_;
-  IkStructure ik_;
   std::array<bool, kMaxJoints> loaded_{};
   bool has_compliance_ = false;
   std::vector<EffectValue> joint_effects_;
@@ -147,39 +124,24 @@ class Model {
 
 using ModelPtr = std::shared_ptr<const Model>;
 
+class IkSolver;  // kincal/ik/ik.hpp
+
 /// A robot as users name it: the nominal geometry (for the closed-form IK start) and the
-/// calibrated one (for FK and compensation). For a nominal robot both are the same object.
+/// calibrated one (for FK and compensation). For a nominal robot both are the same object. The
+/// nominal model's IK solver is built once with the Robot (src/model/robot.cpp), so that programs
+/// do not rebuild it per pose; set the models through the constructor only.
 struct Robot {
   ModelPtr nominal;
   ModelPtr calibrated;
+
+  Robot() = default;  ///< no models (to be assigned a whole Robot)
+  Robot(ModelPtr nominal_model, ModelPtr calibrated_model);
   bool identified() const { return nominal != calibrated; }
+  /// the nominal model's closed-form IK (ik/ik.hpp); only on a Robot built with its models
+  const IkSolver& ik() const { return *ik_; }
+
+ private:
+  std::shared_ptr<const IkSolver> ik_;
 };
-
-/// The built-in KUKA KR 500 R2830-class robot with a tape-laying head (sources in model.cpp).
-ModelSpec kr500_spec();
-/// The built-in Universal Robots UR10 (UR's published DH parameters; sources in model.cpp).
-ModelSpec ur10_spec();
-/// Names of the built-in robots.
-std::vector<std::string> builtin_names();
-/// A built-in robot by name; throws InputError naming the unknown robot.
-ModelSpec builtin_spec(const std::string& name);
-
-/// Model JSON (contract: "format": "kincal-model", "version"). Exact round trip.
-std::string robot_to_json(const Robot& robot);
-Robot robot_from_json(const std::string& text, const std::string& source);
-/// A built-in name or a model JSON file path (URDF files are read by the Python layer).
-Robot load_robot(const std::string& name_or_path);
-std::string spec_to_json(const ModelSpec& spec);
-
-}  // namespace kincal
-
-namespace kincal {
-
-/// Realistic manufacturing errors for simulations and tests: every axis tilted by about sigma_deg
-/// and moved by about sigma_mm normal to itself, the tool moved and turned by the same amounts;
-/// with_compliance sets a joint compliance on every gravity-loaded joint (deg per kN m, about
-/// `compliance` each). Deterministic for a seed.
-ModelSpec perturbed_spec(const ModelSpec& spec, unsigned seed, double sigma_mm = 1.0, double sigma_deg = 0.05,
-                         double compliance = 0.0);
 
 }  // namespace kincal

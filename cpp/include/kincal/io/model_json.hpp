@@ -1,0 +1,18 @@
+// kincal: the model JSON file (contract: "format": "kincal-model", "version" 1 or 2; written as
+// version 2) of a Robot or a ModelSpec, and load_robot (a built-in name or a model JSON path).
+#pragma once
+
+#include "kincal/model/model.hpp"
+
+#include <string>
+
+namespace kincal {
+
+/// Model JSON (contract: "format": "kincal-model", "version"). Exact round trip.
+std::string robot_to_json(const Robot& robot);
+Robot robot_from_json(const std::string& text, const std::string& source);
+/// A built-in name or a model JSON file path (URDF files are read by the Python layer).
+Robot load_robot(const std::string& name_or_path);
+std::string spec_to_json(const ModelSpec& spec);
+
+}  // namespace kincal

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "kincal/compensation/program.hpp"
+#include "kincal/model/robots.hpp"
 
 #include <gtest/gtest.h>
 

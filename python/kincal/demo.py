@@ -14,7 +14,6 @@
 
 from __future__ import annotations
 
-import html
 import json
 import math
 import time
@@ -28,16 +27,12 @@ from . import diagnose as dg
 from . import feed as feedmod
 from . import fivebar as fb
 from . import identify as ident
+from . import report
+from .csv_text import format_rows
 
 SEED = 7
 #: the effect the starting model does not know: joint 2 lags 0.01 deg behind its command (a gear's play)
 HIDDEN = [("backlash", 2, [math.radians(-0.01)])]
-
-
-def _fmt_rows(header, rows) -> str:
-    out = [",".join(header)]
-    out += [",".join(repr(float(v)) for v in r) for r in rows]
-    return "\n".join(out) + "\n"
 
 
 def _gcode(poses: np.ndarray) -> str:
@@ -45,12 +40,6 @@ def _gcode(poses: np.ndarray) -> str:
     g += [f"N{10 * (i + 1)} G1 X{p[0]:.4f} Y{p[1]:.4f} Z{p[2]:.4f} A{p[3]:.5f} B{p[4]:.5f} C{p[5]:.5f}"
           for i, p in enumerate(poses)]
     return "\n".join(g + ["M30"]) + "\n"
-
-
-def _table(header, rows) -> str:
-    h = "".join(f"<th>{html.escape(str(x))}</th>" for x in header)
-    b = "".join("<tr>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r) + "</tr>" for r in rows)
-    return f"<table><tr>{h}</tr>{b}</table>"
 
 
 def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
@@ -89,7 +78,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     b_fit = res.fit["nominal_fitted"]  # nominal geometry with the measured tracker frame
     # the line is taught in the tracker (user) frame: where the nominal robot would put it
     poses = fk(b_fit, compensate(b_fit, base_line, compensate=False)["q_deg"], frame="instrument")
-    w(str(out / "line.csv"), _fmt_rows(["x", "y", "z", "a", "b", "c"], poses))
+    w(str(out / "line.csv"), format_rows(["x", "y", "z", "a", "b", "c"], poses))
     w(str(out / "line.gcode"), _gcode(poses))
     unc = _core.compensate_program(b_fit, str(out / "line.gcode"), str(out / "uncompensated.gcode"), compensate=False,
                                    instrument=True)
@@ -201,16 +190,8 @@ def _report(out: Path, res, diag, summary, err_unc, err_com, err_dia, fres, tabl
     t1_rows = [[k, v["points"], f"{v['a']:.3f}", f"{v['b']:.3f}", f"{v['c']:.3f}", f"{v['d']:.3f}",
                 f"{v['max_error_mm'] * 1000:.1f}"] for k, v in table_fits.items()]
     hb = summary["fivebar_max_error_mm"]
-    feed_imgs = "".join(f'<figure><img src="feed/axis{a}.png" alt="axis {a}"></figure>' for a in (1, 2, 3))
-    page = f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>kincal demo</title>
-<style>body{{font-family:sans-serif;max-width:980px;margin:2em auto;color:#222;line-height:1.4}}
-table{{border-collapse:collapse;margin:0.5em 0}}td,th{{border:1px solid #ccc;padding:3px 8px}}
-img{{max-width:100%}}code{{background:#f3f3f3}}</style>
-<script>window.addEventListener("load", () => {{ const i = [...document.images];
-document.body.setAttribute("data-images-loaded", i.filter(x => x.complete && x.naturalWidth > 0).length + "/" + i.length);
-}});</script></head><body>
-<h1>kincal demo</h1>
+    feed_imgs = "".join(report.figure(f"feed/axis{a}.png", f"axis {a}") for a in (1, 2, 3))
+    body = f"""<h1>kincal demo</h1>
 <p>The whole pipeline on built-in examples, in {summary['seconds']:.0f} s. Every number here comes from this
 run; the inputs and outputs are in this folder (listed at the end).</p>
 
@@ -225,49 +206,61 @@ truth in <code>truth.json</code>).</p>
 <p>Geometry (30 parameters) and joint compliance (5), the tracker frame and the reflector offsets, by Ceres
 with an analytic Jacobian (<code>model.json</code>, full summary in <code>identify.txt</code>). Position
 error in mm, nominal model (with the measured tracker frame) against the identified one:</p>
-{_table(["", "RMS before", "RMS after", "max before", "max after"], ident_rows)}
+{report.table(["", "RMS before", "RMS after", "max before", "max after"], ident_rows)}
 <p>Condition number {res.fit['condition_number']:.3g}; {sum(res.fit['fixed'])} parameters are held because the
 data cannot determine them (redundant with others), named in <code>identify.txt</code>.</p>
 
 <h2>3. Diagnosis: what is the model missing?</h2>
-{_table(["step", "effect", "joint", "F", "CV RMS before (um)", "after (um)"], diag_rows)}
-<p>{html.escape(diag['verdict'])} (cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um). The hidden effect was
+{report.table(["step", "effect", "joint", "F", "CV RMS before (um)", "after (um)"], diag_rows)}
+<p>{report.esc(diag['verdict'])} (cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um). The hidden effect was
 backlash on joint 2. Full report: <a href="diagnosis/report.html">diagnosis/report.html</a>.</p>
-<figure><img src="diagnosis/gap.png" alt="gap"></figure>
+{report.figure("diagnosis/gap.png", "gap")}
 
 <h2>4. Compensation of the paper's line: the named effect reaches the robot</h2>
 <p>The Samak paper's use case: 297 poses 5 mm apart on a 1480 mm line, tool orientation constant, taught in the
 tracker frame (<code>line.gcode</code>). The uncompensated program is the nominal closed-form IK; the compensated
 ones are Newton on a model (at most {summary['newton_iterations']['max']} iterations per pose): the identified
 model (geometry and compliance, <code>model.json</code>) and the diagnosed one, which carries the effects the
-diagnosis named ({html.escape(", ".join(summary['diagnosed_model_effects']) or "none")},
+diagnosis named ({report.esc(", ".join(summary['diagnosed_model_effects']) or "none")},
 <code>diagnosis/model.json</code>). Each program runs on the true robot, whose joint 2 lags by its backlash
 in the direction the commanded motion arrives from. Position error on the true robot (mm):</p>
-{_table(["program", "mean", "max"], [
+{report.table(["program", "mean", "max"], [
     ["uncompensated (nominal IK)", f"{summary['position_error_uncompensated_mm']['mean']:.3f}",
      f"{summary['position_error_uncompensated_mm']['max']:.3f}"],
     ["compensated on the identified model", f"{summary['position_error_compensated_mm']['mean']:.3f}",
      f"{summary['position_error_compensated_mm']['max']:.3f}"],
     ["compensated on the diagnosed model", f"{summary['position_error_compensated_diagnosed_mm']['mean']:.3f}",
      f"{summary['position_error_compensated_diagnosed_mm']['max']:.3f}"]])}
-<figure><img src="line_errors.png" alt="line errors"></figure>
+{report.figure("line_errors.png", "line errors")}
 
 <h2>5. Derivative analysis</h2>
 <p>Both programs against the kr500's velocity, acceleration and jerk limits at a rate of s of
 {feedmod.DEFAULT_FEED} rad/s (<code>feed/feed.json</code>, one figure per axis in <code>feed/</code>):</p>
-{_table(["program", "s total (rad)", "violations", "time-optimal traversal (s)", "at constant feed (s)"], feed_rows)}
+{report.table(["program", "s total (rad)", "violations", "time-optimal traversal (s)", "at constant feed (s)"], feed_rows)}
 {feed_imgs}
 
 <h2>6. The five-bar hidden robot</h2>
 <p>Table I of the Kiper paper, ranked as the paper does for the polynomial and least-squares methods:</p>
-{_table(["method", "points", "a", "b", "c", "d", "largest error (um)"], t1_rows)}
+{report.table(["method", "points", "a", "b", "c", "d", "largest error (um)"], t1_rows)}
 <p>On the simulated over-constrained 6-bar: nominal lengths miss by up to {hb['nominal'] * 1000:.0f} um, the fitted
 hidden robot by {hb['fit'] * 1000:.0f} um, fit plus the 5 mm error matrix by {hb['fit_and_matrix'] * 1000:.1f} um
 (400 points off the grid, 1 um instrument; target 30 um).</p>
-<figure><img src="fivebar/error_maps.png" alt="five-bar error maps"></figure>
+{report.figure("fivebar/error_maps.png", "five-bar error maps")}
 
 <h2>Files</h2>
 <p>{", ".join(sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()))}, report.html, summary.json</p>
-</body></html>
 """
-    _core.write_file_atomic(str(out / "report.html"), page)
+    report.write(out / "report.html", "kincal demo", body)
+
+
+def summary_text(summary: dict) -> str:
+    """One line on what run() found (its summary)."""
+    return (f"identification: held-out RMS {summary['identification']['held_out_rms_before_mm']:.3f} -> "
+            f"{summary['identification']['held_out_rms_after_mm']:.3f} mm; diagnosis named "
+            + ", ".join(f"{d['effect']}" + (f" (joint {d['joint']})" if d["joint"] else "") for d in summary["diagnosis"])
+            + f"; the line on the true robot: uncompensated {summary['position_error_uncompensated_mm']['mean']:.3f} mm, "
+            f"compensated on the identified model {summary['position_error_compensated_mm']['mean']:.3f} mm, on the "
+            f"diagnosed model {summary['position_error_compensated_diagnosed_mm']['mean']:.4f} mm (mean); feed "
+            f"violations {summary['feed_violations']}; five-bar "
+            f"{summary['fivebar_max_error_mm']['fit_and_matrix'] * 1000:.1f} um after fit + matrix "
+            f"({summary['seconds']:.0f} s)")

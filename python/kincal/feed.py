@@ -16,7 +16,9 @@ derivatives are exact and smooth: it does not invent violations.
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from typing import Optional, Sequence
 
 import numpy as np
@@ -150,8 +152,6 @@ def json_ready(result: dict) -> dict:
 
 def robot_limits(robot) -> tuple[list, list, list]:
     """Velocity, acceleration and jerk limits (deg/s, /s^2, /s^3) of a robot's model."""
-    import json
-
     joints = json.loads(robot.to_json())["nominal"]["joints"]
     v = [jt["max_velocity_deg_s"] for jt in joints]
     a = [jt["max_acceleration_deg_s2"] for jt in joints]
@@ -221,3 +221,53 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
     fig.suptitle(f"derivative analysis at feed {feed:g} rad/s (constraint lines: +- limit / feed^k)")
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_path: Optional[str] = None,
+                  feed: float = DEFAULT_FEED, samples: int = DEFAULT_SAMPLES, method: str = "spline",
+                  window: Optional[tuple] = None, zoom: Optional[tuple] = None) -> dict:
+    """`kincal feed`: the joint programs ``programs`` (key -> file: "program" and optionally
+    "compare") analysed against the robot's limits (overridden by the CSV ``limits_path``); writes
+    out/feed.json and one figure per axis. Returns the results by key (with ``file`` and ``label``)."""
+    from . import _core
+
+    limits = robot_limits(robot)
+    if limits_path:
+        limits = read_limits(limits_path, robot.dof, limits)
+    for name, lim in zip(("velocity", "acceleration", "jerk"), limits):
+        if not all(x > 0 for x in lim):
+            raise ValueError(f"{robot_arg}: the model has no {name} limit for some axis; give --limits L.csv")
+    results = {}
+    for key, path in programs.items():
+        q, _ = _core.read_joint_program(path, robot.dof)
+        res = analyse(np.asarray(q), *limits, feed=feed, samples=samples, method=method)
+        res["file"] = path
+        res["label"] = Path(path).name
+        results[key] = res
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    figures = []
+    for axis in range(1, robot.dof + 1):
+        name = f"axis{axis}.png"
+        figure(results, *limits, feed, axis, str(folder / name), window=window, zoom=zoom)
+        figures.append(name)
+    doc = {"feed_rad_s": feed, "method": method, "samples": samples,
+           "limits": {"v_max_deg_s": limits[0], "a_max_deg_s2": limits[1], "j_max_deg_s3": limits[2]},
+           "programs": {k: json_ready(r) for k, r in results.items()},
+           "figures": figures}
+    _core.write_file_atomic(str(folder / "feed.json"), json.dumps(doc) + "\n")
+    return results
+
+
+def summary(results: dict, feed: float) -> str:
+    """`kincal feed`'s summary of analyse_files()'s results: per program its length in s, its
+    violations at the rate ``feed`` (the first ten) and its time-optimal traversal."""
+    lines = []
+    for k, r in results.items():
+        t = r.get("time_optimal", {})
+        lines.append(f"{k} ({r['file']}): s = {r['s_total_rad']:.4f} rad, {len(r['violations'])} violation(s) at "
+                     f"{feed:g} rad/s; time-optimal traversal {t.get('time_s', float('nan')):.3f} s")
+        for v in r["violations"][:10]:
+            lines.append(f"  axis A{v['axis']} {v['limit']} limit from s = {v['s']:.4f} to {v['s_end']:.4f} rad "
+                         f"(allowed feed down to {v['allowed_feed']:.4g} rad/s)")
+    return "\n".join(lines)

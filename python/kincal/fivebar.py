@@ -1,4 +1,6 @@
-"""The Kiper paper's hidden robot: link-length synthesis, the error-correction matrix, commands.
+"""The Kiper paper's hidden robot: link-length synthesis, the error-correction matrix, commands,
+and the diagnosis of what the four lengths miss (the engine of kincal.diagnose, with this
+mechanism's candidates and refit) with its report.
 
 A point set is a dict of numpy arrays (``id``, ``theta1_deg``, ``theta2_deg``, ``desired`` n x 2,
 ``measured`` n x 2), the rows of data/fivebar-table1.csv. Kinematics, synthesis, the subset search
@@ -9,12 +11,15 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Any, Optional
+from pathlib import Path
+from typing import Callable, Optional, Union
 
 import numpy as np
 
-from . import _core
+from . import _core, report
 from ._core import ErrorMatrix, FiveBar
+from .csv_text import format_rows
+from .diagnose import engine
 
 METHODS = ("polynomial", "lsq", "minimax", "nonlinear")
 
@@ -205,7 +210,7 @@ def _basis(effect, t1: np.ndarray, t2: np.ndarray) -> np.ndarray:
     return b
 
 
-def _predict(pts: dict, x: np.ndarray, effects: list) -> np.ndarray:
+def predict(pts: dict, x: np.ndarray, effects: list) -> np.ndarray:
     """Model positions (n x 2) for lengths x[:4] and the effects' parameters after them (effects:
     _core.Effect objects, joint = link or actuator from 1)."""
     t1, t2 = np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"])
@@ -237,112 +242,133 @@ def fit_with_effects(pts: dict, effects: list, start: Optional[np.ndarray] = Non
     x0 = np.r_[np.array([150.0, 150, 150, 150]) if start is None else start[:4], np.zeros(sum(e.size for e in effects))]
     if start is not None and len(start) > 4:
         x0[4:len(start)] = start[4:]
-    r = least_squares(lambda x: (_predict(pts, x, effects) - pts["measured"]).ravel(), x0, method="trf",
+    r = least_squares(lambda x: (predict(pts, x, effects) - pts["measured"]).ravel(), x0, method="trf",
                       x_scale="jac", xtol=1e-12, ftol=1e-12, diff_step=1e-7)
     return r.x
 
 
-def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
-             noise_mm: Optional[float] = None, say=lambda s: None) -> dict:
-    """The model-discrepancy workflow on the hidden robot (contract names link_deflection, with
-    "link": "a".."d", and transmission_error with the actuator as "joint")."""
-    import math
+def _subset(pts: dict, mask: Union[np.ndarray, slice]) -> dict:
+    return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in pts.items()}
 
-    from scipy.stats import f as fdist
 
-    n = len(pts["id"])
-    rng = np.random.default_rng(seed)
-    order = rng.permutation(n)
-    masks = [np.isin(np.arange(n), order[i::folds]) for i in range(folds)]
-    sub = lambda m: {k: (v[m] if isinstance(v, np.ndarray) else v) for k, v in pts.items()}  # noqa: E731
+class Diagnosis:
+    """The hidden robot's diagnosis problem (kincal.diagnose.engine.Problem): the measured points,
+    folds of points dealt at random, the refit of the lengths and the effects' parameters
+    (fit_with_effects) and its linearisation: the current model's columns by central differences,
+    a candidate's by the chain rule on the five-bar's Jacobians."""
 
-    def cv(effects):
-        sq = 0.0
-        for m in masks:
-            x = fit_with_effects(sub(~m), effects)
-            sq += float(np.sum((_predict(sub(m), x, effects) - pts["measured"][m]) ** 2))
-        return math.sqrt(sq / n)
+    dims = 2
 
-    cands = library()
-    effects: list = []
-    cur = cv(effects)
-    steps = []
-    while True:
+    def __init__(self, pts: dict, folds: int = 5, seed: int = 0):
+        n = len(pts["id"])
+        order = np.random.default_rng(seed).permutation(n)
+        self.pts = pts
+        self.folds = [np.isin(np.arange(n), order[i::folds]) for i in range(folds)]
+
+    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+        x = fit_with_effects(_subset(self.pts, ~held), effects)
+        return predict(_subset(self.pts, held), x, effects) - self.pts["measured"][held]
+
+    def linearise(self, effects: list) -> engine.Linearisation:
+        pts = self.pts
         x = fit_with_effects(pts, effects)
-        r = (_predict(pts, x, effects) - pts["measured"]).ravel()
-        # current model's columns by central differences, candidates' by the chain rule on them
+        r = (predict(pts, x, effects) - pts["measured"]).ravel()
         h = 1e-6
         cols = []
         for k in range(len(x)):
             xp, xm = x.copy(), x.copy()
             xp[k] += h
             xm[k] -= h
-            cols.append(((_predict(pts, xp, effects) - _predict(pts, xm, effects)) / (2 * h)).ravel())
+            cols.append(((predict(pts, xp, effects) - predict(pts, xm, effects)) / (2 * h)).ravel())
         Jc = np.array(cols).T
-        t1, t2 = np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"])
         model = FiveBar(*x[:4])
-        scored: list[dict[str, Any]] = []
-        for eff in cands:
-            if eff in effects:
-                continue
-            idx = eff.joint - 1
-            b = _basis(eff, t1, t2)
-            k_par = eff.size
-            R = np.zeros((2 * n, k_par))
-            for i in range(n):
-                if _acts_on(eff) == "link_length":
-                    _, jl = _core.fivebar_errors(model, {k: (v[i:i + 1] if isinstance(v, np.ndarray) else v)
-                                                         for k, v in pts.items()})
-                    d = jl[:, idx]
-                else:
-                    jm = model.jacobian(pts["theta1_deg"][i], pts["theta2_deg"][i])
-                    if jm is None:
-                        raise ValueError(f"point {int(pts['id'][i])}: a singular pose of the hidden robot")
-                    d = jm[:, idx]
-                R[2 * i:2 * i + 2] = np.outer(d, b[i])
-            Q, _ = np.linalg.qr(Jc)
-            Rp = R - Q @ (Q.T @ R)
-            beta, *_ = np.linalg.lstsq(Rp, r, rcond=None)
-            rss0, rss1 = float(r @ r), float(np.sum((r - Rp @ beta) ** 2))
-            dof = 2 * n - Jc.shape[1] - k_par
-            F = ((rss0 - rss1) / k_par) / (rss1 / dof) if rss1 > 0 and dof > 0 else math.inf
-            p = float(fdist.sf(F, k_par, dof)) if math.isfinite(F) else 0.0
-            before = after = 0.0
-            for m in masks:
-                rows = np.repeat(m, 2)
-                bb, *_ = np.linalg.lstsq(Rp[~rows], r[~rows], rcond=None)
-                before += float(r[rows] @ r[rows])
-                after += float(np.sum((r[rows] - Rp[rows] @ bb) ** 2))
-            scored.append({"effect": eff, "F": F, "p_value": p,
-                           "cv_gain": 1 - math.sqrt(after / before) if before > 0 else 0.0})
-        scored.sort(key=lambda s: -s["cv_gain"])
-        sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
-        if not sig:
-            break
-        best = sig[0]
-        trial = effects + [best["effect"]]
-        new = cv(trial)
-        if new >= cur:
-            break
-        eff = best["effect"]
-        step = {"effect": eff.name, "joint": None, "evidence": {"F": best["F"], "p_value": best["p_value"],
-                                                                "cv_gain_linear": best["cv_gain"]},
-                "rms_before_mm": cur, "rms_after_mm": new}
-        if _core.effect_kind(eff.name).concerns == "link":
-            step["link"] = LINKS[eff.joint - 1]
-        else:
-            step["joint"] = eff.joint
-        steps.append(step)
-        say(f"step {len(steps)}: {eff.name} ({step.get('link') or step['joint']}), cross-validated RMS "
-            f"{cur * 1000:.1f} -> {new * 1000:.1f} um")
-        effects, cur = trial, new
-    x = fit_with_effects(pts, effects)
-    e = np.linalg.norm(_predict(pts, x, effects) - pts["measured"], axis=1)
-    scatter = math.sqrt(float(np.sum(e ** 2)) / max(1, 2 * n - len(x))) * math.sqrt(2.0)
-    noise = scatter if noise_mm is None else noise_mm * math.sqrt(2.0)
-    left = [s for s in scored if s["p_value"] < alpha]
-    at_noise = (cur <= 1.3 * noise) if noise_mm is not None else not left
-    return {"steps": steps, "final_rms_mm": cur, "noise_rms_mm": noise, "noise_known": noise_mm is not None,
-            "verdict": "what remains is at the noise level" if at_noise else
-            "what remains is structured but not explained by the library", "notes": [], "folds": folds,
+        return lambda eff: (r, Jc, self._regressors(model, eff))
+
+    def _regressors(self, model: FiveBar, eff) -> np.ndarray:
+        """The candidate's columns (2n x size): the point's derivative in the link length or actuator
+        angle the effect changes, times the effect's basis functions."""
+        pts = self.pts
+        n = len(pts["id"])
+        b = _basis(eff, np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"]))
+        R = np.zeros((2 * n, eff.size))
+        for i in range(n):
+            if _acts_on(eff) == "link_length":
+                _, jl = _core.fivebar_errors(model, _subset(pts, slice(i, i + 1)))
+                d = jl[:, eff.joint - 1]
+            else:
+                jm = model.jacobian(pts["theta1_deg"][i], pts["theta2_deg"][i])
+                if jm is None:
+                    raise ValueError(f"point {int(pts['id'][i])}: a singular pose of the hidden robot")
+                d = jm[:, eff.joint - 1]
+            R[2 * i:2 * i + 2] = np.outer(d, b[i])
+        return R
+
+    def describe(self, effect) -> dict:
+        if _core.effect_kind(effect.name).concerns == "link":
+            return {"effect": effect.name, "joint": None, "link": LINKS[effect.joint - 1]}
+        return {"effect": effect.name, "joint": effect.joint}
+
+    def label(self, effect) -> str:
+        d = self.describe(effect)
+        return f"{effect.name}(link {d['link']})" if "link" in d else effect.label
+
+    def model_label(self, effects: list) -> str:
+        return " + ".join(["four lengths"] + [self.label(e) for e in effects])
+
+
+def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
+             noise_mm: Optional[float] = None, say: Callable[[str], None] = lambda s: None) -> dict:
+    """The model-discrepancy workflow on the hidden robot (the engine of kincal.diagnose; contract
+    names link_deflection, with "link": "a".."d", and transmission_error with the actuator as
+    "joint"), every candidate of library() allowed."""
+    problem = Diagnosis(pts, folds, seed)
+    cands = library()
+    found = engine.search(problem, [], cands, alpha=alpha, min_gain=min_gain, max_steps=len(cands), say=say)
+    x = fit_with_effects(pts, found.effects)
+    e = np.linalg.norm(predict(pts, x, found.effects) - pts["measured"], axis=1)
+    concl = engine.conclude(problem, found, e, len(x), noise_mm, alpha, say)
+    return {"steps": found.steps, "final_rms_mm": found.cv_rms_mm, "noise_rms_mm": concl["noise_rms_mm"],
+            "noise_known": concl["noise_known"], "fit_scatter_mm": concl["fit_scatter_mm"],
+            "verdict": concl["verdict"], "notes": [], "history": found.history, "folds": folds,
             "lengths_mm": x[:4].tolist()}
+
+
+def effects_of(diag: dict) -> list:
+    """The effects a diagnosis named (_core.Effect, joint: the link or actuator from 1)."""
+    return [_core.Effect(s["effect"], LINKS.index(s["link"]) + 1 if s.get("link") else s["joint"])
+            for s in diag["steps"]]
+
+
+def write_diagnosis(pts: dict, diag: dict, out: Union[str, Path], title: str) -> None:
+    """In the folder ``out``: residual_map.png (the four lengths against the model with the named
+    effects), report.html and diagnosis.json."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    named = effects_of(diag)
+    before = dict(pts, desired=predict(pts, fit_with_effects(pts, []), []))
+    after = dict(pts, desired=predict(pts, fit_with_effects(pts, named), named))
+    error_map_figure([("four lengths", before), ("with the named effects", after)], str(folder / "residual_map.png"),
+                     title="five-bar: model minus measured position")
+    rows = [[k + 1, s["effect"], s.get("link") or s["joint"], f"{s['evidence']['F']:.3g}",
+             f"{s['rms_before_mm'] * 1000:.1f}", f"{s['rms_after_mm'] * 1000:.1f}"] for k, s in enumerate(diag["steps"])]
+    body = f"""<h1>{report.esc(title)}</h1>
+{report.table(["step", "effect", "link / actuator", "F", "CV RMS before (um)", "after (um)"], rows)}
+<p>{report.esc(diag['verdict'])}: cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um.</p>
+{report.figure("residual_map.png", "residual map")}"""
+    report.write(folder / "report.html", title, body)
+    _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
+
+
+def diagnosis_summary(diag: dict) -> str:
+    """`kincal diagnose --robot fivebar`'s summary: each named effect and the final verdict."""
+    lines = [f"{st['effect']} {st.get('link') or st['joint']}: cross-validated RMS "
+             f"{st['rms_before_mm'] * 1000:.1f} -> {st['rms_after_mm'] * 1000:.1f} um" for st in diag["steps"]]
+    return "\n".join(lines + [f"final {diag['final_rms_mm'] * 1000:.1f} um: {diag['verdict']}"])
+
+
+def points_csv(pts: dict) -> str:
+    """A point set as the CSV of data/fivebar-table1.csv."""
+    rows = [[int(i), t1, t2, d[0], d[1], m[0], m[1]] for i, t1, t2, d, m in
+            zip(pts["id"], pts["theta1_deg"], pts["theta2_deg"], pts["desired"], pts["measured"])]
+    return format_rows(["point", "theta1_deg", "theta2_deg", "x_desired_mm", "y_desired_mm", "x_measured_mm",
+                        "y_measured_mm"], rows)

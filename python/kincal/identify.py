@@ -120,6 +120,32 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     return out
 
 
+def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> tuple:
+    """NAME:JOINT:V1,V2.. of `kincal simulate --hide`: (Effect, values in core units). The values are
+    in the model file's units (degrees for angles, 1/C for thermal_expansion: joint 0); their number
+    comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order)."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
+    name, joint, vals = parts[0], parts[1], parts[2]
+    kinds = [k for k in _core.effect_kinds() if k.domain == "serial" and k.name != "joint_compliance"]
+    kind = next((k for k in kinds if k.name == name), None)
+    if kind is None:
+        raise ValueError(f"--hide {text}: unknown effect '{name}' ({', '.join(k.name for k in kinds)})")
+    try:
+        j = int(joint)
+        v = [float(x) for x in vals.split(",")]
+    except ValueError:
+        raise ValueError(f"--hide {text}: joint and values must be numbers") from None
+    if kind.concerns == "joint" and not 1 <= j <= dof:
+        raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
+    e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
+    if len(v) != e.size or not all(math.isfinite(x) for x in v):
+        raise ValueError(f"--hide {text}: {e.label} takes {e.size} finite value(s) "
+                         f"({', '.join(f'{n} ({u})' for n, u in zip(e.parameter_names, e.file_units))})")
+    return e, [x / sc for x, sc in zip(v, e.file_scale)]
+
+
 def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
     """The data columns the effects read (the registry's ``needs``) are present: a clear error names
     the file and the column otherwise."""

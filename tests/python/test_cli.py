@@ -1,5 +1,5 @@
 """The commands of the contract: fk, ik, compensate, kincal-compensate (file and --stream), demo,
-and bad input (one message naming file, line and cause; non-zero exit; no output file)."""
+bench, and bad input (one message naming file, line and cause; non-zero exit; no output file)."""
 
 from __future__ import annotations
 
@@ -169,3 +169,19 @@ def test_demo(tmp_path):
     m = re.search(r'data-images-loaded="(\d+)/(\d+)"', dom.stdout)
     assert m, dom.stderr[-2000:]
     assert int(m.group(2)) >= 6 and m.group(1) == m.group(2)
+
+
+def test_bench_prints_one_json_object():
+    """kincal bench (the identification and diagnosis skipped, 50 poses): one JSON object on stdout
+    with the core's timings beside KDL's, the derivative analysis and the whole run's time; the
+    benchmarks ship beside the package (kincal_benchmarks), not inside it."""
+    import kincal_benchmarks
+
+    package = Path(kincal.__file__).parent
+    assert Path(kincal_benchmarks.__file__).parent.parent == package.parent  # installed beside kincal
+    assert not (package / "_numpy_model.py").exists()
+    r = run("kincal", "bench", "--poses", "50", "--no-identify", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(r.stdout)
+    assert {"fk_ns", "kdl_fk_ns", "feed_297_poses_ms", "feed_100000_poses_ms", "bench_seconds"} <= set(doc)
+    assert "identify_ms" not in doc and "diagnose_500_poses_s" not in doc

@@ -172,7 +172,7 @@ def test_observability_selection_beats_random_poses():
 def test_numpy_residuals_equal_the_core():
     """The numpy measurement model of the scipy benchmark baseline computes the core's residuals
     (kr500, compliance, two targets, a random parameter point) to 1e-9 mm."""
-    from kincal._numpy_model import NumpyPointModel
+    from kincal_benchmarks.numpy_model import NumpyPointModel
 
     robot = kincal.load_robot("kr500")
     data = ident.simulate(ident.default_truth(robot, seed=1), 50, seed=1, targets=2)

@@ -1,5 +1,5 @@
 """The `.pyi` stubs of the private core agree with the compiled module (mypy's stubtest) and the
-typed package passes mypy."""
+typed package and its benchmarks pass mypy."""
 
 from __future__ import annotations
 
@@ -23,4 +23,12 @@ def test_package_passes_mypy():
     pytest.importorskip("mypy")
     r = subprocess.run([sys.executable, "-m", "mypy", "--ignore-missing-imports", str(ROOT / "python" / "kincal")],
                        capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-3000:]
+
+
+def test_benchmarks_pass_mypy():
+    """kincal_benchmarks (shipped beside kincal) against the installed, typed kincal."""
+    pytest.importorskip("mypy")
+    r = subprocess.run([sys.executable, "-m", "mypy", "--ignore-missing-imports", "-p", "kincal_benchmarks"],
+                       capture_output=True, text=True, timeout=300, cwd=str(ROOT / "benchmarks"))
     assert r.returncode == 0, r.stdout[-3000:]

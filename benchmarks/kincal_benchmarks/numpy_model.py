@@ -9,7 +9,7 @@ import json
 
 import numpy as np
 
-from . import _core
+from kincal import _core
 
 
 def _unit_orthogonal(w: np.ndarray) -> np.ndarray:

@@ -1,0 +1,204 @@
+"""The diagnosis engine, the same for every mechanism (the serial robot, the five-bar hidden robot):
+the greedy search that names the effects a model misses, the F-test and the cross-validated scores.
+
+Each step: the current model is fitted; every candidate effect gives regressors, the columns its
+parameters would add to the identification Jacobian at the current fit. They are projected off the
+span of the current model's columns (so a constant offset cannot pass for another effect: the model
+absorbs it), then scored by an F-test on the residual and by the drop of the cross-validated
+residual of a linear fit (the same folds). The best significant candidate is added, everything is
+refitted, and its cross-validated RMS must fall; otherwise, or when no candidate is significant, the
+search stops.
+
+A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
+candidates; effects are _core.Effect objects.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Protocol, Sequence
+
+import numpy as np
+
+from .. import _core
+
+#: how many of a round's candidates (best cross-validated gain first) the history lists and the
+#: verdict weighs
+LISTED = 8
+
+#: residual r (dims per point), the current model's free columns Jc and a candidate's columns R
+Linearisation = Callable[["_core.Effect"], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+class Problem(Protocol):
+    """What the engine needs of a mechanism and its measurements."""
+
+    @property
+    def dims(self) -> int:
+        """Coordinates per measured point (3: a serial robot's x, y, z; 2: the five-bar's x, y)."""
+        ...
+
+    @property
+    def folds(self) -> Sequence[np.ndarray]:
+        """Boolean masks of the held-out points, one per fold (a partition of the points)."""
+        ...
+
+    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+        """Errors (one row per point) of the held points, the model with ``effects`` fitted on the others."""
+        ...
+
+    def linearise(self, effects: list) -> Linearisation:
+        """The model with ``effects`` fitted on every point, linearised for each candidate."""
+        ...
+
+    def describe(self, effect: "_core.Effect") -> dict:
+        """The names of an effect in diagnosis.json: ``{"effect": NAME, "joint": k or None, ...}``."""
+        ...
+
+    def label(self, effect: "_core.Effect") -> str:
+        """An effect in words (e.g. "backlash(joint 2)")."""
+        ...
+
+    def model_label(self, effects: list) -> str:
+        """The model with ``effects`` in words (e.g. "geometry + backlash(joint 2)")."""
+        ...
+
+
+def cv_rms(problem: Problem, effects: list) -> float:
+    """Cross-validated RMS point error (mm): fit on the other folds, predict each fold."""
+    sq, n = 0.0, 0
+    for held in problem.folds:
+        e = problem.held_errors(effects, held)
+        sq += float(np.sum(e ** 2))
+        n += len(e)
+    return math.sqrt(sq / n)
+
+
+def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray]) -> dict:
+    """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
+    (``row_folds``: the held-out residual rows of each fold). Columns the span absorbs are dropped;
+    a candidate absorbed whole scores nothing."""
+    from scipy.stats import f as fdist
+
+    Q, _ = np.linalg.qr(Jc)
+    Rp = R - Q @ (Q.T @ R)
+    keep = np.linalg.norm(Rp, axis=0) > 1e-9 * max(1.0, float(np.linalg.norm(R)))
+    if not keep.any():
+        return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": True}
+    Rp = Rp[:, keep]
+    k = Rp.shape[1]
+    beta, *_ = np.linalg.lstsq(Rp, r, rcond=None)
+    rss0, rss1 = float(r @ r), float(np.sum((r - Rp @ beta) ** 2))
+    dof = len(r) - Jc.shape[1] - k
+    F = ((rss0 - rss1) / k) / (rss1 / dof) if rss1 > 0 and dof > 0 else math.inf
+    p = float(fdist.sf(F, k, dof)) if math.isfinite(F) else 0.0
+    before = after = 0.0
+    for h in row_folds:
+        b, *_ = np.linalg.lstsq(Rp[~h], r[~h], rcond=None)
+        before += float(r[h] @ r[h])
+        after += float(np.sum((r[h] - Rp[h] @ b) ** 2))
+    gain = 1.0 - math.sqrt(after / before) if before > 0 else 0.0
+    return {"F": float(F), "p_value": p, "cv_gain": gain, "absorbed": False, "parameters": int(k)}
+
+
+@dataclass
+class Search:
+    """What the search found: the effects added to the starting ones (in order) and the model's
+    cross-validated RMS; ``history`` (each model, its CV RMS and its LISTED best candidates),
+    ``last_scores`` (the LISTED best candidates of the last round, best gain first; empty when the
+    search stopped at its step limit)."""
+    effects: list
+    steps: list
+    history: list
+    cv_rms_mm: float
+    last_scores: list
+
+
+def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: float = 1e-6, min_gain: float = 0.03,
+           max_steps: int = 6, say: Callable[[str], None] = lambda s: None) -> Search:
+    """The greedy search from the model with the ``start`` effects: at most ``max_steps`` effects of
+    ``candidates`` added, each significant (F-test p below ``alpha``), gaining more than ``min_gain``
+    in the linear cross-validation, and lowering the refitted model's cross-validated RMS."""
+    effects = list(start)
+    row_folds = [np.repeat(m, problem.dims) for m in problem.folds]
+    say(f"fitting the starting model ({problem.model_label(effects)})")
+    cur = cv_rms(problem, effects)
+    history: list[dict[str, Any]] = [{"model": problem.model_label(effects), "cv_rms_mm": cur}]
+    steps: list[dict[str, Any]] = []
+    scored: list[dict[str, Any]] = []
+    for _ in range(max_steps):
+        regressors = problem.linearise(effects)
+        scored = []
+        for c in candidates:
+            if any(e.name == c.name and e.joint == c.joint for e in effects):
+                continue
+            s = score(*regressors(c), row_folds)
+            s.update(problem.describe(c))
+            s["_cand"] = c
+            scored.append(s)
+        scored.sort(key=lambda s: -s["cv_gain"])
+        history[-1]["candidates"] = [{k: v for k, v in s.items() if k != "_cand"} for s in scored[:LISTED]]
+        sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
+        if not sig:
+            break
+        best = sig[0]
+        cand = best["_cand"]
+        say(f"step {len(steps) + 1}: {problem.label(cand)} (F = {best['F']:.3g}, cross-validated gain "
+            f"{best['cv_gain']:.1%}); refitting")
+        new = cv_rms(problem, effects + [cand])
+        if new >= cur:
+            history[-1]["rejected"] = dict(problem.describe(cand), cv_rms_mm=new)
+            break
+        runners_up = [dict(problem.describe(s["_cand"]), cv_gain_linear=s["cv_gain"], p_value=s["p_value"])
+                      for s in scored[1:4]]
+        steps.append(dict(problem.describe(cand),
+                          evidence={"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
+                                    "cv_gain_linear": best["cv_gain"], "runners_up": runners_up},
+                          rms_before_mm=cur, rms_after_mm=new))
+        effects, cur = effects + [cand], new
+        history.append({"model": problem.model_label(effects), "cv_rms_mm": cur})
+        scored = []
+    return Search(effects=effects, steps=steps, history=history, cv_rms_mm=cur, last_scores=scored[:LISTED])
+
+
+def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int, noise_mm: Optional[float],
+             alpha: float = 1e-6, say: Callable[[str], None] = lambda s: None) -> dict:
+    """The verdict on what remains, from the final model's point errors fitted on every point
+    (``errors``, ``n_params`` free parameters). noise_rms_mm: with ``noise_mm`` (the instrument's
+    noise per coordinate, if known) its RMS per point; otherwise the final fit's own scatter, an
+    upper bound of the noise. "At the noise level" when the cross-validated RMS is within 1.3 times
+    the known noise, or, with the noise unknown, when no candidate of the last round (of the LISTED
+    best) is even significant."""
+    dims = problem.dims
+    scatter = math.sqrt(float(np.sum(errors ** 2)) / max(1, dims * len(errors) - n_params)) * math.sqrt(dims)
+    left = [s for s in found.last_scores if s["p_value"] < alpha]
+    if noise_mm is not None:
+        noise = noise_mm * math.sqrt(dims)
+        at_noise = found.cv_rms_mm <= 1.3 * noise
+    else:
+        noise = scatter
+        at_noise = not left
+    if at_noise:
+        verdict = "what remains is at the noise level"
+    else:
+        gains = ", ".join(f"{problem.label(s['_cand'])} {s['cv_gain']:.1%}" for s in left[:3])
+        verdict = ("what remains is structured but not explained by the library"
+                   + (f" (significant candidates gain too little: {gains})" if left else ""))
+    say(f"{len(found.steps)} effect(s) named; cross-validated RMS {found.cv_rms_mm * 1000:.1f} um, noise estimate "
+        f"{noise * 1000:.1f} um: {verdict}")
+    return {"noise_rms_mm": noise, "noise_known": noise_mm is not None, "fit_scatter_mm": scatter, "verdict": verdict}
+
+
+def contract_json(diag: dict) -> dict:
+    """diagnosis.json: the contract's keys and the evidence, without the fitted objects (an infinite
+    F statistic, from a perfect fit, is written as null: JSON has no infinity)."""
+    def clean(x):
+        if isinstance(x, float) and not math.isfinite(x):
+            return None
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v) for v in x]
+        return x
+    return clean({k: v for k, v in diag.items() if not k.startswith("_")})

@@ -1,0 +1,220 @@
+"""The diagnosis of a serial robot (`kincal diagnose --robot R`): its candidate effects from the
+registry (joint_compliance, transmission_error, backlash, thermal_expansion, per joint where it
+concerns one), its refit (Ceres, C++ core) and its linearisation (the columns a candidate's
+parameters would add to the identification Jacobian at the current fit), for the engine's search;
+then the final model identified on all the data, and the files of the command.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Callable, Optional, Sequence, Union
+
+import numpy as np
+
+from .. import _core
+from .. import identify as ident
+from .._core import Robot
+from . import engine
+
+
+def _needs_column(kind) -> str:
+    """The measurement-set key of the column an effect kind reads ('' when none)."""
+    return "dir" if kind.needs == "dir" else kind.needs
+
+
+def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, list]:
+    """Every candidate effect (a _core.Effect per joint where it applies, from the registry) the data
+    can support, and notes on those skipped. Effects of ``start`` (the model the diagnosis starts
+    from) are no candidates."""
+    out, notes = [], []
+    have = {(e.name, e.joint) for e in start}
+    for kind in _core.effect_kinds():
+        if kind.domain != "serial":
+            continue
+        col = _needs_column(kind)
+        if col == "dir" and col not in data:
+            notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
+            continue
+        if col == "temperature_c" and (col not in data or np.ptp(data[col]) <= 0.5):
+            notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
+            continue
+        if col and col not in data:
+            notes.append(f"{kind.name} skipped: the data have no {col} column")
+            continue
+        joints = ident.applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
+        out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
+    return out, notes
+
+
+class Spec:
+    """The model under test: its effects (joint_compliance per joint included) and the fit's options."""
+
+    def __init__(self, effects: Sequence = (), **fit_options):
+        self.effects: list = list(effects)
+        self.fit_options = dict(fit_options)
+
+    def with_(self, cand) -> "Spec":
+        return Spec(self.effects + [cand], **self.fit_options)
+
+    def has(self, cand) -> bool:
+        return any(e.name == cand.name and e.joint == cand.joint for e in self.effects)
+
+    @property
+    def compliance(self) -> list:
+        return [e.joint for e in self.effects if e.name == "joint_compliance"]
+
+    def label(self) -> str:
+        return " + ".join(["geometry"] + [e.label for e in self.effects])
+
+    def fit(self, robot: Robot, data: dict) -> "_core.IdentifyResult":
+        return _core.identify(robot, data, ident.options(self.effects, covariance=False, **self.fit_options))
+
+    def errors(self, res, data: dict) -> np.ndarray:
+        return _core.point_errors(res.robot, res.targets, data)
+
+
+def _key(p) -> tuple:
+    return (p.kind, p.joint, p.target, p.name)
+
+
+def _regressors(robot: Robot, res, data: dict, spec: Spec, cand):
+    """Residual r (3n), the current model's free columns and the candidate's columns at the fit."""
+    layout = res.layout
+    extra = list(layout.effect_list) + ([cand] if cand.name != "joint_compliance" else [])
+    pm = _core.PointModel(res.robot, len(res.targets), extra, res.t_ref, True)
+    new = pm.layout.parameters
+    old = {_key(p): p.index for p in layout.parameters}
+    x = np.zeros(len(new))
+    fit_x = np.asarray(res.x)
+    for p in new:
+        # geometry, tool and base are corrections to the calibrated model (zero); compliances,
+        # targets and effect values are absolute
+        if p.kind not in ("joint_geometry", "tool", "base") and _key(p) in old:
+            x[p.index] = fit_x[old[_key(p)]]
+    r, J = pm.residuals(list(x), data, True)
+    fixed = np.asarray(res.fixed)
+    cur_cols = [p.index for p in new if _key(p) in old and not fixed[old[_key(p)]]]
+    kind = "compliance" if cand.name == "joint_compliance" else cand.name
+    cand_cols = [p.index for p in new if p.kind == kind and p.joint == cand.joint
+                 and (kind == "compliance" or _key(p) not in old)]
+    return np.asarray(r), np.asarray(J)[:, cur_cols], np.asarray(J)[:, cand_cols]
+
+
+class SerialProblem:
+    """The diagnosis problem of a serial robot (engine.Problem): its measurements, folds of poses
+    and the identification options of every fit."""
+
+    dims = 3
+
+    def __init__(self, robot: Robot, data: dict, folds: list, fit_options: dict):
+        self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit_options
+
+    def spec(self, effects: Sequence) -> Spec:
+        return Spec(effects, **self.fit_options)
+
+    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+        spec = self.spec(effects)
+        res = spec.fit(self.robot, ident.subset(self.data, ~held))
+        return spec.errors(res, ident.subset(self.data, held))
+
+    def linearise(self, effects: list) -> engine.Linearisation:
+        spec = self.spec(effects)
+        res = spec.fit(self.robot, self.data)
+        return lambda cand: _regressors(self.robot, res, self.data, spec, cand)
+
+    def describe(self, effect) -> dict:
+        return {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
+
+    def label(self, effect) -> str:
+        return effect.label
+
+    def model_label(self, effects: list) -> str:
+        return self.spec(effects).label()
+
+
+def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03,
+             max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
+             progress: Optional[Callable[[str], None]] = None, effects: Sequence = (), loss: str = "huber",
+             loss_scale_mm: float = 0.1, orientation_weight: float = 100.0) -> dict:
+    """The workflow (engine.search, then engine.conclude); returns the diagnosis.json of the
+    contract (plus details for the report).
+
+    ``effects``: the model the diagnosis starts from besides the geometry (Effect objects or texts of
+    ``--effects``); they are no candidates. ``loss``, ``loss_scale_mm``, ``orientation_weight``:
+    identify's options, used in every fit. ``noise_mm``: the instrument's noise per coordinate, if
+    known (see engine.conclude)."""
+    say = progress or (lambda s: None)
+    start_effects = ident.check_effects(effects, robot)
+    ident.check_data_for(start_effects, data, robot)
+    cands, notes = candidates(robot, data, start_effects)
+    fit_options = dict(loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
+    problem = SerialProblem(robot, data, ident.folds(data, folds, seed), fit_options)
+    found = engine.search(problem, start_effects, cands, alpha=alpha, min_gain=min_gain, max_steps=max_steps, say=say)
+    spec = problem.spec(found.effects)
+    final = spec.fit(robot, data)
+    concl = engine.conclude(problem, found, spec.errors(final, data), int(np.sum(~np.asarray(final.fixed))), noise_mm,
+                            alpha, say)
+    final_model = {"effects": [{"effect": x.name, "joint": x.joint or None, "label": x.label} for x in spec.effects],
+                   "started_from": [x.label for x in start_effects]}
+    return {"steps": found.steps, "final_rms_mm": found.cv_rms_mm, "noise_rms_mm": concl["noise_rms_mm"],
+            "noise_known": concl["noise_known"], "fit_scatter_mm": concl["fit_scatter_mm"],
+            "verdict": concl["verdict"], "notes": notes, "history": found.history, "folds": folds,
+            "final_model": final_model, "_final_fit": final, "_spec": spec, "_start": problem.spec(start_effects)}
+
+
+def final_identification(robot: Robot, data: dict, diag: dict,
+                         tool_targets: Optional[np.ndarray] = None) -> "ident.Identification":
+    """The diagnosed model (every named effect and those it started from), identified on all the data
+    with Ceres as `kincal identify` does (covariance included), ready for model.json; with
+    ``tool_targets`` (the targets' offsets in the tool frame) the TCP is placed as identify's
+    --tool-targets does."""
+    spec: Spec = diag["_spec"]
+    res = ident.identify(robot, data, effects=spec.effects, holdout=0.0, **spec.fit_options)
+    res.validation = {"scheme": f"fitted on every row; cross-validated ({diag['folds']} folds) in the diagnosis",
+                      "held_rows": 0, "fit_rows": int(len(data["pose"])),
+                      "diagnosis_cv_rms_mm": diag["final_rms_mm"]}
+    if tool_targets is not None:
+        res = ident.tool_from_targets(res, tool_targets)
+    return res
+
+
+def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_targets: Optional[np.ndarray] = None,
+        progress: Optional[Callable[[str], None]] = None, **options) -> tuple[dict, "ident.Identification"]:
+    """`kincal diagnose`: the diagnosis (``options``: those of diagnose()), the final model identified
+    on all the data, and in the folder ``out`` report.html with its figures, diagnosis.json and
+    model.json. Returns the diagnosis and the final identification."""
+    from .serial_report import write_report
+
+    say = progress or (lambda s: None)
+    diag = diagnose(robot, data, progress=progress, **options)
+    say("identifying the final model on all the data")
+    model = final_identification(robot, data, diag, tool_targets)
+    diag["final_model"]["file"] = "model.json"
+    diag["final_model"]["parameters"] = [
+        {"effect": e.name, "joint": e.joint or None, "label": e.label,
+         "values": [v * sc for v, sc in zip(vals, e.file_scale)], "units": e.file_units}
+        for e, vals in model.robot.effects]
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    write_report(robot, data, diag, folder, title=title, model_file="model.json")
+    _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
+    _core.write_file_atomic(str(folder / "model.json"), model.model_json())
+    return diag, model
+
+
+def summary(diag: dict, model: "ident.Identification", out: Union[str, Path], seconds: float) -> str:
+    """`kincal diagnose`'s summary of run()'s results: each named effect, the final verdict and the
+    files written in ``out``."""
+    folder = Path(out)
+    lines = []
+    for st in diag["steps"]:
+        j = f" joint {st['joint']}" if st["joint"] else ""
+        lines.append(f"{st['effect']}{j}: cross-validated RMS {st['rms_before_mm'] * 1000:.1f} -> "
+                     f"{st['rms_after_mm'] * 1000:.1f} um (F = {st['evidence']['F']:.3g})")
+    lines.append(f"final cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um, noise estimate "
+                 f"{diag['noise_rms_mm'] * 1000:.1f} um: {diag['verdict']} ({seconds:.1f} s); "
+                 f"report: {folder / 'report.html'}; model ({' + '.join(['geometry'] + model.effect_labels())}): "
+                 f"{folder / 'model.json'}")
+    return "\n".join(lines)

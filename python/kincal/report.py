@@ -1,0 +1,56 @@
+"""The HTML report pages of kincal (`kincal diagnose`, its five-bar form, `kincal demo`): one page
+skeleton with one stylesheet, tables, and figures (PNG files beside the page, embedded by
+reference). Every page sets ``data-images-loaded="loaded/total"`` on its body once the browser has
+loaded it, so a headless browser can check that every figure shows."""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+from typing import Any, Iterable, Sequence, Union
+
+from . import _core
+
+STYLE = """body{font-family:sans-serif;max-width:980px;margin:2em auto;color:#222;line-height:1.4}
+table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:3px 8px}
+table.num td,table.num th{text-align:right}
+img{max-width:100%}code{background:#f3f3f3}"""
+
+# counts the figures that loaded (checked by the demo test in a headless browser)
+_IMAGES_LOADED = """window.addEventListener("load", () => { const i = [...document.images];
+document.body.setAttribute("data-images-loaded", i.filter(x => x.complete && x.naturalWidth > 0).length + "/" + i.length);
+});"""
+
+
+def esc(text: Any) -> str:
+    """Text (any value, by str) escaped for HTML."""
+    return html.escape(str(text))
+
+
+def page(title: str, body: str) -> str:
+    """A whole HTML page: ``title`` in the head, ``body`` (HTML) as it is."""
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{esc(title)}</title>
+<style>{STYLE}</style>
+<script>{_IMAGES_LOADED}</script></head><body>
+{body.rstrip()}
+</body></html>
+"""
+
+
+def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = False) -> str:
+    """A table of escaped cells; ``numeric``: the cells right-aligned (columns of numbers)."""
+    h = "".join(f"<th>{esc(x)}</th>" for x in header)
+    b = "".join("<tr>" + "".join(f"<td>{esc(x)}</td>" for x in r) + "</tr>" for r in rows)
+    cls = ' class="num"' if numeric else ""
+    return f"<table{cls}><tr>{h}</tr>{b}</table>"
+
+
+def figure(src: str, alt: str) -> str:
+    """A figure: the image file ``src`` (relative to the page)."""
+    return f'<figure><img src="{esc(src)}" alt="{esc(alt)}"></figure>'
+
+
+def write(path: Union[str, Path], title: str, body: str) -> None:
+    """The page written atomically to ``path``."""
+    _core.write_file_atomic(str(path), page(title, body))

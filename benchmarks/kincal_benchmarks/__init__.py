@@ -21,10 +21,10 @@ def run(poses: int = 2000, seed: int = 1, threads: int = 0, identify_poses: int 
     """Every benchmark: ``poses`` random configurations for the core's (``threads`` batch threads,
     0: all cores), ``identify_poses`` for the identification; ``identify`` False skips the
     identification and the diagnosis. Adds ``bench_seconds``, the whole run's time."""
-    from kincal import _core
+    from . import _bench
 
     t0 = time.perf_counter()
-    r = dict(_core.run_benchmarks(poses, seed, threads))
+    r = dict(_bench.run_benchmarks(poses, seed, threads))
     if identify:
         r.update(bench_identify(identify_poses, seed))
     r.update(bench_feed(seed))

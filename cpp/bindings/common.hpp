@@ -14,6 +14,5 @@ void define_kinematics(py::module_& m);
 void define_compensation(py::module_& m);
 void define_io(py::module_& m);
 void define_feed(py::module_& m);
-void define_bench(py::module_& m);
 void define_identify(py::module_& m);
 void define_fivebar(py::module_& m);

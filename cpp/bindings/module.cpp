@@ -11,7 +11,6 @@ PYBIND11_MODULE(_core, m) {
   define_compensation(m);
   define_io(m);
   define_feed(m);
-  define_bench(m);
   define_identify(m);
   define_fivebar(m);
 }

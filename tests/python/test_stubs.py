@@ -12,9 +12,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def test_stubs_match_the_module():
+@pytest.mark.parametrize("module", ["kincal._core", "kincal_benchmarks._bench"])
+def test_stubs_match_the_module(module):
     pytest.importorskip("mypy")
-    r = subprocess.run([sys.executable, "-m", "mypy.stubtest", "kincal._core", "--allowlist",
+    r = subprocess.run([sys.executable, "-m", "mypy.stubtest", module, "--allowlist",
                         str(ROOT / "tests" / "stubtest_allowlist.txt")], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-2000:]
 

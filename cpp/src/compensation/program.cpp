@@ -65,8 +65,8 @@ PoseSolution compensate_from(const Robot& robot, const ProgramOptions& opt, cons
     const VecQ a = q0 * kDeg;
     const Eigen::Isometry3d at_q0 = approximate_start ? fk(nom, a) : target;
     const Eigen::Isometry3d e = at_q0.inverse() * fk_model(cal, a, ctx);
-    const IkSolutions s2 = ik_all(nom, target * e.inverse(), q0.data(), false, true);
-    const int k2 = ik_nearest(nom, s2, q0.data());
+    const IkSolutions s2 = robot.ik().solve(target * e.inverse(), IkOptions(q0, Branches::NearestReference));
+    const int k2 = s2.nearest(q0.data());
     if (k2 >= 0) q0 = s2.sol[k2].q_deg;
   }
   const CompensationResult r = compensate(cal, pose, q0, opt.comp, ctx);
@@ -79,16 +79,17 @@ PoseSolution compensate_from(const Robot& robot, const ProgramOptions& opt, cons
 // nearest first, when the nearest one's compensated solution is not inside the limits.
 PoseSolution solve_closed_form(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
                                const EffectContext& ctx) {
-  const Model& nom = *robot.nominal;
+  const IkSolver& ik = robot.ik();
   const Eigen::Isometry3d target = pose_to_iso(pose);
   // the branch nearest the reference first; all branches when it is out of limits
-  IkSolutions s = ik_all(nom, target, ref.data(), false, true);
+  IkSolutions s = ik.solve(target, IkOptions(ref, Branches::NearestReference));
   bool all = false;
-  if (s.status != IkStatus::Ok || !s.sol[0].within_limits) s = ik_all(nom, target, ref.data()), all = true;
+  if (s.status != IkStatus::Ok || !s.sol[0].within_limits) s = ik.solve(target, IkOptions(ref)), all = true;
   // a calibrated robot may reach a little beyond the nominal one: start from the nearest
-  if (s.status != IkStatus::Ok && opt.compensate) s = ik_all(nom, target, ref.data(), true), all = true;
+  if (s.status != IkStatus::Ok && opt.compensate)
+    s = ik.solve(target, IkOptions(ref, Branches::All, OutOfReach::Nearest)), all = true;
   if (s.status != IkStatus::Ok) return failed("pose out of reach of the robot (no inverse-kinematics solution)");
-  const int k = ik_nearest(nom, s, ref.data());
+  const int k = s.nearest(ref.data());
   if (!opt.compensate) {
     if (k < 0) return failed("no inverse-kinematics solution within the joint limits");
     PoseSolution sol;
@@ -106,7 +107,7 @@ PoseSolution solve_closed_form(const Robot& robot, const ProgramOptions& opt, co
   // the nearest branch does not give a compensated solution inside the limits: the others, nearest
   // first (a nominal solution a little outside the limits may come inside once compensated)
   const Vec6 tried = k >= 0 ? s.sol[k].q_deg : Vec6::Constant(1e300);
-  if (!all) s = ik_all(nom, target, ref.data(), false, false);
+  if (!all) s = ik.solve(target, IkOptions(ref));
   std::array<int, 8> order;
   std::array<double, 8> dist;
   for (int i = 0; i < s.count; ++i) order[i] = i, dist[i] = (s.sol[i].q_deg - ref).cwiseAbs().maxCoeff();

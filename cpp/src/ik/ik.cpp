@@ -416,14 +416,5 @@ int IkSolutions::nearest(const double* ref_deg) const {
   return best;
 }
 
-// TRANSITIONAL: removed at merge
-IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg, bool nearest_if_unreachable,
-                   bool nearest_branch) {
-  return IkSolver(m).solve(target, IkOptions(ref_deg, nearest_branch ? Branches::NearestReference : Branches::All,
-                                             nearest_if_unreachable ? OutOfReach::Nearest : OutOfReach::NoSolution));
-}
-
-// TRANSITIONAL: removed at merge
-int ik_nearest(const Model&, const IkSolutions& s, const double* ref_deg) { return s.nearest(ref_deg); }
 
 }  // namespace kincal

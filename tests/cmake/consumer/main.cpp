@@ -9,6 +9,7 @@
 #include "kincal/ik/ik.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 #include "kincal/model/model.hpp"
+#include "kincal/model/robots.hpp"
 
 int main() {
   const kincal::Model model(kincal::kr500_spec());
@@ -23,7 +24,7 @@ int main() {
   kdl.JntToCart(qk, f);
   double d = 0;
   for (int i = 0; i < 3; ++i) d = std::max(d, std::abs(f.p(i) - t.translation()[i]));
-  const auto sols = kincal::ik_all(model, t);
+  const auto sols = kincal::IkSolver(model).solve(t);
   double best = 1e9;
   for (int s = 0; s < sols.count; ++s) best = std::min(best, (sols.sol[s].q_deg - q / kincal::kDeg).cwiseAbs().maxCoeff());
   std::printf("kincal consumer: fk vs KDL %.3g mm, IK round trip %.3g deg\n", d, best);

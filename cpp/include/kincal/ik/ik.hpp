@@ -116,11 +116,4 @@ class IkSolver {
   std::array<double, 6> lo_{}, hi_{};  ///< joint limits (deg) widened by 1e-9
 };
 
-// TRANSITIONAL: removed at merge. The former free functions, for the callers not yet moved to
-// IkSolver (compensation, kincal-compensate); each ik_all call builds a solver from the model.
-IkSolutions ik_all(const Model& m, const Eigen::Isometry3d& target, const double* ref_deg = nullptr,
-                   bool nearest_if_unreachable = false, bool nearest_branch = false);
-// TRANSITIONAL: removed at merge (use IkSolutions::nearest).
-int ik_nearest(const Model& m, const IkSolutions& s, const double* ref_deg);
-
 }  // namespace kincal

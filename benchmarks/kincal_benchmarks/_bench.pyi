@@ -1,0 +1,3 @@
+"""kincal's C++ benchmarks (benchmarks/bindings.cpp): our code and KDL's solvers timed in one run."""
+
+def run_benchmarks(n: int = ..., seed: int = ..., threads: int = ...) -> dict[str, float]: ...

@@ -162,4 +162,15 @@ void define_kinematics(py::module_& m) {
       },
       py::arg("robot"), py::arg("pose"), py::arg("ref_deg") = py::none(),
       "Every closed-form IK solution of the nominal model for a pose x,y,z,a,b,c; [] when out of reach");
+  m.def(
+      "ik_nearest",
+      [](const Robot& r, const Vec6& pose, const Vec6& ref) -> std::optional<int> {
+        if (!pose.allFinite() || !ref.allFinite()) throw InputError("pose or reference contains NaN or infinite values");
+        const IkSolutions s = r.ik().solve(pose_to_iso(Pose6{pose.head<3>(), pose.tail<3>()}), IkOptions(ref));
+        const int k = s.nearest(ref.data());
+        if (k < 0) return std::nullopt;
+        return k;
+      },
+      py::arg("robot"), py::arg("pose"), py::arg("ref_deg"),
+      "Index in ik_all(robot, pose, ref_deg) of the solution within the limits nearest ref_deg; None when none");
 }

@@ -81,15 +81,6 @@ def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: st
     _core.write_file_atomic(out, format_rows(head, rows))
 
 
-def ik_nearest(solutions: list, ref_deg: np.ndarray) -> Optional[dict]:
-    """Of ik()'s solutions, the one within the joint limits nearest ``ref_deg`` (least sum of squared
-    differences, as the core's ik_nearest picks); None when none is within the limits."""
-    ok = [s for s in solutions if s["within_limits"]]
-    if not ok:
-        return None
-    return min(ok, key=lambda s: float(np.sum((np.asarray(s["q_deg"]) - ref_deg) ** 2)))
-
-
 def ik_file(robot: _core.Robot, robot_arg: str, poses_path: str, out: str, every: bool = False) -> None:
     """`kincal ik`: nominal closed-form IK of the pose program ``poses_path`` written to ``out``, each
     pose's solution nearest the previous one (the first nearest the robot's home); ``every``: all
@@ -105,10 +96,10 @@ def ik_file(robot: _core.Robot, robot_arg: str, poses_path: str, out: str, every
             raise ValueError(f"{poses_path}:{line}: pose out of reach of the robot (no IK solution)")
         if every:
             rows += [[i, k, int(s["within_limits"])] + list(s["q_deg"]) for k, s in enumerate(sols)]
-        best = ik_nearest(sols, np.asarray(ref))
+        best = _core.ik_nearest(robot, np.asarray(pose, dtype=float), np.asarray(ref, dtype=float))
         if best is None:
             raise ValueError(f"{poses_path}:{line}: no IK solution within the joint limits")
-        ref = list(best["q_deg"])
+        ref = list(sols[best]["q_deg"])
         if not every:
             rows.append(ref)
     qn = [f"q{j + 1}" for j in range(robot.dof)]

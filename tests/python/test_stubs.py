@@ -15,8 +15,10 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.mark.parametrize("module", ["kincal._core", "kincal_benchmarks._bench"])
 def test_stubs_match_the_module(module):
     pytest.importorskip("mypy")
-    r = subprocess.run([sys.executable, "-m", "mypy.stubtest", module, "--allowlist",
-                        str(ROOT / "tests" / "stubtest_allowlist.txt")], capture_output=True, text=True, timeout=300)
+    # the allowlist names what stubtest cannot check in the core (pybind11's generated members)
+    allow = ["--allowlist", str(ROOT / "tests" / "stubtest_allowlist.txt")] if module == "kincal._core" else []
+    r = subprocess.run([sys.executable, "-m", "mypy.stubtest", module, *allow], capture_output=True, text=True,
+                       timeout=300)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-2000:]
 
 

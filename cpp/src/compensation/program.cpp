@@ -119,6 +119,7 @@ PoseSolution solve_closed_form(const Robot& robot, const ProgramOptions& opt, co
     PoseSolution other = compensate_from(robot, opt, pose, target, c.q_deg, c.approximate, ctx);
     if (other.ok()) {
       other.status = PoseStatus::BranchChanged;
+      other.error = std::move(nearest.error);  // why the nearest branch did not do
       return other;
     }
   }
@@ -217,7 +218,10 @@ PoseSolution next_pose(const Robot& robot, const ProgramOptions& opt, const Pose
       c2.dir = turned;
       PoseSolution s2 = solve_pose(robot, opt, pose, cur.prev, c2);
       if (!s2.ok()) return s2;
-      if (s.branch_changed()) s2.status = PoseStatus::BranchChanged;
+      if (s.branch_changed() && !s2.branch_changed()) {
+        s2.status = PoseStatus::BranchChanged;
+        s2.error = std::move(s.error);
+      }
       s = std::move(s2);
       // the directions the commanded motion really has (a move inside the backlash keeps its sign)
       for (int j = 0; j < 6; ++j) {

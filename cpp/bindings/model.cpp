@@ -1,6 +1,6 @@
 #include "common.hpp"
 
-#include "kincal/identify/identify.hpp"
+#include "kincal/identify/simulate.hpp"
 #include "kincal/model/model.hpp"
 
 #include <array>

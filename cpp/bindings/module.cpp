@@ -9,6 +9,7 @@ PYBIND11_MODULE(_core, m) {
   define_model(m);
   define_kinematics(m);
   define_programs(m);
+  define_measurements(m);
   define_identify(m);
   define_fivebar(m);
 }

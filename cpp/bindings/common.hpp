@@ -1,4 +1,5 @@
-// Shared declarations of the _core bindings: one define_<area> per area, gathered in module.cpp.
+// Shared declarations of the _core bindings: one define_<area> per area, gathered in module.cpp,
+// and the helpers several areas use.
 #pragma once
 
 #include <pybind11/eigen.h>
@@ -8,11 +9,37 @@
 
 namespace py = pybind11;
 
+namespace kincal {
+struct MeasurementSet;
+}
+
 void define_effects(py::module_& m);
 void define_model(py::module_& m);
 void define_kinematics(py::module_& m);
 void define_compensation(py::module_& m);
 void define_io(py::module_& m);
 void define_feed(py::module_& m);
+void define_measurements(py::module_& m);
 void define_identify(py::module_& m);
 void define_fivebar(py::module_& m);
+
+/// A measurement set as the dict of numpy arrays Python sees, and back (measurements.cpp).
+py::dict measurements_to_dict(const kincal::MeasurementSet& m, int dof);
+kincal::MeasurementSet measurements_from_dict(const py::dict& d, int dof);
+
+inline void dict_put(py::dict&) {}
+
+template <class T, class... Rest>
+void dict_put(py::dict& d, const char* key, const T& value, const Rest&... rest) {
+  d[key] = value;
+  dict_put(d, rest...);
+}
+
+/// A dict of named values, Eigen vectors and matrices as numpy arrays: dict_of("id", id, "line",
+/// line). Records cross the boundary so (measurement sets, five-bar points).
+template <class... KeyValues>
+py::dict dict_of(const KeyValues&... key_values) {
+  py::dict d;
+  dict_put(d, key_values...);
+  return d;
+}

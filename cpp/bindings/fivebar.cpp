@@ -24,14 +24,7 @@ py::dict points_to(const std::vector<FiveBarPoint>& pts) {
     des.row(i) = pts[i].desired.transpose();
     mea.row(i) = pts[i].measured.transpose();
   }
-  py::dict d;
-  d["id"] = id;
-  d["theta1_deg"] = t1;
-  d["theta2_deg"] = t2;
-  d["desired"] = des;
-  d["measured"] = mea;
-  d["line"] = line;
-  return d;
+  return dict_of("id", id, "theta1_deg", t1, "theta2_deg", t2, "desired", des, "measured", mea, "line", line);
 }
 
 std::vector<FiveBarPoint> points_from(const py::dict& d) {

@@ -1,107 +1,19 @@
-// Bindings of measurement campaigns and identification. A measurement set crosses the boundary as
-// a dict of numpy arrays: pose (n), q_deg (n x dof), xyz (n x 3), target (n), payload_kg (n, NaN
-// for the model's payload), line (n: source line, 0 when simulated).
+// Bindings of simulated campaigns, the identification's measurement model and identify(). Measurement
+// sets cross the boundary as dicts of numpy arrays (measurements.cpp).
 #include "common.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <optional>
 #include <tuple>
 
 #include "kincal/identify/identify.hpp"
+#include "kincal/identify/simulate.hpp"
 #include "kincal/model/model.hpp"
 
 using namespace kincal;
 
 namespace {
-
-
-py::dict to_dict(const MeasurementSet& m, int dof) {
-  const size_t n = m.rows.size();
-  Eigen::VectorXi pose(n), target(n), line(n);
-  RowMatrix q(n, dof), xyz(n, 3);
-  Eigen::VectorXd pay(n), temp(n);
-  const bool dir = n > 0 && m.rows[0].dir.size() == dof;
-  RowMatrix dirs(dir ? n : 0, dof);
-  for (size_t i = 0; i < n; ++i) {
-    temp[i] = m.rows[i].temperature_c;
-    if (dir) dirs.row(i) = m.rows[i].dir.transpose();
-    const Measurement& r = m.rows[i];
-    pose[i] = r.pose;
-    target[i] = r.target;
-    line[i] = r.line;
-    q.row(i) = r.q_deg.transpose();
-    xyz.row(i) = r.xyz.transpose();
-    pay[i] = r.payload_kg;
-  }
-  py::dict d;
-  d["pose"] = pose;
-  d["q_deg"] = q;
-  d["xyz"] = xyz;
-  d["target"] = target;
-  d["payload_kg"] = pay;
-  d["line"] = line;
-  d["source"] = m.source;
-  if (!std::isnan(temp.sum())) d["temperature_c"] = temp;
-  if (m.orientation) {
-    RowMatrix abc(n, 3);
-    for (size_t i = 0; i < n; ++i) abc.row(i) = m.rows[i].abc.transpose();
-    d["abc"] = abc;
-  }
-  if (dir) d["dir"] = dirs;
-  return d;
-}
-
-MeasurementSet from_dict(const py::dict& d, int dof) {
-  const auto pose = d["pose"].cast<Eigen::VectorXi>();
-  const auto q = d["q_deg"].cast<RowMatrix>();
-  const auto xyz = d["xyz"].cast<RowMatrix>();
-  const size_t n = pose.size();
-  const Eigen::VectorXi target =
-      d.contains("target") ? d["target"].cast<Eigen::VectorXi>() : Eigen::VectorXi::Zero(n).eval();
-  Eigen::VectorXd pay = Eigen::VectorXd::Constant(n, std::nan(""));
-  if (d.contains("payload_kg")) pay = d["payload_kg"].cast<Eigen::VectorXd>();
-  Eigen::VectorXi line = Eigen::VectorXi::Zero(n);
-  if (d.contains("line")) line = d["line"].cast<Eigen::VectorXi>();
-  MeasurementSet m;
-  m.source = d.contains("source") ? d["source"].cast<std::string>() : std::string("<data>");
-  if (static_cast<size_t>(q.rows()) != n || static_cast<size_t>(xyz.rows()) != n || xyz.cols() != 3 ||
-      static_cast<size_t>(target.size()) != n || static_cast<size_t>(pay.size()) != n)
-    throw InputError(m.source + ": measurement arrays of different lengths");
-  if (q.cols() != dof)
-    throw InputError(m.source + ": " + std::to_string(q.cols()) + " joint angles per row but the robot has " +
-                     std::to_string(dof));
-  int nt = 1;
-  for (size_t i = 0; i < n; ++i) {
-    Measurement r;
-    r.pose = pose[i];
-    r.q_deg = q.row(i).transpose();
-    r.xyz = xyz.row(i).transpose();
-    r.target = target[i];
-    if (r.target < 0) throw InputError(m.source + ": negative target");
-    r.payload_kg = pay[i];
-    r.line = line[i];
-    nt = std::max(nt, r.target + 1);
-    m.rows.push_back(r);
-  }
-  if (d.contains("temperature_c")) {
-    const auto t = d["temperature_c"].cast<Eigen::VectorXd>();
-    if (static_cast<size_t>(t.size()) != n) throw InputError(m.source + ": temperature_c of a different length");
-    for (size_t i = 0; i < n; ++i) m.rows[i].temperature_c = t[i];
-  }
-  if (d.contains("abc")) {
-    const auto a = d["abc"].cast<RowMatrix>();
-    if (static_cast<size_t>(a.rows()) != n || a.cols() != 3) throw InputError(m.source + ": abc of a different shape");
-    for (size_t i = 0; i < n; ++i) m.rows[i].has_abc = true, m.rows[i].abc = a.row(i).transpose();
-    m.orientation = true;
-  }
-  if (d.contains("dir")) {
-    const auto dd = d["dir"].cast<RowMatrix>();
-    if (static_cast<size_t>(dd.rows()) != n || dd.cols() != dof) throw InputError(m.source + ": dir of a different shape");
-    for (size_t i = 0; i < n; ++i) m.rows[i].dir = dd.row(i).transpose();
-  }
-  m.n_targets = nt;
-  return m;
-}
 
 std::vector<EffectValue> effect_values_from(const std::vector<std::pair<Effect, std::vector<double>>>& e) {
   std::vector<EffectValue> out;
@@ -118,6 +30,19 @@ py::list effect_values_to(const std::vector<EffectValue>& e) {
   py::list l;
   for (const auto& v : e) l.append(py::make_tuple(v.effect, v.p));
   return l;
+}
+
+/// Joint numbers from 1 (Python) to indices from 0 (the core), and back.
+std::vector<int> joints_from_one(const std::vector<int>& joints) {
+  std::vector<int> j;
+  for (int k : joints) j.push_back(k - 1);
+  return j;
+}
+
+std::vector<int> joints_to_one(const std::vector<int>& joints) {
+  std::vector<int> j;
+  for (int k : joints) j.push_back(k + 1);
+  return j;
 }
 
 std::vector<Vec3> targets_from(const RowMatrix& t) {
@@ -215,33 +140,16 @@ IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
 
 void define_identify(py::module_& m) {
   m.def(
-      "read_measurements", [](const std::string& path, int dof) { return to_dict(read_measurements(path, dof), dof); },
-      py::arg("path"), py::arg("dof"));
-  m.def(
-      "parse_measurements",
-      [](const std::string& text, const std::string& src, int dof) { return to_dict(parse_measurements(text, src, dof), dof); },
-      py::arg("text"), py::arg("source") = "<text>", py::arg("dof") = 6);
-  m.def(
-      "format_measurements",
-      [](const py::dict& d, int dof) { return format_measurements(from_dict(d, dof), dof); }, py::arg("data"),
-      py::arg("dof"));
-  m.def(
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
          const RowMatrix& targets, double limit_margin, const std::vector<std::pair<Effect, std::vector<double>>>& effects,
          double t_ref, double orientation_noise_deg) {
         SimulationOptions o;
-        o.orientation_noise_deg = orientation_noise_deg;
-        o.effects = effect_values_from(effects);
-        o.t_ref = t_ref;
-        o.poses = poses;
-        o.seed = seed;
-        o.noise_mm = noise_mm;
-        o.outlier_fraction = outlier_fraction;
-        o.outlier_mm = outlier_mm;
-        o.targets = targets_from(targets);
-        o.limit_margin = limit_margin;
-        return to_dict(simulate(*truth.calibrated, o), truth.calibrated->dof());
+        o.poses = poses, o.seed = seed, o.limit_margin = limit_margin;
+        o.noise_mm = noise_mm, o.orientation_noise_deg = orientation_noise_deg;
+        o.outlier_fraction = outlier_fraction, o.outlier_mm = outlier_mm;
+        o.targets = targets_from(targets), o.effects = effect_values_from(effects), o.t_ref = t_ref;
+        return measurements_to_dict(simulate(*truth.calibrated, o), truth.calibrated->dof());
       },
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
@@ -252,7 +160,7 @@ void define_identify(py::module_& m) {
   m.def(
       "point_errors",
       [](const Robot& r, const RowMatrix& targets, const py::dict& d) {
-        const auto e = point_errors(*r.calibrated, targets_from(targets), from_dict(d, r.calibrated->dof()));
+        const auto e = point_errors(*r.calibrated, targets_from(targets), measurements_from_dict(d, r.calibrated->dof()));
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("targets"), py::arg("data"),
@@ -269,26 +177,27 @@ void define_identify(py::module_& m) {
       .def_readonly("effect", &Parameter::effect, "the effect it belongs to (None for the others)")
       .def("__repr__", [](const Parameter& p) { return "<Parameter " + std::to_string(p.index) + " " + p.name + ">"; });
 
-  py::class_<ParamLayout>(m, "ParamLayout", "Layout of the identification parameter vector")
-      .def_readonly("dof", &ParamLayout::dof)
-      .def_readonly("n_targets", &ParamLayout::n_targets)
-      .def_readonly("size", &ParamLayout::size)
-      .def_readonly("joints", &ParamLayout::joints, "offset of the joint geometry (4 per joint)")
-      .def_readonly("compliance", &ParamLayout::compliance, "offset of the compliances (1 per gravity-loaded joint)")
-      .def_readonly("tool", &ParamLayout::tool, "offset of the tool frame (6)")
-      .def_readonly("base", &ParamLayout::base, "offset of the base frame in the instrument frame (6)")
-      .def_readonly("targets", &ParamLayout::targets, "offset of the target offsets (3 per target)")
-      .def_readonly("effects", &ParamLayout::effects, "offset of the extra effects' parameters")
+  py::class_<ParamLayout> layout(m, "ParamLayout", "Layout of the identification parameter vector");
+  // its sizes, and the offsets of the parts of the vector in their order
+  const std::tuple<const char*, int ParamLayout::*, const char*> sizes_and_offsets[] = {
+      {"dof", &ParamLayout::dof, "number of joints"},
+      {"n_targets", &ParamLayout::n_targets, "number of targets"},
+      {"size", &ParamLayout::size, "number of parameters"},
+      {"joints", &ParamLayout::joints, "offset of the joint geometry (4 per joint)"},
+      {"compliance", &ParamLayout::compliance, "offset of the compliances (1 per gravity-loaded joint)"},
+      {"tool", &ParamLayout::tool, "offset of the tool frame (6)"},
+      {"base", &ParamLayout::base, "offset of the base frame in the instrument frame (6)"},
+      {"targets", &ParamLayout::targets, "offset of the target offsets (3 per target)"},
+      {"effects", &ParamLayout::effects, "offset of the extra effects' parameters"}};
+  for (const auto& [name, field, doc] : sizes_and_offsets) layout.def_readonly(name, field, doc);
+  layout
       .def_readonly("effect_list", &ParamLayout::effect_list, "the extra effects, in order")
       .def_readonly("effect_offset", &ParamLayout::effect_offset, "offset of each extra effect")
-      .def_readonly("t_ref", &ParamLayout::t_ref)
-      .def_property_readonly("loaded", [](const ParamLayout& L) {
-             std::vector<int> j;
-             for (int k : L.loaded) j.push_back(k + 1);
-             return j;
-           }, "joints (from 1) with a compliance parameter: the gravity-loaded ones")
-      .def_readonly("names", &ParamLayout::names)
-      .def_readonly("units", &ParamLayout::units)
+      .def_readonly("t_ref", &ParamLayout::t_ref, "reference temperature of thermal_expansion (degC)")
+      .def_property_readonly("loaded", [](const ParamLayout& L) { return joints_to_one(L.loaded); },
+                             "joints (from 1) with a compliance parameter: the gravity-loaded ones")
+      .def_readonly("names", &ParamLayout::names, "one per parameter, e.g. 'joint3.tilt_u', 'base.ry'")
+      .def_readonly("units", &ParamLayout::units, "one per parameter: 'rad', 'mm', 'deg/kNm', ...")
       .def_property_readonly("parameters", &parameters_of)
       .def(
           "indices",
@@ -310,19 +219,11 @@ void define_identify(py::module_& m) {
                        double rank_tolerance, double weak_tolerance, double min_torque_share,
                        double correlation_threshold) {
              IdentifyOptions o;
-             o.compliance = compliance;
-             o.loss = loss;
-             o.loss_scale_mm = loss_scale_mm;
-             o.max_iterations = max_iterations;
-             o.fix = fix;
-             for (int j : compliance_joints) o.compliance_joints.push_back(j - 1);
-             o.effects = effects;
-             o.covariance = covariance;
-             o.orientation_weight = orientation_weight;
-             o.rank_tolerance = rank_tolerance;
-             o.weak_tolerance = weak_tolerance;
-             o.min_torque_share = min_torque_share;
-             o.correlation_threshold = correlation_threshold;
+             o.compliance = compliance, o.compliance_joints = joints_from_one(compliance_joints), o.effects = effects;
+             o.loss = loss, o.loss_scale_mm = loss_scale_mm, o.max_iterations = max_iterations;
+             o.fix = fix, o.covariance = covariance, o.orientation_weight = orientation_weight;
+             o.rank_tolerance = rank_tolerance, o.weak_tolerance = weak_tolerance;
+             o.min_torque_share = min_torque_share, o.correlation_threshold = correlation_threshold;
              return o;
            }),
            py::arg("compliance") = def.compliance, py::arg("loss") = def.loss,
@@ -335,24 +236,20 @@ void define_identify(py::module_& m) {
       .def_readwrite("compliance", &IdentifyOptions::compliance, "identify the joint compliances")
       .def_readwrite("loss", &IdentifyOptions::loss, "'none', 'huber' or 'cauchy'")
       .def_readwrite("loss_scale_mm", &IdentifyOptions::loss_scale_mm, "where the robust loss bends (mm)")
-      .def_readwrite("max_iterations", &IdentifyOptions::max_iterations)
-      .def_readwrite("rank_tolerance", &IdentifyOptions::rank_tolerance)
-      .def_readwrite("min_torque_share", &IdentifyOptions::min_torque_share)
-      .def_readwrite("weak_tolerance", &IdentifyOptions::weak_tolerance)
-      .def_readwrite("correlation_threshold", &IdentifyOptions::correlation_threshold)
+      .def_readwrite("max_iterations", &IdentifyOptions::max_iterations, "Levenberg-Marquardt iterations at most")
+      .def_readwrite("rank_tolerance", &IdentifyOptions::rank_tolerance,
+                     "a unit Jacobian column closer than this to the others' span is redundant (held)")
+      .def_readwrite("min_torque_share", &IdentifyOptions::min_torque_share,
+                     "the compliance of a joint with less gravity torque than this share of the largest is held")
+      .def_readwrite("weak_tolerance", &IdentifyOptions::weak_tolerance,
+                     "a unit column closer than this is so weakly seen that it is held too")
+      .def_readwrite("correlation_threshold", &IdentifyOptions::correlation_threshold,
+                     "correlations at least this large (in absolute value) are reported")
       .def_readwrite("covariance", &IdentifyOptions::covariance, "standard deviations and correlations")
       .def_readwrite("fix", &IdentifyOptions::fix, "parameter names held in any case")
       .def_property(
-          "compliance_joints",
-          [](const IdentifyOptions& o) {
-            std::vector<int> j;
-            for (int k : o.compliance_joints) j.push_back(k + 1);
-            return j;
-          },
-          [](IdentifyOptions& o, const std::vector<int>& j) {
-            o.compliance_joints.clear();
-            for (int k : j) o.compliance_joints.push_back(k - 1);
-          },
+          "compliance_joints", [](const IdentifyOptions& o) { return joints_to_one(o.compliance_joints); },
+          [](IdentifyOptions& o, const std::vector<int>& j) { o.compliance_joints = joints_from_one(j); },
           "with compliance: only these joints (from 1; empty: every gravity-loaded joint)")
       .def_readwrite("effects", &IdentifyOptions::effects,
                      "effects identified with the rest (assign a whole list); joint_compliance entries turn\n"
@@ -420,7 +317,7 @@ void define_identify(py::module_& m) {
       [](const Robot& robot, const py::dict& d, const IdentifyOptions& options, py::object progress,
          bool from_calibrated) {
         const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
-        const MeasurementSet data = from_dict(d, nominal.dof());
+        const MeasurementSet data = measurements_from_dict(d, nominal.dof());
         IdentifyOptions o = core_options(options, nominal);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
         PyIdentifyResult out{identify(nominal, data, o), Robot{}, Robot{}};
@@ -444,23 +341,21 @@ void define_identify(py::module_& m) {
       .def_property_readonly("layout", [](const PointModel& p) -> const ParamLayout& { return p.layout(); },
                              py::return_value_policy::reference_internal)
       .def_property_readonly("names", [](const PointModel& p) { return p.layout().names; })
-      .def("start", [](const PointModel& p, const py::dict& d) { return p.start(from_dict(d, p.layout().dof)); },
+      .def("start", [](const PointModel& p, const py::dict& d) { return p.start(measurements_from_dict(d, p.layout().dof)); },
            py::arg("data"))
       .def(
           "residuals",
           [](PointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
-            const MeasurementSet data = from_dict(d, p.layout().dof);
+            const MeasurementSet data = measurements_from_dict(d, p.layout().dof);
             if (static_cast<int>(x.size()) != p.layout().size) throw InputError("PointModel: wrong parameter count");
             p.prepare_payloads(data);
             p.set_params(x);
-            const int P = p.layout().size, RS = data.orientation ? 6 : 3;
-            Eigen::VectorXd r(RS * data.rows.size());
-            RowMatrix J(jac ? RS * data.rows.size() : 0, P);
-            std::vector<double> full(6 * static_cast<size_t>(P));
-            for (size_t i = 0; i < data.rows.size(); ++i) {
-              row_residuals(p, data.rows[i], weight, RS == 6, r.data() + RS * i, jac ? full.data() : nullptr);
-              if (jac) std::copy_n(full.data(), RS * P, J.data() + RS * i * P);
-            }
+            const size_t n = residual_size(residual_kind(data)) * data.rows.size();
+            std::vector<int> every(p.layout().size);
+            std::iota(every.begin(), every.end(), 0);
+            Eigen::VectorXd r(n);
+            RowMatrix J(jac ? n : 0, p.layout().size);
+            all_residuals(p, data, weight, every, r.data(), jac ? J.data() : nullptr);
             return py::make_tuple(r, J);
           },
           py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0);

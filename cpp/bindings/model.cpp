@@ -1,7 +1,6 @@
 #include "common.hpp"
 
-#include "kincal/identify/identify.hpp"
-#include "kincal/ik/ik.hpp"
+#include "kincal/identify/simulate.hpp"
 #include "kincal/io/model_json.hpp"
 #include "kincal/model/model.hpp"
 #include "kincal/model/robots.hpp"

@@ -11,6 +11,7 @@ PYBIND11_MODULE(_core, m) {
   define_compensation(m);
   define_io(m);
   define_feed(m);
+  define_measurements(m);
   define_identify(m);
   define_fivebar(m);
 }

@@ -1,0 +1,111 @@
+// Bindings of measurement files. A measurement set crosses the boundary as a dict of numpy arrays:
+// pose (n), q_deg (n x dof), xyz (n x 3), target (n), payload_kg (n, NaN for the model's payload),
+// line (n: source line, 0 when simulated), source; when the set has them also temperature_c (n),
+// abc (n x 3: the measured orientations) and dir (n x dof: the joints' directions of motion).
+#include "common.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kincal/io/measurements.hpp"
+
+using namespace kincal;
+
+py::dict measurements_to_dict(const MeasurementSet& m, int dof) {
+  const size_t n = m.rows.size();
+  Eigen::VectorXi pose(n), target(n), line(n);
+  RowMatrix q(n, dof), xyz(n, 3);
+  Eigen::VectorXd pay(n), temp(n);
+  const bool dir = n > 0 && m.rows[0].dir.size() == dof;
+  RowMatrix dirs(dir ? n : 0, dof);
+  for (size_t i = 0; i < n; ++i) {
+    temp[i] = m.rows[i].temperature_c;
+    if (dir) dirs.row(i) = m.rows[i].dir.transpose();
+    const Measurement& r = m.rows[i];
+    pose[i] = r.pose;
+    target[i] = r.target;
+    line[i] = r.line;
+    q.row(i) = r.q_deg.transpose();
+    xyz.row(i) = r.xyz.transpose();
+    pay[i] = r.payload_kg;
+  }
+  py::dict d = dict_of("pose", pose, "q_deg", q, "xyz", xyz, "target", target, "payload_kg", pay, "line", line,
+                       "source", m.source);
+  if (!std::isnan(temp.sum())) d["temperature_c"] = temp;
+  if (m.orientation) {
+    RowMatrix abc(n, 3);
+    for (size_t i = 0; i < n; ++i) abc.row(i) = m.rows[i].abc.transpose();
+    d["abc"] = abc;
+  }
+  if (dir) d["dir"] = dirs;
+  return d;
+}
+
+MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
+  const auto pose = d["pose"].cast<Eigen::VectorXi>();
+  const auto q = d["q_deg"].cast<RowMatrix>();
+  const auto xyz = d["xyz"].cast<RowMatrix>();
+  const size_t n = pose.size();
+  const Eigen::VectorXi target =
+      d.contains("target") ? d["target"].cast<Eigen::VectorXi>() : Eigen::VectorXi::Zero(n).eval();
+  Eigen::VectorXd pay = Eigen::VectorXd::Constant(n, std::nan(""));
+  if (d.contains("payload_kg")) pay = d["payload_kg"].cast<Eigen::VectorXd>();
+  Eigen::VectorXi line = Eigen::VectorXi::Zero(n);
+  if (d.contains("line")) line = d["line"].cast<Eigen::VectorXi>();
+  MeasurementSet m;
+  m.source = d.contains("source") ? d["source"].cast<std::string>() : std::string("<data>");
+  if (static_cast<size_t>(q.rows()) != n || static_cast<size_t>(xyz.rows()) != n || xyz.cols() != 3 ||
+      static_cast<size_t>(target.size()) != n || static_cast<size_t>(pay.size()) != n)
+    throw InputError(m.source + ": measurement arrays of different lengths");
+  if (q.cols() != dof)
+    throw InputError(m.source + ": " + std::to_string(q.cols()) + " joint angles per row but the robot has " +
+                     std::to_string(dof));
+  int nt = 1;
+  for (size_t i = 0; i < n; ++i) {
+    Measurement r;
+    r.pose = pose[i];
+    r.q_deg = q.row(i).transpose();
+    r.xyz = xyz.row(i).transpose();
+    r.target = target[i];
+    if (r.target < 0) throw InputError(m.source + ": negative target");
+    r.payload_kg = pay[i];
+    r.line = line[i];
+    nt = std::max(nt, r.target + 1);
+    m.rows.push_back(r);
+  }
+  if (d.contains("temperature_c")) {
+    const auto t = d["temperature_c"].cast<Eigen::VectorXd>();
+    if (static_cast<size_t>(t.size()) != n) throw InputError(m.source + ": temperature_c of a different length");
+    for (size_t i = 0; i < n; ++i) m.rows[i].temperature_c = t[i];
+  }
+  if (d.contains("abc")) {
+    const auto a = d["abc"].cast<RowMatrix>();
+    if (static_cast<size_t>(a.rows()) != n || a.cols() != 3) throw InputError(m.source + ": abc of a different shape");
+    for (size_t i = 0; i < n; ++i) m.rows[i].has_abc = true, m.rows[i].abc = a.row(i).transpose();
+    m.orientation = true;
+  }
+  if (d.contains("dir")) {
+    const auto dd = d["dir"].cast<RowMatrix>();
+    if (static_cast<size_t>(dd.rows()) != n || dd.cols() != dof) throw InputError(m.source + ": dir of a different shape");
+    for (size_t i = 0; i < n; ++i) m.rows[i].dir = dd.row(i).transpose();
+  }
+  m.n_targets = nt;
+  return m;
+}
+
+void define_measurements(py::module_& m) {
+  m.def(
+      "read_measurements",
+      [](const std::string& path, int dof) { return measurements_to_dict(read_measurements(path, dof), dof); },
+      py::arg("path"), py::arg("dof"));
+  m.def(
+      "parse_measurements",
+      [](const std::string& text, const std::string& src, int dof) {
+        return measurements_to_dict(parse_measurements(text, src, dof), dof);
+      },
+      py::arg("text"), py::arg("source") = "<text>", py::arg("dof") = 6);
+  m.def(
+      "format_measurements",
+      [](const py::dict& d, int dof) { return format_measurements(measurements_from_dict(d, dof), dof); },
+      py::arg("data"), py::arg("dof"));
+}

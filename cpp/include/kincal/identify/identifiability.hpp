@@ -1,0 +1,43 @@
+// kincal: which identification parameters the data can determine. Before the solve, parameters
+// are held (fixed at their start value, with the reason) where nothing lets the data see them
+// (targets never measured, compliances not asked for or of joints the poses barely load, those
+// held by request) and where the unit-scaled Jacobian shows them redundant or too weakly seen
+// (greedy selection of independent columns in a preferred order); data that leave redundant what a
+// generic campaign determines are an input error. After the solve: the condition number and the
+// observability index of the free parameters.
+#pragma once
+
+#include "kincal/identify/identify.hpp"
+
+#include <vector>
+
+namespace kincal {
+
+/// Fix what the options and the measured poses rule out: targets never measured, compliances not
+/// asked for (opt.compliance, opt.compliance_joints) or of a joint with less than
+/// opt.min_torque_share of the largest gravity torque over the poses, and the parameters named in
+/// opt.fix (InputError for an unknown name).
+void fix_unobservable(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
+                      IdentifyResult& res);
+
+/// The Jacobian of every parameter (a row per residual, as all_residuals) and the residuals of a
+/// measurement set at one parameter vector.
+struct Linearization {
+  Eigen::MatrixXd jacobian;
+  std::vector<double> residuals;
+};
+
+/// Fix what the data cannot determine at x: the greedy selection of independent unit-scaled
+/// Jacobian columns (opt.rank_tolerance: redundant, opt.weak_tolerance: too weakly seen), on the
+/// data and on a generic campaign (100 random poses in the limits of the nominal model, the targets
+/// measured, the same kind of rows). Throws InputError when the data leave redundant what the
+/// generic campaign determines (too few or too similar poses). Returns the data's linearization at
+/// x (pm's parameters are then x).
+Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
+                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res);
+
+/// The condition number and the observability index of the free parameters (the unit-scaled
+/// Jacobian at res.x), into res.
+void observability(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res);
+
+}  // namespace kincal

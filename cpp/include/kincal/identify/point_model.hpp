@@ -1,0 +1,136 @@
+// kincal: the measurement model of identification and its analytic Jacobian (step 3 of the Samak
+// paper): the layout of the parameter vector, PointModel (one row's predicted point and tool frame
+// for a parameter vector) and the residuals of a row and of a whole measurement set.
+//
+// Measurement model: a point measured in the instrument's frame is
+//   y = B * P(q + K tau(q)) * M * t_k
+// with B the robot base seen from the instrument, P the product of exponentials of the joint lines,
+// K tau the joint deflection under gravity, M the tool frame at the zero configuration and t_k the
+// offset of target (reflector) k in the tool frame.
+//
+// Parameters (all relative to the nominal model, so zero is the nominal):
+//   per joint 4: axis tilt along u and v (rad; w' = normalise(w + a_u u + a_v v)) and the axis moved
+//                along u and v (mm), with u, v unit vectors normal to the nominal axis;
+//   per gravity-loaded joint 1: compliance (deg per kN m, absolute);
+//   tool 6: translation (mm) and rotation vector (rad, R = R0 Exp(phi));
+//   base 6: the same for the base frame in the instrument frame;
+//   per target 3: offset in the tool frame (mm, absolute);
+//   per extra effect (transmission_error 2 per harmonic order, backlash 1, thermal_expansion 1), see
+//   effects.hpp (the registry).
+// Rows with a measured orientation (a, b, c) add 3 residuals: the weighted rotation vector from the
+// measured to the predicted tool frame.
+#pragma once
+
+#include "kincal/io/measurements.hpp"
+#include "kincal/model/model.hpp"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace kincal {
+
+/// Layout of the identification parameter vector for a model and a number of targets.
+struct ParamLayout {
+  int dof = 0, n_targets = 0;
+  int joints = 0, compliance = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
+  std::vector<int> loaded;            ///< joint of every compliance parameter
+  std::vector<Effect> effect_list;    ///< extra effects, their parameters from `effects` on
+  std::vector<int> effect_offset;
+  double t_ref = 20.0;
+  std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry"
+  std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm"
+  ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0);
+};
+
+/// Evaluates the measurement model and its analytic Jacobian for one parameter vector.
+class PointModel {
+ public:
+  PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0);
+  const ParamLayout& layout() const { return layout_; }
+  /// Set the parameters (size layout().size); builds the current model.
+  void set_params(const std::vector<double>& x);
+  /// Build the model variants for the payloads named in the data (payload_kg column).
+  void prepare_payloads(const MeasurementSet& data);
+  /// The current geometry as a model spec (base_in_instrument and tool included).
+  ModelSpec spec() const;
+  /// Jacobian columns of the base frame and targets only (the others left zero), for fitting the frames.
+  /// With the data, every row's flange frame is computed here once and reused while only the frames
+  /// move (set_params must not change the robot's own parameters until it is switched off).
+  void set_frames_only(bool on, const MeasurementSet* data = nullptr);
+  /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.
+  /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
+  /// (instrument frame) per parameter.
+  Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
+  /// Starting parameters: nominal geometry, base frame from the best rigid fit (Horn) of the
+  /// nominal prediction of target 0 at the tool point, targets at the tool point.
+  std::vector<double> start(const MeasurementSet& data) const;
+
+ private:
+  const Model& nominal_;
+  ParamLayout layout_;
+  std::vector<Vec3> u_, v_;
+  std::vector<double> x_;
+  bool frames_only_ = false;
+  struct Flange {
+    Mat3 r;
+    Vec3 t;
+    double scale;
+  };
+  std::vector<Flange> flange_;          ///< per row of flange_rows_, while frames_only_
+  const Measurement* flange_rows_ = nullptr;
+  const Flange* cached_flange(const Measurement& m) const;
+  ModelSpec spec_;
+  std::shared_ptr<const Model> current_;
+  std::vector<std::pair<double, std::shared_ptr<const Model>>> payload_models_;
+  Mat3 rb_, rm_, jrb_, jrm_;
+  Vec3 tb_, tm_;
+  std::vector<Vec3> w_, p_;
+  const Model& model_for(double payload) const;
+  void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;
+  /// Gravity at the commanded angles: frames, centres of mass, moment arms and joint torques.
+  struct GravityState {
+    std::array<Mat3, kMaxJoints + 1> gr;
+    std::array<Vec3, kMaxJoints + 1> gt, S;
+    std::array<double, kMaxJoints + 1> M;
+    std::array<Vec3, kMaxJoints> wc, oc, arm;
+    std::array<double, kMaxJoints> tau{};
+    Vec3 cp;
+    double mp = 0;
+  };
+  void gravity_state(const Model& model, const Measurement& m, GravityState& gs) const;
+  /// The joint frames G_0..G_n of row m with compliance and effects acting, and the thermal scale.
+  void row_frames(const Model& model, const Measurement& m, GravityState& gs, std::array<Mat3, kMaxJoints + 1>& gr,
+                  std::array<Vec3, kMaxJoints + 1>& gt, double& scale) const;
+  void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
+                        const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const;
+};
+
+/// What the residual of a row holds: its point (3 position components, mm) or its full pose (the
+/// same and 3 orientation components). The value is the number of residuals.
+enum class ResidualKind { position = 3, pose = 6 };
+
+/// The number of residuals of a row of that kind.
+constexpr int residual_size(ResidualKind kind) { return static_cast<int>(kind); }
+
+/// The residual kind of every row of a set: pose when it carries measured orientations.
+inline ResidualKind residual_kind(const MeasurementSet& data) {
+  return data.orientation ? ResidualKind::pose : ResidualKind::position;
+}
+
+/// The residual of one row (3 position components in mm; for a pose 3 more: orientation_weight
+/// times the rotation vector log(R_measured^T R_model)) and, when J is not null, its Jacobian
+/// (row-major, rows x size; J must hold 6 x size). Returns the number of residuals.
+int row_residuals(const PointModel& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
+                  double* J);
+
+/// The residuals of every row of data at pm's parameters (residual_size(residual_kind(data)) per
+/// row, in order, into r; r null: not kept) and, when J is not null, the Jacobian's columns
+/// `columns` in that order (row-major: a row per residual, columns.size() wide). The rows are
+/// evaluated on all cores; nothing is allocated per row.
+void all_residuals(const PointModel& pm, const MeasurementSet& data, double orientation_weight,
+                   const std::vector<int>& columns, double* r, double* J);
+
+}  // namespace kincal

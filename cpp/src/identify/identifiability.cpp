@@ -1,0 +1,238 @@
+// kincal: which identification parameters the data can determine (held before the solve), and the
+// condition number and observability index of the free ones after it.
+#include "kincal/identify/identifiability.hpp"
+
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <random>
+#include <set>
+
+namespace kincal {
+
+namespace {
+
+/// J^T J with only its lower triangle filled (half the work of the product; what a self-adjoint
+/// solver reads).
+Eigen::MatrixXd normal_matrix_lower(const Eigen::MatrixXd& j) {
+  Eigen::MatrixXd n = Eigen::MatrixXd::Zero(j.cols(), j.cols());
+  n.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose());
+  return n;
+}
+
+/// Which targets the data measure (by target index).
+std::vector<bool> measured_targets(const MeasurementSet& data) {
+  std::vector<bool> used(data.n_targets, false);
+  for (const auto& r : data.rows) used[r.target] = true;
+  return used;
+}
+
+int count_poses(const MeasurementSet& d) {
+  std::set<int> ids;
+  for (const auto& r : d.rows) ids.insert(r.pose);
+  return static_cast<int>(ids.size());
+}
+
+/// A compliance is only identifiable where gravity loads its joint: below min_torque_share of the
+/// largest joint's torque over the measured poses it is held (its effect is lost in the geometry).
+void fix_unloaded_compliances(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
+                              IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  std::vector<double> tmax(L.dof, 0.0);
+  VecQ tau;
+  for (const auto& r : data.rows) {
+    gravity_torque(nominal, r.q_deg * kDeg, tau);
+    for (int j = 0; j < L.dof; ++j) tmax[j] = std::max(tmax[j], std::abs(tau[j]));
+  }
+  const double top = *std::max_element(tmax.begin(), tmax.end());
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int j = L.loaded[i];
+    if (tmax[j] < opt.min_torque_share * top) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "gravity torque too small to see it (at most %.3g N m, %.1f%% of joint %d's)",
+                    tmax[j] / 1000.0, 100.0 * tmax[j] / top,
+                    static_cast<int>(std::max_element(tmax.begin(), tmax.end()) - tmax.begin()) + 1);
+      res.fix(L.compliance + static_cast<int>(i), buf);
+    }
+  }
+}
+
+/// The order in which the greedy selection keeps parameters: targets, compliances, extra effects,
+/// the joint lines from the second on, then the frames and the first joint line (what is left of
+/// them is a gauge of the others).
+std::vector<int> preference_order(const ParamLayout& L, bool orientation) {
+  std::vector<int> order;
+  for (int i = L.targets; i < L.effects; ++i) order.push_back(i);
+  for (int i = L.compliance; i < L.tool; ++i) order.push_back(i);
+  for (int i = L.effects; i < L.size; ++i) order.push_back(i);
+  for (int j = 1; j < L.dof; ++j)
+    for (int k = 0; k < 4; ++k) order.push_back(4 * j + k);
+  // with measured orientations the tool's rotation is seen: keep it, hold the base's gauge instead
+  if (orientation)
+    for (int i = L.tool + 3; i < L.tool + 6; ++i) order.push_back(i);
+  for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
+  for (int k = 0; k < 4; ++k) order.push_back(k);
+  for (int i = L.tool; i < L.tool + (orientation ? 3 : 6); ++i) order.push_back(i);
+  return order;
+}
+
+/// Greedy selection on the normal matrix of J's unit-scaled columns in order: the squared distance
+/// of column i from the span of the chosen ones is N_ii - N_iS N_SS^-1 N_Si (an incremental
+/// Cholesky factor). A column without effect, too close to the span or only weakly out of it is fixed.
+void select_independent(const Eigen::MatrixXd& J, const std::vector<int>& order, const IdentifyOptions& opt,
+                        IdentifyResult& res) {
+  const int P = static_cast<int>(J.cols());
+  Eigen::VectorXd nrm = J.colwise().norm().transpose();
+  Eigen::MatrixXd N = normal_matrix_lower(J);
+  N.triangularView<Eigen::StrictlyUpper>() = N.transpose();
+  for (int a = 0; a < P; ++a)
+    for (int b = 0; b < P; ++b) N(a, b) /= (nrm[a] > 0 ? nrm[a] : 1.0) * (nrm[b] > 0 ? nrm[b] : 1.0);
+  std::vector<int> chosen;
+  Eigen::MatrixXd Lc(P, P);  // rows: chosen index k; Lc(k, i) = component of column i on chosen k
+  for (int i : order) {
+    if (res.fixed[i]) continue;
+    if (nrm[i] == 0) {
+      res.fix(i, "no effect on the measured points");
+      continue;
+    }
+    double left2 = N(i, i);
+    const int k = static_cast<int>(chosen.size());
+    Eigen::VectorXd li(k);
+    for (int a = 0; a < k; ++a) {
+      double v = N(chosen[a], i);
+      for (int b = 0; b < a; ++b) v -= Lc(b, chosen[a]) * li[b];
+      li[a] = v / Lc(a, chosen[a]);
+      left2 -= li[a] * li[a];
+    }
+    const double left = std::sqrt(std::max(0.0, left2));
+    if (left < opt.rank_tolerance) {
+      res.fix(i, "not identifiable: a combination of the other parameters");
+      continue;
+    }
+    if (left < opt.weak_tolerance) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "barely identifiable: only %.1e of its effect is not a combination of the others", left);
+      res.fix(i, buf);
+      continue;
+    }
+    for (int a = 0; a < k; ++a) Lc(a, i) = li[a];
+    Lc(k, i) = left;
+    chosen.push_back(i);
+  }
+}
+
+/// A generic campaign: 100 random poses in the joint limits, every measured target, the same kind
+/// of rows (J_r^-1 keeps the rank for any abc) and temperatures drawn from the data.
+MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data) {
+  const int dof = nominal.dof();
+  const std::vector<bool> measured = measured_targets(data);
+  MeasurementSet generic;
+  generic.n_targets = data.n_targets;
+  generic.orientation = data.orientation;
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> ud(-0.45, 0.45);
+  for (int p = 0; p < 100; ++p) {
+    Measurement row;
+    row.pose = p;
+    row.q_deg.resize(dof);
+    for (int j = 0; j < dof; ++j) {
+      const JointSpec& js = nominal.spec().joints[j];
+      row.q_deg[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg);
+    }
+    row.dir.resize(dof);
+    for (int j = 0; j < dof; ++j) row.dir[j] = ud(rng) < 0 ? -1.0 : 1.0;
+    row.temperature_c = data.rows[rng() % data.rows.size()].temperature_c;
+    row.has_abc = data.orientation;
+    for (int t = 0; t < data.n_targets; ++t)
+      if (measured[t]) row.target = t, generic.rows.push_back(row);
+  }
+  return generic;
+}
+
+/// The Jacobian of every parameter and the residuals of data at x (set on pm).
+Linearization linearize(PointModel& pm, const MeasurementSet& data, const std::vector<double>& x, double weight) {
+  pm.set_params(x);
+  const int P = pm.layout().size;
+  const size_t n = residual_size(residual_kind(data)) * data.rows.size();
+  std::vector<int> every(P);
+  std::iota(every.begin(), every.end(), 0);
+  RowMatrix J(n, P);
+  Linearization lin;
+  lin.residuals.assign(n, 0.0);
+  all_residuals(pm, data, weight, every, lin.residuals.data(), J.data());
+  lin.jacobian = J;
+  return lin;
+}
+
+}  // namespace
+
+void fix_unobservable(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
+                      IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  const std::vector<bool> measured = measured_targets(data);
+  for (int t = 0; t < data.n_targets; ++t)
+    if (!measured[t])
+      for (int k = 0; k < 3; ++k) res.fix(L.targets + 3 * t + k, "target never measured");
+  if (!opt.compliance)
+    for (int i = L.compliance; i < L.tool; ++i) res.fix(i, "not asked for (--effects)");
+  else if (!opt.compliance_joints.empty())
+    for (size_t i = 0; i < L.loaded.size(); ++i) {
+      const auto& asked = opt.compliance_joints;
+      if (std::find(asked.begin(), asked.end(), L.loaded[i]) == asked.end())
+        res.fix(L.compliance + static_cast<int>(i), "not in the model");
+    }
+  if (opt.compliance && !L.loaded.empty()) fix_unloaded_compliances(nominal, data, opt, res);
+  for (const auto& name : opt.fix) {
+    auto it = std::find(L.names.begin(), L.names.end(), name);
+    if (it == L.names.end()) throw InputError("identify: no parameter named '" + name + "'");
+    res.fix(static_cast<int>(it - L.names.begin()), "held by request");
+  }
+}
+
+Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
+                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  const std::vector<int> order = preference_order(L, data.orientation);
+  // what the generic campaign determines but the data do not means the data are too few or too alike
+  IdentifyResult generic = res;
+  select_independent(linearize(pm, generic_campaign(nominal, data), x, opt.orientation_weight).jacobian, order, opt,
+                     generic);
+  Linearization lin = linearize(pm, data, x, opt.orientation_weight);
+  select_independent(lin.jacobian, order, opt, res);
+  std::string missing;
+  int n_missing = 0;
+  // only what the data make exactly redundant counts (near the weak threshold the two may differ)
+  for (int i = 0; i < L.size; ++i)
+    if (res.fixed[i] && !generic.fixed[i] && res.fixed_reason[i].rfind("not identifiable", 0) == 0)
+      missing += (n_missing++ ? ", " : "") + L.names[i];
+  if (n_missing)
+    throw InputError(data.source + ": the " + std::to_string(data.rows.size()) + " measured points of " +
+                     std::to_string(count_poses(data)) + " poses cannot determine " + missing +
+                     ": too few or too similar poses to identify the model");
+  return lin;
+}
+
+void observability(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
+  const Eigen::MatrixXd J = linearize(pm, data, res.x, opt.orientation_weight).jacobian;
+  std::vector<int> free_idx;
+  for (int i = 0; i < res.layout.size; ++i)
+    if (!res.fixed[i]) free_idx.push_back(i);
+  Eigen::MatrixXd Jf(J.rows(), free_idx.size());
+  for (size_t k = 0; k < free_idx.size(); ++k) {
+    const double nrm = J.col(free_idx[k]).norm();
+    Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
+  }
+  // singular values from the eigenvalues of the (small) normal matrix
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal_matrix_lower(Jf), Eigen::EigenvaluesOnly);
+  const Eigen::VectorXd s = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  res.condition_number = s.maxCoeff() / s.minCoeff();
+  double logsum = 0;
+  for (int k = 0; k < s.size(); ++k) logsum += std::log(s(k));
+  res.observability_index = std::exp(logsum / s.size()) / std::sqrt(static_cast<double>(data.rows.size()));
+}
+
+}  // namespace kincal

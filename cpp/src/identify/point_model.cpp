@@ -1,0 +1,409 @@
+// kincal: the identification's measurement model: the parameter layout, PointModel's prediction
+// of a row with its analytic Jacobian (geometry, compliance through the gravity torque, tool and
+// base frames, targets, extra effects) and the residuals of a row and of a whole measurement set.
+#include "kincal/identify/point_model.hpp"
+
+#include "kincal/identify/so3.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+namespace kincal {
+
+namespace {
+
+/// Joint-angle offsets (rad) of the effects at a row, and the thermal scale factor.
+void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measurement& m, double t_ref, VecQ& dq,
+                    double& scale) {
+  scale = 1.0;
+  double b[128];
+  for (const Effect& e : eff) {
+    if (e.name == "thermal_expansion") {
+      if (std::isnan(m.temperature_c)) throw InputError("thermal_expansion needs the temperature_c column");
+      scale *= 1.0 + p[0] * (m.temperature_c - t_ref);
+    } else {
+      if (e.name == "backlash" && m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
+      joint_basis(e, m.q_deg[e.joint] * kDeg, e.name == "backlash" ? m.dir[e.joint] : 0.0, b);
+      for (int k = 0; k < e.size(); ++k) dq[e.joint] += p[k] * b[k];
+    }
+    p += e.size();
+  }
+}
+
+}  // namespace
+
+ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr)
+    : dof(nominal.dof()), n_targets(nt), effect_list(eff), t_ref(tr) {
+  for (int j = 0; j < dof; ++j)
+    if (nominal.gravity_loaded(j)) loaded.push_back(j);
+  joints = 0;
+  compliance = 4 * dof;
+  tool = compliance + static_cast<int>(loaded.size());
+  base = tool + 6;
+  targets = base + 6;
+  effects = targets + 3 * n_targets;
+  size = effects;
+  for (const Effect& e : effect_list) {
+    check_effect(e, dof, "");
+    if (e.name == "joint_compliance")
+      throw InputError("joint_compliance is identified through IdentifyOptions::compliance, not as an extra effect");
+    effect_offset.push_back(size);
+    size += e.size();
+  }
+  for (int j = 0; j < dof; ++j) {
+    const std::string p = "joint" + std::to_string(j + 1);
+    for (const char* s : {".tilt_u", ".tilt_v"}) names.push_back(p + s), units.push_back("rad");
+    for (const char* s : {".move_u", ".move_v"}) names.push_back(p + s), units.push_back("mm");
+  }
+  for (int j : loaded) names.push_back("joint" + std::to_string(j + 1) + ".compliance"), units.push_back("deg/kNm");
+  for (const std::string f : {"tool", "base"}) {
+    for (const char* s : {".x", ".y", ".z"}) names.push_back(f + s), units.push_back("mm");
+    for (const char* s : {".rx", ".ry", ".rz"}) names.push_back(f + s), units.push_back("rad");
+  }
+  for (int t = 0; t < n_targets; ++t)
+    for (const char* s : {".x", ".y", ".z"}) names.push_back("target" + std::to_string(t) + s), units.push_back("mm");
+  for (const Effect& e : effect_list) {
+    const std::string p = e.joint >= 0 ? "joint" + std::to_string(e.joint + 1) + "." : "";
+    for (const auto& n : e.parameter_names()) names.push_back(p + n);
+    for (const auto& u : e.units()) units.push_back(u);
+  }
+}
+
+PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects, double t_ref)
+    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref) {
+  const int n = nominal.dof();
+  for (int j = 0; j < n; ++j) {
+    const Vec3 w = nominal.axis(j);
+    u_.push_back(w.unitOrthogonal());
+    v_.push_back(w.cross(u_.back()));
+  }
+  w_.resize(n);
+  p_.resize(n);
+  std::vector<double> x(layout_.size, 0.0);
+  for (size_t i = 0; i < layout_.loaded.size(); ++i)
+    x[layout_.compliance + i] = nominal.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
+  set_params(x);
+}
+
+void PointModel::set_params(const std::vector<double>& x) {
+  x_ = x;
+  spec_ = nominal_.spec();
+  spec_.effects.clear();  // the layout's effects act through x, never twice through the model
+  const int n = layout_.dof;
+  for (int j = 0; j < n; ++j) {
+    const double* a = &x[4 * j];
+    w_[j] = (nominal_.axis(j) + a[0] * u_[j] + a[1] * v_[j]).normalized();
+    p_[j] = nominal_.point(j) + a[2] * u_[j] + a[3] * v_[j];
+    spec_.joints[j].axis = w_[j];
+    spec_.joints[j].point = p_[j];
+    spec_.joints[j].compliance_deg_per_knm = 0;
+  }
+  for (size_t i = 0; i < layout_.loaded.size(); ++i)
+    spec_.joints[layout_.loaded[i]].compliance_deg_per_knm = x[layout_.compliance + i];
+  const Vec3 phim(x[layout_.tool + 3], x[layout_.tool + 4], x[layout_.tool + 5]);
+  rm_ = nominal_.tool().linear() * so3::exp(phim);
+  jrm_ = so3::right_jacobian(phim);
+  tm_ = nominal_.tool().translation() + Vec3(x[layout_.tool], x[layout_.tool + 1], x[layout_.tool + 2]);
+  const Vec3 phib(x[layout_.base + 3], x[layout_.base + 4], x[layout_.base + 5]);
+  rb_ = nominal_.base_in_instrument().linear() * so3::exp(phib);
+  jrb_ = so3::right_jacobian(phib);
+  tb_ = nominal_.base_in_instrument().translation() + Vec3(x[layout_.base], x[layout_.base + 1], x[layout_.base + 2]);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = rm_;
+  t.translation() = tm_;
+  spec_.tool = iso_to_pose(t);
+  t.linear() = rb_;
+  t.translation() = tb_;
+  spec_.base_in_instrument = iso_to_pose(t);
+  current_ = std::make_shared<const Model>(spec_);
+  for (auto& pm : payload_models_) {
+    ModelSpec s = spec_;
+    s.payload_kg = pm.first;
+    pm.second = std::make_shared<const Model>(s);
+  }
+}
+
+void PointModel::prepare_payloads(const MeasurementSet& data) {
+  std::set<double> pays;
+  for (const auto& r : data.rows)
+    if (!std::isnan(r.payload_kg) && r.payload_kg != spec_.payload_kg) pays.insert(r.payload_kg);
+  payload_models_.clear();
+  for (double p : pays) payload_models_.emplace_back(p, nullptr);
+  set_params(x_);
+}
+
+const Model& PointModel::model_for(double payload) const {
+  if (std::isnan(payload) || payload == spec_.payload_kg) return *current_;
+  for (const auto& pm : payload_models_)
+    if (pm.first == payload) return *pm.second;
+  throw std::logic_error("PointModel: payload not prepared");
+}
+
+ModelSpec PointModel::spec() const { return spec_; }
+
+void PointModel::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr,
+                              std::array<Vec3, kMaxJoints + 1>& gt) const {
+  gr[0].setIdentity();
+  gt[0].setZero();
+  for (int j = 0; j < layout_.dof; ++j) {
+    const Mat3 e = axis_rotation(w_[j], q[j]);
+    const Vec3 et = p_[j] - e * p_[j];
+    gr[j + 1] = gr[j] * e;
+    gt[j + 1] = gr[j] * et + gt[j];
+  }
+}
+
+void PointModel::row_frames(const Model& model, const Measurement& m, GravityState& gs,
+                            std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt,
+                            double& scale) const {
+  const int n = layout_.dof;
+  VecQ qe = m.q_deg * kDeg;
+  const bool torque = !layout_.loaded.empty();
+  if (torque) {
+    gravity_state(model, m, gs);
+    for (int j = 0; j < n; ++j) qe[j] += model.compliance(j) * gs.tau[j];
+  }
+  scale = 1.0;
+  const bool effects = !layout_.effect_list.empty();
+  if (effects) {
+    VecQ dq = VecQ::Zero(n);
+    effect_offsets(layout_.effect_list, &x_[layout_.effects], m, layout_.t_ref, dq, scale);
+    qe += dq;
+  }
+  // G_j = exp(xi_1 qe_1) ... exp(xi_j qe_j), G_0 = identity
+  if (torque && !model.has_compliance() && !effects) {
+    gr = gs.gr;
+    gt = gs.gt;
+  } else {
+    chain_frames(qe, gr, gt);
+  }
+}
+
+void PointModel::set_frames_only(bool on, const MeasurementSet* data) {
+  frames_only_ = on;
+  flange_.clear();
+  flange_rows_ = nullptr;
+  if (!on || !data || data->rows.empty()) return;
+  const int n = layout_.dof;
+  flange_.resize(data->rows.size());
+  for (size_t i = 0; i < data->rows.size(); ++i) {
+    const Measurement& m = data->rows[i];
+    GravityState gs;
+    std::array<Mat3, kMaxJoints + 1> gr;
+    std::array<Vec3, kMaxJoints + 1> gt;
+    row_frames(model_for(m.payload_kg), m, gs, gr, gt, flange_[i].scale);
+    flange_[i].r = gr[n];
+    flange_[i].t = gt[n];
+  }
+  flange_rows_ = data->rows.data();
+}
+
+const PointModel::Flange* PointModel::cached_flange(const Measurement& m) const {
+  if (flange_.empty()) return nullptr;
+  const auto a = reinterpret_cast<std::uintptr_t>(&m), b = reinterpret_cast<std::uintptr_t>(flange_rows_);
+  if (a < b || (a - b) % sizeof(Measurement) != 0) return nullptr;
+  const size_t i = (a - b) / sizeof(Measurement);
+  return i < flange_.size() ? &flange_[i] : nullptr;
+}
+
+Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
+  const Model& model = model_for(m.payload_kg);
+  const int n = layout_.dof;
+  const VecQ q = m.q_deg * kDeg;
+  GravityState gs;
+  double scale;
+  std::array<Mat3, kMaxJoints + 1> gr;
+  std::array<Vec3, kMaxJoints + 1> gt;
+  if (const Flange* f = frames_only_ ? cached_flange(m) : nullptr) {
+    gr[n] = f->r;  // only the flange frame is read on the frames-only path
+    gt[n] = f->t;
+    scale = f->scale;
+  } else {
+    row_frames(model, m, gs, gr, gt, scale);
+  }
+  const Vec3 tkv(x_[layout_.targets + 3 * m.target], x_[layout_.targets + 3 * m.target + 1],
+                 x_[layout_.targets + 3 * m.target + 2]);
+  const Vec3 x0 = rm_ * tkv + tm_;
+  const Mat3& rn = gr[n];
+  const Vec3 xr = rn * x0 + gt[n];  // the point of the unscaled robot
+  const Vec3 x = scale * xr;
+  const Vec3 y = rb_ * x + tb_;
+  if (rot) *rot = rb_ * rn * rm_;
+  if (!jac) return y;
+  const int P = layout_.size;
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  J.setZero();
+  // angular velocity of the tool frame (instrument frame) per parameter, when asked for
+  const bool ang = jac_rot != nullptr;
+  double dummy[3];
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(ang ? jac_rot : dummy, 3, ang ? P : 1);
+  if (ang) {
+    W.setZero();
+    W.block<3, 3>(0, layout_.base + 3) = rb_ * jrb_;
+  }
+  const Mat3 rbn = rb_ * rn;
+  J.block<3, 3>(0, layout_.base) = Mat3::Identity();
+  J.block<3, 3>(0, layout_.base + 3) = -rb_ * so3::skew(x) * jrb_;
+  J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
+  if (frames_only_) {
+    J.block<3, 3>(0, layout_.tool + 3) = -scale * rbn * rm_ * so3::skew(tkv) * jrm_;
+    if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
+    return y;
+  }
+  // x in the frames G_j: xl_j = G_j^-1 x
+  std::array<Vec3, kMaxJoints + 1> xl;
+  for (int j = 0; j <= n; ++j) xl[j] = gr[j].transpose() * (xr - gt[j]);
+  for (int j = 0; j < n; ++j) {
+    const Vec3 wraw = nominal_.axis(j) + x_[4 * j] * u_[j] + x_[4 * j + 1] * v_[j];
+    const double nn = wraw.norm();
+    for (int k = 0; k < 2; ++k) {
+      const Vec3& d = k == 0 ? u_[j] : v_[j];
+      const Vec3 dw = (d - w_[j] * w_[j].dot(d)) / nn;
+      const Vec3 om = w_[j].cross(dw);  // the line turns about p_j
+      const Vec3 dx = gr[j] * om.cross(xl[j] - p_[j]) - gr[j + 1] * om.cross(xl[j + 1] - p_[j]);
+      J.col(4 * j + k) = rb_ * dx;
+      if (ang) W.col(4 * j + k) = rb_ * (gr[j] * om - gr[j + 1] * om);
+      const Vec3 dxt = gr[j] * d - gr[j + 1] * d;  // the line moves along d
+      J.col(4 * j + 2 + k) = rb_ * dxt;
+    }
+  }
+  // velocity of the point per unit rotation of each joint (current configuration, base frame)
+  std::array<Vec3, kMaxJoints> jp;
+  for (int j = 0; j < n; ++j) jp[j] = gr[j] * w_[j].cross(xl[j] - p_[j]);
+  for (size_t i = 0; i < layout_.loaded.size(); ++i) {
+    const int j = layout_.loaded[i];
+    const double dq = gs.tau[j] * kDeg / 1e6;  // per deg/kNm
+    J.col(layout_.compliance + static_cast<int>(i)) = rb_ * jp[j] * dq;
+    if (ang) W.col(layout_.compliance + static_cast<int>(i)) = rb_ * (gr[j] * w_[j]) * dq;
+  }
+  J.block<3, 3>(0, layout_.tool) = rbn;
+  J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * so3::skew(tkv) * jrm_;
+  if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
+  std::array<Vec3, kMaxJoints> jw;  // angular velocity per unit rotation of each joint (base frame)
+  for (int j = 0; j < n; ++j) jw[j] = gr[j] * w_[j];
+  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, jw, J.data(), ang ? W.data() : nullptr);
+  for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
+    const Effect& ef = layout_.effect_list[e];
+    const int c = layout_.effect_offset[e];
+    if (ef.name != "thermal_expansion") {  // joint-angle effects: dq_j = p . basis
+      double b[128];
+      joint_basis(ef, q[ef.joint], ef.name == "backlash" ? m.dir[ef.joint] : 0.0, b);
+      for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
+      if (ang)
+        for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
+    } else {
+      J.col(c) = rb_ * xr * (m.temperature_c - layout_.t_ref);
+    }
+  }
+  if (scale != 1.0) {
+    // every column through the robot's point scales with it (not the base's, not thermal's own)
+    J.leftCols(layout_.base) *= scale;
+    for (size_t e = 0; e < layout_.effect_list.size(); ++e)
+      if (layout_.effect_list[e].name != "thermal_expansion")
+        J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
+  }
+  return y;
+}
+
+std::vector<double> PointModel::start(const MeasurementSet& data) const {
+  std::vector<double> x(layout_.size, 0.0);
+  for (size_t i = 0; i < layout_.loaded.size(); ++i)
+    x[layout_.compliance + i] = nominal_.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
+  // nominal prediction of the tool point in the base frame, matched to the measurements (Horn)
+  const size_t m = data.rows.size();
+  Eigen::Matrix3Xd a(3, m), b(3, m);
+  for (size_t i = 0; i < m; ++i) {
+    a.col(i) = fk_compliant(nominal_, data.rows[i].q_deg * kDeg).translation();
+    b.col(i) = data.rows[i].xyz;
+  }
+  const Vec3 ca = a.rowwise().mean(), cb = b.rowwise().mean();
+  const Mat3 h = (a.colwise() - ca) * (b.colwise() - cb).transpose();
+  Eigen::JacobiSVD<Mat3> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 d = Mat3::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  const Mat3 r = svd.matrixV() * d * svd.matrixU().transpose();
+  const Vec3 t = cb - r * ca;
+  const Vec3 dt = t - nominal_.base_in_instrument().translation();
+  const Vec3 phi = so3::log(nominal_.base_in_instrument().linear().transpose() * r);
+  for (int k = 0; k < 3; ++k) x[layout_.base + k] = dt[k], x[layout_.base + 3 + k] = phi[k];
+  return x;
+}
+
+int row_residuals(const PointModel& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
+                  double* J) {
+  const int P = pm.layout().size;
+  const bool orientation = kind == ResidualKind::pose;
+  Mat3 rot;
+  thread_local std::vector<double> jw;
+  if (J && orientation) jw.resize(3 * static_cast<size_t>(P));
+  const Vec3 y = pm.predict(m, J, orientation ? &rot : nullptr, (J && orientation) ? jw.data() : nullptr);
+  for (int k = 0; k < 3; ++k) r[k] = y[k] - m.xyz[k];
+  if (!orientation) return 3;
+  if (!m.has_abc) throw InputError("a row without a measured orientation in a 6-D measurement set");
+  const Vec3 e = so3::log(abc_to_rotation(m.abc).transpose() * rot);
+  for (int k = 0; k < 3; ++k) r[3 + k] = orientation_weight * e[k];
+  if (J) {
+    // e' = log(Rm^T Exp(w) R) ~ e + Jr^-1(e) R^T w. predict() wrote the 3 position rows at J, which
+    // are already the top rows of the 6-row layout (row-major, P wide): only the bottom rows are new
+    const Mat3 d = orientation_weight * so3::right_jacobian_inv(e) * rot.transpose();
+    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jw.data(), 3, P);
+    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>> JJ(J, 6, P);
+    JJ.bottomRows(3) = d * W;
+  }
+  return 6;
+}
+
+namespace {
+
+/// Run f(i) for i in [0, n) on all cores (rows are independent; PointModel::predict is const). An
+/// exception stops its chunk and is rethrown once every thread is joined: the one of the first row
+/// that failed, as in a serial loop.
+template <class F>
+void parallel_rows(size_t n, F&& f) {
+  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), n / 256 + 1);
+  if (threads <= 1) {
+    for (size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  const size_t chunk = (n + threads - 1) / threads;
+  std::vector<std::exception_ptr> errors(threads);
+  auto run = [&](size_t t) {
+    try {
+      for (size_t i = t * chunk; i < std::min(n, (t + 1) * chunk); ++i) f(i);
+    } catch (...) {
+      errors[t] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < threads; ++t) pool.emplace_back(run, t);
+  run(0);
+  for (auto& th : pool) th.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace
+
+void all_residuals(const PointModel& pm, const MeasurementSet& data, double orientation_weight,
+                   const std::vector<int>& columns, double* r, double* J) {
+  const ResidualKind kind = residual_kind(data);
+  const size_t RS = residual_size(kind), P = pm.layout().size, F = columns.size();
+  parallel_rows(data.rows.size(), [&](size_t i) {
+    thread_local std::vector<double> full;
+    if (J) full.resize(6 * P);
+    double row_r[6];
+    row_residuals(pm, data.rows[i], kind, orientation_weight, r ? r + RS * i : row_r, J ? full.data() : nullptr);
+    if (J)
+      for (size_t k = 0; k < RS; ++k)
+        for (size_t c = 0; c < F; ++c) J[(RS * i + k) * F + c] = full[k * P + columns[c]];
+  });
+}
+
+}  // namespace kincal

@@ -1,0 +1,141 @@
+// kincal: PointModel's gravity state and the Jacobian terms through the gravity torque.
+// The deflection K tau(q) depends on the geometry through the gravity torque: moving a joint line
+// moves the links (their centres of mass) and the axes the torque is taken about; moving the tool
+// frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter).
+// K tau itself acts in row_frames() (point_model.cpp); these are its derivatives.
+#include "kincal/identify/point_model.hpp"
+
+#include <cmath>
+
+namespace kincal {
+
+void PointModel::gravity_state(const Model& model, const Measurement& m, GravityState& gs) const {
+  const int n = layout_.dof;
+  const ModelSpec& sp = model.spec();
+  chain_frames(m.q_deg * kDeg, gs.gr, gs.gt);
+  const auto& gr = gs.gr;
+  const auto& gt = gs.gt;
+  const double mp = std::isnan(m.payload_kg) ? sp.payload_kg : m.payload_kg;
+  gs.mp = mp;
+  // current centres of mass; S[i] = sum_{k>=i} m_k c_k, M[i] = sum_{k>=i} m_k (payload on the last link)
+  gs.cp = gr[n] * (rm_ * sp.payload_com + tm_) + gt[n];
+  gs.S[n] = mp * gs.cp;
+  gs.M[n] = mp;
+  for (int k = n - 1; k >= 0; --k) {
+    const double mk = sp.joints[k].mass_kg;
+    gs.S[k] = gs.S[k + 1] + mk * (gr[k + 1] * sp.joints[k].com + gt[k + 1]);
+    gs.M[k] = gs.M[k + 1] + mk;
+  }
+  const Vec3& g = model.gravity();
+  for (int j = 0; j < n; ++j) {
+    gs.wc[j] = gr[j] * w_[j];
+    gs.oc[j] = gr[j] * p_[j] + gt[j];
+    gs.arm[j] = gs.S[j] - gs.M[j] * gs.oc[j];
+    gs.tau[j] = gs.wc[j].dot(gs.arm[j].cross(g));  // N mm, the same as gravity_torque()
+  }
+}
+
+void PointModel::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
+                                  const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const {
+  const int n = layout_.dof, P = layout_.size;
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  double dummy[3];
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot ? jac_rot : dummy, 3,
+                                                                         jac_rot ? P : 1);
+  // the torque is taken at the commanded angles (frames of gs), the point moves at the deflected ones
+  const auto& gr = gs.gr;
+  const auto& gt = gs.gt;
+  const auto& S = gs.S;
+  const auto& M = gs.M;
+  const auto& wc = gs.wc;
+  const auto& oc = gs.oc;
+  const auto& arm = gs.arm;
+  const Vec3& cp = gs.cp;
+  const double mp = gs.mp;
+  const Vec3& g = model.gravity();
+  auto ad = [&](int k, const Vec3& om, const Vec3& v, Vec3& omo, Vec3& vo) {
+    omo = gr[k] * om;
+    vo = gr[k] * v + gt[k].cross(omo);
+  };
+  // effect on the point (instrument frame) of a torque change dtau (N mm) on every loaded joint:
+  // the sum of rb K_j jp_j dtau_j, those vectors formed once per pose
+  std::array<Vec3, kMaxJoints> kp, kw;
+  for (int j : layout_.loaded) {
+    kp[j] = rb_ * jp[j] * model.compliance(j);
+    if (jac_rot) kw[j] = rb_ * jw[j] * model.compliance(j);
+  }
+  auto apply = [&](int col, const std::array<double, kMaxJoints>& dtau) {
+    Vec3 dx = Vec3::Zero(), dw = Vec3::Zero();
+    for (int j : layout_.loaded) {
+      dx += kp[j] * dtau[j];
+      if (jac_rot) dw += kw[j] * dtau[j];
+    }
+    J.col(col) += dx;
+    if (jac_rot) W.col(col) += dw;
+  };
+  // Every torque change below is linear in the motion (go, gv) of line i and (dom, dv) of the links
+  // beyond it; the vectors it is dotted with depend on the pose only and are formed once:
+  // B_j = g x wc_j, C_j = wc_j x (arm_j x g), A_j = C_j + arm_j x B_j.
+  std::array<Vec3, kMaxJoints> A, B, C, OB;
+  for (int j : layout_.loaded) {
+    B[j] = g.cross(wc[j]);
+    C[j] = wc[j].cross(arm[j].cross(g));
+    A[j] = C[j] + arm[j].cross(B[j]);
+    OB[j] = oc[j].cross(B[j]);
+  }
+  for (int i = 0; i < n; ++i) {
+    const Vec3 wraw = nominal_.axis(i) + x_[4 * i] * u_[i] + x_[4 * i + 1] * v_[i];
+    const double nn = wraw.norm();
+    std::array<Vec3, kMaxJoints> SB;  // S_i x B_j for the joints up to i
+    for (int j : layout_.loaded)
+      if (j <= i) SB[j] = S[i].cross(B[j]);
+    for (int c = 0; c < 4; ++c) {
+      const Vec3& d = (c % 2 == 0) ? u_[i] : v_[i];
+      Vec3 om, v;
+      if (c < 2) {
+        om = w_[i].cross((d - w_[i] * w_[i].dot(d)) / nn);
+        v = p_[i].cross(om);
+      } else {
+        om.setZero();
+        v = d;
+      }
+      Vec3 go, gv, ao, av;  // Gamma: the line itself; Delta: the links beyond it
+      ad(i, om, v, go, gv);
+      ad(i + 1, om, v, ao, av);
+      const Vec3 dom = go - ao, dv = gv - av;
+      std::array<double, kMaxJoints> dtau{};
+      for (int j : layout_.loaded) {
+        if (j > i) {
+          // dom x wc_j . (arm_j x g) + wc_j . ((dom x arm_j) x g)
+          dtau[j] = dom.dot(A[j]);
+        } else if (j == i) {
+          // go x wc_j . (arm_j x g) + wc_j . (darm x g), darm = M_j dv + dom x S_j - M_j (gv + go x oc_j)
+          dtau[j] = go.dot(C[j]) + M[j] * (dv - gv).dot(B[j]) + dom.dot(SB[j]) - M[j] * go.dot(OB[j]);
+        } else {
+          // wc_j . (darm x g), darm = M_i dv + dom x S_i
+          dtau[j] = M[i] * dv.dot(B[j]) + dom.dot(SB[j]);
+        }
+      }
+      apply(4 * i + c, dtau);
+    }
+  }
+  if (mp != 0) {
+    for (int c = 0; c < 6; ++c) {
+      Vec3 om = Vec3::Zero(), v = Vec3::Zero();
+      if (c < 3) {
+        v[c] = 1;
+      } else {
+        om = rm_ * jrm_.col(c - 3);
+        v = tm_.cross(om);
+      }
+      Vec3 lo, lv;
+      ad(n, om, v, lo, lv);
+      const Vec3 dcp = mp * (lv + lo.cross(cp));
+      std::array<double, kMaxJoints> dtau{};
+      for (int j : layout_.loaded) dtau[j] = wc[j].dot(dcp.cross(g));
+      apply(layout_.tool + c, dtau);
+    }
+  }
+}
+
+}  // namespace kincal

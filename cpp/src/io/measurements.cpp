@@ -1,0 +1,121 @@
+// kincal: the measurement CSV reader and writer (the columns in measurements.hpp).
+#include "kincal/io/measurements.hpp"
+
+#include "kincal/io/csv.hpp"
+#include "kincal/io/file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace kincal {
+
+namespace {
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
+  const std::string& source = t.source;
+  MeasurementSet m;
+  m.source = source;
+  const int cpose = t.require("pose");
+  std::vector<int> cq;
+  for (int j = 0; j < dof; ++j) cq.push_back(t.require("q" + std::to_string(j + 1)));
+  if (t.find("q" + std::to_string(dof + 1)) >= 0)
+    throw InputError(source + ":1: column q" + std::to_string(dof + 1) + " but the robot has " +
+                     std::to_string(dof) + " joints");
+  const int cx = t.require("x"), cy = t.require("y"), cz = t.require("z");
+  const int ca = t.find("a"), cb = t.find("b"), cc = t.find("c");
+  const bool abc = ca >= 0 && cb >= 0 && cc >= 0;
+  if (!abc && (ca >= 0 || cb >= 0 || cc >= 0))
+    throw InputError(source + ":1: an orientation needs all three columns a, b, c");
+  m.orientation = abc;
+  const int ctarget = t.find("target"), cpay = t.find("payload_kg"), ctemp = t.find("temperature_c");
+  std::vector<int> cdir;
+  for (int j = 0; j < dof; ++j) cdir.push_back(t.find("dir" + std::to_string(j + 1)));
+  const bool have_dir = std::all_of(cdir.begin(), cdir.end(), [](int c) { return c >= 0; });
+  int max_target = 0;
+  for (size_t r = 0; r < t.cells.size(); ++r) {
+    Measurement row;
+    const double pid = t.number(r, cpose);
+    if (pid != std::floor(pid)) throw InputError(t.where(r) + ": column 'pose': not an integer");
+    row.pose = static_cast<int>(pid);
+    row.q_deg.resize(dof);
+    for (int j = 0; j < dof; ++j) row.q_deg[j] = t.number(r, cq[j]);
+    row.xyz = Vec3(t.number(r, cx), t.number(r, cy), t.number(r, cz));
+    if (abc) {
+      row.has_abc = true;
+      row.abc = Vec3(t.number(r, ca), t.number(r, cb), t.number(r, cc));
+    }
+    if (ctarget >= 0) {
+      const double tv = t.number(r, ctarget);
+      if (tv < 0 || tv != std::floor(tv) || tv > 99)
+        throw InputError(t.where(r) + ": column 'target': expected an integer 0..99");
+      row.target = static_cast<int>(tv);
+      max_target = std::max(max_target, row.target);
+    }
+    if (cpay >= 0) {
+      row.payload_kg = t.number(r, cpay);
+      if (row.payload_kg < 0) throw InputError(t.where(r) + ": column 'payload_kg': negative mass");
+    }
+    if (ctemp >= 0) row.temperature_c = t.number(r, ctemp);
+    if (have_dir) {
+      row.dir.resize(dof);
+      for (int j = 0; j < dof; ++j) {
+        row.dir[j] = t.number(r, cdir[j]);
+        if (row.dir[j] != 1 && row.dir[j] != -1)
+          throw InputError(t.where(r) + ": column 'dir" + std::to_string(j + 1) + "': expected +1 or -1");
+      }
+    }
+    row.line = t.line[r];
+    m.rows.push_back(row);
+  }
+  if (m.rows.empty()) throw InputError(source + ": no measurements");
+  m.n_targets = max_target + 1;
+  return m;
+}
+
+}  // namespace
+
+MeasurementSet parse_measurements(const std::string& text, const std::string& source, int dof) {
+  return measurements_from_table(parse_csv(text, source), dof);
+}
+
+MeasurementSet read_measurements(const std::string& path, int dof) {
+  return measurements_from_table(read_csv(path), dof);
+}
+
+std::string format_measurements(const MeasurementSet& m, int dof) {
+  std::string s = "pose";
+  for (int j = 0; j < dof; ++j) s += ",q" + std::to_string(j + 1);
+  s += m.orientation ? ",x,y,z,a,b,c,target" : ",x,y,z,target";
+  bool pay = false;
+  for (const auto& r : m.rows) pay = pay || !std::isnan(r.payload_kg);
+  if (pay) s += ",payload_kg";
+  const bool dir = !m.rows.empty() && m.rows[0].dir.size() == dof;
+  const bool temp = !m.rows.empty() && !std::isnan(m.rows[0].temperature_c);
+  if (temp) s += ",temperature_c";
+  if (dir)
+    for (int j = 0; j < dof; ++j) s += ",dir" + std::to_string(j + 1);
+  s += "\n";
+  for (const auto& r : m.rows) {
+    s += std::to_string(r.pose);
+    for (int j = 0; j < dof; ++j) s += "," + fmt(r.q_deg[j]);
+    for (int k = 0; k < 3; ++k) s += "," + fmt(r.xyz[k]);
+    if (m.orientation)
+      for (int k = 0; k < 3; ++k) s += "," + fmt(r.abc[k]);
+    s += "," + std::to_string(r.target);
+    if (pay) s += "," + fmt(r.payload_kg);
+    if (temp) s += "," + fmt(r.temperature_c);
+    if (dir)
+      for (int j = 0; j < dof; ++j) s += r.dir[j] > 0 ? ",1" : ",-1";
+    s += "\n";
+  }
+  return s;
+}
+
+}  // namespace kincal

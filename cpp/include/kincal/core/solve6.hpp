@@ -65,7 +65,7 @@ inline bool well_conditioned3(const Mat3& a, double det) {
 
 /// Solves j x = b (b becomes x) for a Jacobian whose first three columns are the arm's and last three
 /// the wrist's, by 3x3 blocks: x_wrist from the Schur complement S = D - C A^-1 B, then x_arm. Two
-/// divisions instead of six dependent eliminations (the solve is latency-bound: 40 against 90 ns).
+/// divisions instead of six dependent eliminations (the solve is latency-bound; BENCHMARKS.md has the figures).
 /// The rows should have the arm block A well conditioned (the position of the wrist, see
 /// DeviationEvaluator::solve); when A or S is near singular, solve6's partial pivoting takes over.
 /// Returns |det j| (0 when singular).

@@ -1,6 +1,7 @@
 #include "common.hpp"
 
 #include "kincal/identify/simulate.hpp"
+#include "kincal/ik/ik.hpp"
 #include "kincal/io/model_json.hpp"
 #include "kincal/model/model.hpp"
 #include "kincal/model/robots.hpp"

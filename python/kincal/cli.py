@@ -336,8 +336,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", required=True, help="model JSON")
     effect_opts(sp, "joint_compliance", "non-geometric effects to identify")
     loss_opts(sp)
-    sp.add_argument("--holdout", type=float, default=0.25, help="share of poses held out for validation")
-    sp.add_argument("--folds", type=int, default=0, help="k-fold cross-validation instead of a split (k >= 2)")
+    sp.add_argument("--holdout", type=float, default=0.25,
+                    help="share of configurations held out for validation (whole: repeats never on both sides)")
+    sp.add_argument("--folds", type=int, default=0,
+                    help="k-fold cross-validation (whole configurations per fold) instead of a split (k >= 2)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
     model_opts(sp)
@@ -364,7 +366,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "with --robot fivebar a table with the columns of Table I")
     sp.add_argument("--out", required=True, help="folder for diagnosis.json, report.html, figures and model.json "
                                                  "(the final model, for compensate)")
-    sp.add_argument("--folds", type=int, default=5, help="folds of poses for the cross-validation")
+    sp.add_argument("--folds", type=int, default=5, help="folds of the cross-validation (whole configurations per fold)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
     sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
     effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")

@@ -180,7 +180,8 @@ def _report(out: Path, res, diag, summary, err_unc, err_com, err_dia, fres, tabl
     v = res.validation
     ident_rows = [["fitted poses", f"{res.fit['nominal_rms_mm']:.3f}", f"{res.fit['rms_mm']:.3f}",
                    f"{res.fit['nominal_max_mm']:.3f}", f"{res.fit['max_mm']:.3f}"],
-                  [f"held-out poses ({v['scheme']})", f"{v['before_rms_mm']:.3f}", f"{v['after_rms_mm']:.3f}",
+                  [f"held-out poses ({v['scheme']}, {v['configurations']} configurations)",
+                   f"{v['before_rms_mm']:.3f}", f"{v['after_rms_mm']:.3f}",
                    f"{v['before_max_mm']:.3f}", f"{v['after_max_mm']:.3f}"]]
     diag_rows = [[k + 1, s["effect"], s["joint"] or "", f"{s['evidence']['F']:.3g}",
                   f"{s['rms_before_mm'] * 1000:.1f}", f"{s['rms_after_mm'] * 1000:.1f}"]

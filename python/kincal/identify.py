@@ -14,7 +14,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core
+from . import _core, grouping
 from ._core import Robot
 
 #: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
@@ -222,21 +222,15 @@ def subset(data: dict, mask: np.ndarray) -> dict:
 
 
 def split_poses(data: dict, holdout: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Boolean row masks (fit, held out): a random share ``holdout`` of the pose ids is held out."""
-    ids = np.unique(data["pose"])
-    rng = np.random.default_rng(seed)
-    n_out = int(round(holdout * len(ids)))
-    out_ids = rng.choice(ids, size=n_out, replace=False) if n_out else np.array([], dtype=ids.dtype)
-    held = np.isin(data["pose"], out_ids)
-    return ~held, held
+    """Boolean row masks (fit, held out): a random share ``holdout`` of the configurations is held
+    out whole (grouping.split: repeats of one configuration never sit on both sides)."""
+    return grouping.split(data, holdout, seed)
 
 
 def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
-    """k boolean masks of held-out rows, poses dealt at random into k folds."""
-    ids = np.unique(data["pose"])
-    rng = np.random.default_rng(seed)
-    perm = rng.permutation(ids)
-    return [np.isin(data["pose"], perm[i::k]) for i in range(k)]
+    """k boolean masks of held-out rows, whole configurations dealt at random into k folds
+    (grouping.folds)."""
+    return grouping.folds(data, k, seed)
 
 
 def _rms(e: np.ndarray) -> float:
@@ -288,11 +282,13 @@ class Identification:
         lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}"
                      f"{f.nominal_max_mm:>12.4f}{f.max_mm:>12.4f}")
         if v.get("held_rows"):
-            lines.append(f"{'held-out poses (' + v['scheme'] + ')':<28}{v['before_rms_mm']:>12.4f}{v['after_rms_mm']:>12.4f}"
+            lines.append(f"{'held-out poses':<28}{v['before_rms_mm']:>12.4f}{v['after_rms_mm']:>12.4f}"
                          f"{v['before_max_mm']:>12.4f}{v['after_max_mm']:>12.4f}")
         if "after_rms_deg" in v:
             lines.append(f"{'orientation (deg), held out':<28}{v['before_rms_deg']:>12.4f}{v['after_rms_deg']:>12.4f}"
                          f"{v['before_max_deg']:>12.4f}{v['after_max_deg']:>12.4f}")
+        if v.get("held_rows"):
+            lines.append(f"validation: {v['scheme']} ({v['configurations']} configurations: {v['grouping']})")
         lines.append("")
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}")
         fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
@@ -370,10 +366,10 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
             e_before.append(_core.point_errors(r.nominal_fitted, r.nominal_targets, subset(data, held)))
         fit_mask = np.ones(len(data["pose"]), dtype=bool)
         eb, ea = np.concatenate(e_before), np.concatenate(e_after)
-        val = {"scheme": f"{k_folds}-fold", "held_rows": int(len(ea))}
+        val = dict(grouping.describe(data, f"{k_folds}-fold"), held_rows=int(len(ea)))
     else:
         fit_mask, held = split_poses(data, holdout, seed)
-        val = {"scheme": f"{holdout:.0%} held out", "held_rows": int(held.sum())}
+        val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()))
     r = _fit(robot, subset(data, fit_mask), opts, progress)
     if k_folds <= 1 and val["held_rows"]:
         held_data = subset(data, ~fit_mask)

@@ -56,7 +56,9 @@ def test_kfold_validation(campaign):
             "--folds", "4")
     assert r.returncode == 0, r.stderr
     v = json.loads((campaign / "kf.json").read_text())["identification"]["validation"]
-    assert v["scheme"] == "4-fold" and v["held_rows"] == 600
+    assert v["scheme"] == "4-fold, whole configurations" and v["held_rows"] == 600
+    # the campaign has no config column: 200 distinct configurations of 3 reflectors each
+    assert v["configurations"] == 200 and "equal joint angles" in v["grouping"]
     assert v["after_rms_mm"] <= 1.2 * FLOOR
 
 

@@ -13,7 +13,7 @@ from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 
-from .. import _core
+from .. import _core, grouping
 from .. import identify as ident
 from .._core import Robot
 from . import engine
@@ -161,6 +161,7 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
     return {"steps": found.steps, "final_rms_mm": found.cv_rms_mm, "noise_rms_mm": concl["noise_rms_mm"],
             "noise_known": concl["noise_known"], "fit_scatter_mm": concl["fit_scatter_mm"],
             "verdict": concl["verdict"], "notes": notes, "history": found.history, "folds": folds,
+            "validation": grouping.describe(data, f"{folds}-fold"),
             "final_model": final_model, "_final_fit": final, "_spec": spec, "_start": problem.spec(start_effects)}
 
 
@@ -172,7 +173,8 @@ def final_identification(robot: Robot, data: dict, diag: dict,
     --tool-targets does."""
     spec: Spec = diag["_spec"]
     res = ident.identify(robot, data, effects=spec.effects, holdout=0.0, **spec.fit_options)
-    res.validation = {"scheme": f"fitted on every row; cross-validated ({diag['folds']} folds) in the diagnosis",
+    res.validation = {"scheme": f"fitted on every row; cross-validated in the diagnosis ({diag['validation']['scheme']}, "
+                                f"{diag['validation']['configurations']} configurations)",
                       "held_rows": 0, "fit_rows": int(len(data["pose"])),
                       "diagnosis_cv_rms_mm": diag["final_rms_mm"]}
     if tool_targets is not None:

@@ -109,7 +109,8 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     body = f"""<h1>{report.esc(title)}</h1>
 <p>{len(data['pose'])} measured points. Each step scores every candidate effect of the library against the
 residual of the current model (projected off what the model can already absorb), adds the best significant one,
-refits everything and checks that the cross-validated RMS ({diag['folds']} folds of poses) falls.</p>
+refits everything and checks that the cross-validated RMS falls ({diag['folds']} folds of whole configurations:
+the repeats of one of the {diag['validation']['configurations']} configurations never sit on both sides).</p>
 {report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True)}
 <p><b>Result:</b> cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um against a noise estimate of
 {diag['noise_rms_mm'] * 1000:.1f} um: {report.esc(diag['verdict'])}.</p>

@@ -111,6 +111,9 @@ def test_cli_writes_diagnosis_report_and_model(tmp_path):
     assert r.returncode == 0, r.stderr
     doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
     assert {"steps", "final_rms_mm", "noise_rms_mm"} <= set(doc)
+    # 150 configurations (3 reflectors each), folds of whole configurations
+    assert doc["validation"] == {"scheme": "5-fold, whole configurations", "configurations": 150,
+                                 "grouping": "rows with equal joint angles (within 0.001 deg)"}
     assert [(s["effect"], s["joint"]) for s in doc["steps"]] == [("backlash", 3)]
     for s in doc["steps"]:
         assert s["rms_after_mm"] < s["rms_before_mm"]

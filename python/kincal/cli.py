@@ -77,6 +77,16 @@ def _progress(label: str):
     return report
 
 
+def _fold_progress():
+    """A one-line report of the cross-validation's fits on stderr (quiet when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(fold: int, folds: int) -> None:
+        print(f"\rcross-validation: fold {fold + 1} of {folds}   ", end="", file=sys.stderr, flush=True)
+    return report
+
+
 def _harmonics(text: str) -> list:
     """--harmonics 1,2,3: transmission_error's harmonic orders."""
     try:
@@ -114,9 +124,12 @@ def cmd_identify(args) -> None:
     effects = ident.parse_effects(args.effects, robot, args.harmonics)
     data = ident.read_measurements(args.data, robot)
     ident.check_data_for(effects, dict(data, source=args.data), robot)
+    if args.holdout is not None and args.folds is not None:
+        raise ValueError("--holdout and --folds: give one (a split, or cross-validation)")
     res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
-                         holdout=args.holdout, k_folds=args.folds, seed=args.seed,
-                         progress=_progress("identify"), orientation_weight=args.orientation_weight)
+                         holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
+                         progress=_progress("identify"), orientation_weight=args.orientation_weight,
+                         fold_progress=_fold_progress())
     if sys.stderr.isatty():
         print(file=sys.stderr)
     if args.tool_targets:
@@ -336,10 +349,12 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", required=True, help="model JSON")
     effect_opts(sp, "joint_compliance", "non-geometric effects to identify")
     loss_opts(sp)
-    sp.add_argument("--holdout", type=float, default=0.25,
-                    help="share of configurations held out for validation (whole: repeats never on both sides)")
-    sp.add_argument("--folds", type=int, default=0,
-                    help="k-fold cross-validation (whole configurations per fold) instead of a split (k >= 2)")
+    sp.add_argument("--holdout", type=float, default=None,
+                    help="validate on a held-out share of the configurations instead of cross-validation (the "
+                         "model then excludes those rows)")
+    sp.add_argument("--folds", type=int, default=None,
+                    help="k-fold cross-validation of the figures, whole configurations per fold (default 5; 0: "
+                         "none); the model is fitted on every row")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
     model_opts(sp)

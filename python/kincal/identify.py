@@ -288,7 +288,9 @@ class Identification:
             lines.append(f"{'orientation (deg), held out':<28}{v['before_rms_deg']:>12.4f}{v['after_rms_deg']:>12.4f}"
                          f"{v['before_max_deg']:>12.4f}{v['after_max_deg']:>12.4f}")
         if v.get("held_rows"):
-            lines.append(f"validation: {v['scheme']} ({v['configurations']} configurations: {v['grouping']})")
+            lines.append(f"held out: {v['scheme']} ({v['configurations']} configurations: {v['grouping']})")
+        if "model_rows" in v:
+            lines.append(f"the model is fitted on {v['model_rows']} ({v['fit_rows']} rows)")
         lines.append("")
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}")
         fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
@@ -337,53 +339,78 @@ def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARM
     return out
 
 
+def _errors(r: "_core.IdentifyResult", h: dict) -> dict:
+    """Position (and, with measured orientations, orientation) errors of the rows h: before (the
+    nominal geometry, frames fitted) and after (the identified model r)."""
+    out = {"ea": _core.point_errors(r.robot, r.targets, h), "eb": _core.point_errors(r.nominal_fitted,
+                                                                                     r.nominal_targets, h)}
+    if "abc" in h:
+        out.update(oa=orientation_errors_deg(r.robot, h), ob=orientation_errors_deg(r.nominal_fitted, h))
+    return out
+
+
+def _cross_validated_errors(robot: Robot, data: dict, opts, held_masks,
+                            progress: Optional[Callable[[int, int], None]]) -> dict:
+    """_errors of every held-out row, each fold predicted by the model fitted on the other folds."""
+    parts = []
+    for i, held in enumerate(held_masks):
+        if progress:
+            progress(i, len(held_masks))
+        parts.append(_errors(_fit(robot, subset(data, ~held), opts), subset(data, held)))
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
 def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: str = "huber",
-             loss_scale_mm: float = 0.1, holdout: float = 0.25, k_folds: int = 0, seed: int = 0,
+             loss_scale_mm: float = 0.1, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
-             orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> Identification:
+             orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
+             fold_progress: Optional[Callable[[int, int], None]] = None) -> Identification:
     """Identify the robot's parameters from measurements.
 
     ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
     ``--effects`` (``"joint_compliance"``, ``"transmission_error:3"``, ``"backlash:2"``,
-    ``"thermal_expansion"``, or one comma-separated text). Validation: ``k_folds`` > 1 fits k times,
-    each time predicting the fold it did not see; otherwise a share ``holdout`` of the poses is held
-    out. The returned model is fitted on all rows (k-fold) or on the fitted rows (split)."""
+    ``"thermal_expansion"``, or one comma-separated text).
+
+    The model returned is fitted on every row. Its validation figures come from ``k_folds``-fold
+    cross-validation (whole configurations per fold; 0: no validation). With ``holdout`` (a share in
+    (0, 1)) a random share of the configurations is held out instead, and the model then excludes
+    those rows (the validation says so). ``fold_progress(fold, folds)`` reports each validation fit."""
     effects = check_effects(effects, robot, harmonics)
     check_data_for(effects, data, robot)
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
     if k_folds == 1 or k_folds < 0:
-        raise ValueError("--folds must be 0 (a split) or at least 2")
-    if not 0.0 <= holdout < 1.0:
-        raise ValueError(f"--holdout must be in [0, 1), not {holdout}")
+        raise ValueError(f"--folds must be 0 (no validation) or at least 2, not {k_folds}")
+    if holdout is not None and not 0.0 <= holdout < 1.0:
+        raise ValueError(f"--holdout must be a share in (0, 1), not {holdout}")
+    holdout = holdout or None  # a share of 0 holds nothing out
     opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
-    val: dict = {}
-    if k_folds > 1:
-        e_before, e_after = [], []
-        for held in folds(data, k_folds, seed):
-            r = _fit(robot, subset(data, ~held), opts)
-            e_after.append(_core.point_errors(r.robot, r.targets, subset(data, held)))
-            e_before.append(_core.point_errors(r.nominal_fitted, r.nominal_targets, subset(data, held)))
-        fit_mask = np.ones(len(data["pose"]), dtype=bool)
-        eb, ea = np.concatenate(e_before), np.concatenate(e_after)
-        val = dict(grouping.describe(data, f"{k_folds}-fold"), held_rows=int(len(ea)))
-    else:
+    cv_opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
+                      covariance=False)
+    every_row = np.ones(len(data["pose"]), dtype=bool)
+    if holdout is not None:
         fit_mask, held = split_poses(data, holdout, seed)
-        val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()))
+        val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()),
+                   model_rows="the fitted rows only: the model excludes the held-out rows")
+        masks = [held]
+    elif k_folds > 1:
+        fit_mask, masks = every_row, folds(data, k_folds, seed)
+        val = dict(grouping.describe(data, f"{k_folds}-fold"),
+                   held_rows=int(len(data["pose"])), model_rows="every row (validated by cross-validation)")
+    else:
+        fit_mask, masks = every_row, []
+        val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
+    # folds: each predicted by a model fitted without it; a split: by the delivered model itself
+    e = _cross_validated_errors(robot, data, cv_opts, masks, fold_progress) if masks and holdout is None else {}
     r = _fit(robot, subset(data, fit_mask), opts, progress)
-    if k_folds <= 1 and val["held_rows"]:
-        held_data = subset(data, ~fit_mask)
-        ea = _core.point_errors(r.robot, r.targets, held_data)
-        eb = _core.point_errors(r.nominal_fitted, r.nominal_targets, held_data)
-    if val["held_rows"]:
-        val.update(before_rms_mm=_rms(eb), after_rms_mm=_rms(ea), before_max_mm=float(np.max(eb)),
-                   after_max_mm=float(np.max(ea)))
-        if "abc" in data and k_folds <= 1:
-            held_data = subset(data, ~fit_mask)
-            ob = orientation_errors_deg(r.nominal_fitted, held_data)
-            oa = orientation_errors_deg(r.robot, held_data)
-            val.update(before_rms_deg=_rms(ob), after_rms_deg=_rms(oa), before_max_deg=float(np.max(ob)),
-                       after_max_deg=float(np.max(oa)))
+    if holdout is not None and val["held_rows"]:
+        e = _errors(r, subset(data, ~fit_mask))
+    if e:
+        val.update(before_rms_mm=_rms(e["eb"]), after_rms_mm=_rms(e["ea"]), before_max_mm=float(np.max(e["eb"])),
+                   after_max_mm=float(np.max(e["ea"])))
+        if "oa" in e:
+            val.update(before_rms_deg=_rms(e["ob"]), after_rms_deg=_rms(e["oa"]), before_max_deg=float(np.max(e["ob"])),
+                       after_max_deg=float(np.max(e["oa"])))
     val["fit_rows"] = int(fit_mask.sum())
     return Identification(robot=r.robot, targets=np.asarray(r.targets), fit=r, effects=list(effects),
                           validation=val)

@@ -123,9 +123,9 @@ void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, con
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = opt.max_iterations;
-  so.function_tolerance = 1e-12;
+  so.function_tolerance = 1e-15;
   so.gradient_tolerance = 1e-14;
-  so.parameter_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-14;
   so.num_threads = 1;
   Progress prog(opt.progress);
   if (report == Report::progress && opt.progress) so.callbacks.push_back(&prog);

@@ -172,7 +172,7 @@ def final_identification(robot: Robot, data: dict, diag: dict,
     ``tool_targets`` (the targets' offsets in the tool frame) the TCP is placed as identify's
     --tool-targets does."""
     spec: Spec = diag["_spec"]
-    res = ident.identify(robot, data, effects=spec.effects, holdout=0.0, **spec.fit_options)
+    res = ident.identify(robot, data, effects=spec.effects, k_folds=0, **spec.fit_options)
     res.validation = {"scheme": f"fitted on every row; cross-validated in the diagnosis ({diag['validation']['scheme']}, "
                                 f"{diag['validation']['configurations']} configurations)",
                       "held_rows": 0, "fit_rows": int(len(data["pose"])),

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -234,6 +235,57 @@ def cmd_diagnose(args) -> None:
     print(diagnosis.summary(diag, model, args.out, time.perf_counter() - t0))
 
 
+def _numbers(text: str, n: int, option: str) -> list:
+    """n comma-separated numbers of an option (a clear error otherwise)."""
+    try:
+        v = [float(x) for x in text.split(",")]
+    except ValueError:
+        v = []
+    if len(v) != n or not all(math.isfinite(x) for x in v):
+        raise ValueError(f"{option} {text}: expected {n} comma-separated numbers")
+    return v
+
+
+def cmd_plan(args) -> None:
+    from . import plan
+
+    robot = _robot(args)
+    if args.targets.strip().isdigit():
+        count = int(args.targets)
+        if not 1 <= count <= len(ident.DEFAULT_TARGETS):
+            raise ValueError(f"--targets {args.targets}: a count must be 1..{len(ident.DEFAULT_TARGETS)} (or give a "
+                             "CSV of offsets x,y,z)")
+        targets = ident.DEFAULT_TARGETS[:count]
+    else:
+        targets = _core.read_csv_columns(args.targets, ["x", "y", "z"])
+    cand = None
+    if args.from_:
+        cand = _core.read_csv_columns(args.from_, [f"q{j + 1}" for j in range(robot.dof)])
+    rules = plan.KeepOut(min_sigma=args.min_sigma,
+                         box=_numbers(args.box, 6, "--box") if args.box else None,
+                         instrument=_numbers(args.instrument, 3, "--instrument") if args.instrument else None,
+                         max_range=args.range, max_incidence_deg=args.max_incidence)
+    res = plan.plan(robot, args.poses, targets=targets, effects=ident.parse_effects(args.effects, robot, args.harmonics),
+                    candidates=cand,
+                    n_candidates=args.candidates, rules=rules, noise_mm=args.noise, seed=args.seed,
+                    progress=_step_progress("plan"))
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    _core.write_file_atomic(args.out, format_rows([f"q{j + 1}" for j in range(robot.dof)], res.q_deg.tolist()))
+    print(res.summary(args.noise))
+    print(f"wrote {len(res.q_deg)} configurations, in a short path order, to {args.out}")
+
+
+def _step_progress(label: str):
+    """A one-line report of a loop's steps on stderr (quiet when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(step: int, steps: int) -> None:
+        print(f"\r{label}: {step + 1} of {steps}   ", end="", file=sys.stderr, flush=True)
+    return report
+
+
 def cmd_bench(args) -> None:
     import kincal_benchmarks
 
@@ -418,6 +470,28 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seed", type=int, default=1, help="the truth's manufacturing errors and the noise")
     sp.add_argument("--out", required=True, help="CSV with the columns of data/fivebar-table1.csv")
     sp.set_defaults(func=cmd_hr_simulate)
+
+    sp = sub.add_parser("plan", help="the configurations to measure that determine the model best (D-optimal)")
+    robot_opts(sp)
+    sp.add_argument("--poses", type=int, required=True, help="number of configurations K")
+    sp.add_argument("--out", required=True, help="CSV q1..qN, in a short path order")
+    sp.add_argument("--targets", default="1", help="the reflectors: a CSV of offsets x,y,z on the tool (mm), or "
+                    "their count (kincal simulate's offsets; default 1)")
+    sp.add_argument("--from", dest="from_", metavar="CANDIDATES.csv", help="candidate configurations (q1..qN); "
+                    "default: random ones inside the joint limits")
+    sp.add_argument("--candidates", type=int, default=5000, help="number of random candidates (default 5000)")
+    effect_opts(sp, "joint_compliance", "effects the campaign must identify")
+    sp.add_argument("--noise", type=float, default=0.02, help="the instrument's noise per coordinate (mm) for "
+                    "the predicted uncertainties")
+    sp.add_argument("--min-sigma", type=float, default=0.0, help="keep out of singularities: the tool Jacobian's "
+                    "smallest singular value at least this share of its largest (angular rows times the reach)")
+    sp.add_argument("--box", metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX", help="the TCP stays in this box (mm, base)")
+    sp.add_argument("--instrument", metavar="X,Y,Z", help="the instrument's position (mm, base frame)")
+    sp.add_argument("--range", type=float, default=math.inf, help="with --instrument: its range (mm)")
+    sp.add_argument("--max-incidence", type=float, default=180.0, help="with --instrument: the largest angle "
+                    "(deg) between a reflector's normal (the tool's z axis) and the line to the instrument")
+    sp.add_argument("--seed", type=int, default=0)
+    sp.set_defaults(func=cmd_plan)
 
     sp = sub.add_parser("bench", help="benchmarks: our code and KDL's solvers in one run, JSON on stdout")
     sp.add_argument("--poses", type=int, default=2000)

@@ -233,6 +233,11 @@ def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
     return grouping.folds(data, k, seed)
 
 
+def _figures(e: np.ndarray, when: str, unit: str) -> dict:
+    """RMS, mean (the Samak paper's figure) and max of errors: {when}_rms_{unit}, ..."""
+    return {f"{when}_rms_{unit}": _rms(e), f"{when}_mean_{unit}": float(np.mean(e)), f"{when}_max_{unit}": float(np.max(e))}
+
+
 def _rms(e: np.ndarray) -> float:
     return float(np.sqrt(np.mean(e ** 2))) if len(e) else float("nan")
 
@@ -278,19 +283,18 @@ class Identification:
         lines = [f"identified {int(np.sum(~np.asarray(f.fixed)))} of {f.layout.size} parameters "
                  f"({', '.join(['geometry'] + self.effect_labels())}) in {f.iterations} iterations"]
         lines.append("")
-        lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'max before':>12}{'max after':>12}")
-        lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}"
+        lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
+                     f"{'mean after':>12}{'max before':>12}{'max after':>12}")
+        lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}{'':>24}"
                      f"{f.nominal_max_mm:>12.4f}{f.max_mm:>12.4f}")
-        if v.get("held_rows"):
-            lines.append(f"{'held-out poses':<28}{v['before_rms_mm']:>12.4f}{v['after_rms_mm']:>12.4f}"
-                         f"{v['before_max_mm']:>12.4f}{v['after_max_mm']:>12.4f}")
-        if "after_rms_deg" in v:
-            lines.append(f"{'orientation (deg), held out':<28}{v['before_rms_deg']:>12.4f}{v['after_rms_deg']:>12.4f}"
-                         f"{v['before_max_deg']:>12.4f}{v['after_max_deg']:>12.4f}")
+        for unit, label in (("mm", "held-out poses"), ("deg", "orientation (deg), held out")):
+            if f"after_rms_{unit}" in v:
+                lines.append(f"{label:<28}" + "".join(f"{v[f'{w}_{s}_{unit}']:>12.4f}" for s in ("rms", "mean", "max")
+                                                      for w in ("before", "after")))
         if v.get("held_rows"):
             lines.append(f"held out: {v['scheme']} ({v['configurations']} configurations: {v['grouping']})")
         if "model_rows" in v:
-            lines.append(f"the model is fitted on {v['model_rows']} ({v['fit_rows']} rows)")
+            lines.append(f"model fitted on {v['fit_rows']} rows: {v['model_rows']}")
         lines.append("")
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}")
         fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
@@ -406,11 +410,9 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     if holdout is not None and val["held_rows"]:
         e = _errors(r, subset(data, ~fit_mask))
     if e:
-        val.update(before_rms_mm=_rms(e["eb"]), after_rms_mm=_rms(e["ea"]), before_max_mm=float(np.max(e["eb"])),
-                   after_max_mm=float(np.max(e["ea"])))
+        val.update(_figures(e["eb"], "before", "mm"), **_figures(e["ea"], "after", "mm"))
         if "oa" in e:
-            val.update(before_rms_deg=_rms(e["ob"]), after_rms_deg=_rms(e["oa"]), before_max_deg=float(np.max(e["ob"])),
-                       after_max_deg=float(np.max(e["oa"])))
+            val.update(_figures(e["ob"], "before", "deg"), **_figures(e["oa"], "after", "deg"))
     val["fit_rows"] = int(fit_mask.sum())
     return Identification(robot=r.robot, targets=np.asarray(r.targets), fit=r, effects=list(effects),
                           validation=val)

@@ -5,6 +5,7 @@ nominal closed-form joint angles out."""
 from __future__ import annotations
 
 import json
+import sys
 from typing import Optional
 
 import numpy as np
@@ -76,6 +77,10 @@ def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: st
                 raise ValueError(f"{joints}:{i + 2}: target {t} but the model knows {len(targets)} target(s)")
             if targets[k].any():
                 poses[i, :3] = poses[i, :3] + _core.abc_to_rotation(poses[i, 3:]) @ targets[k]
+    elif frame == "instrument" and identified_targets(robot_arg).any():
+        # a user with one reflector expects the reflector: say what the rows are
+        print(f"kincal fk: {joints} has no target column: the rows are the tool frame's poses, not the "
+              f"identified targets' points (add a target column to predict those)", file=sys.stderr)
     head = list(extra) + ["x", "y", "z", "a", "b", "c"]
     rows = [[extra[k][i] for k in extra] + list(p) for i, p in enumerate(poses)]
     _core.write_file_atomic(out, format_rows(head, rows))

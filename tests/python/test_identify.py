@@ -78,6 +78,12 @@ def test_fk_in_instrument_frame_predicts_the_measurements(campaign):
             str(campaign / "base.csv"))
     base = np.genfromtxt(campaign / "base.csv", delimiter=",", names=True)
     assert np.min(np.abs(base["x"] - meas["x"])) > 100
+    assert "no target column" not in r.stderr
+    # without a target column the rows are the tool frame's: said on stderr, in one line
+    (campaign / "q.csv").write_text("q1,q2,q3,q4,q5,q6\n0,-90,90,0,30,0\n")
+    r = run("kincal", "fk", "--robot", str(campaign / "cal2.json"), "--joints", str(campaign / "q.csv"), "--frame",
+            "instrument", "--out", str(campaign / "tool.csv"))
+    assert r.returncode == 0 and r.stderr.count("\n") == 1 and "no target column" in r.stderr
 
 
 def test_calibrated_urdf_has_the_model_fk(campaign, tmp_path):

@@ -429,12 +429,15 @@ def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float
     names of earlier versions."""
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
-    layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, True, []).layout
-    frames_only = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
-    opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=frames_only,
-                                 covariance=False)
-    cal = _core.identify(robot, data, opts, None, True)
-    nom = _core.identify(robot, data, opts, None, False)
+    def frames_only(calibrated: bool) -> "_core.IdentifyResult":
+        # the calibrated geometry may load a joint the nominal one does not: each its own names
+        layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, calibrated, []).layout
+        held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
+        opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
+                                     covariance=False)
+        return _core.identify(robot, data, opts, None, calibrated)
+
+    cal, nom = frames_only(True), frames_only(False)
     ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data))
     eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data))
     oa = ob = None

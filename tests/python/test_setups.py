@@ -173,13 +173,15 @@ def test_identify_cli_with_a_setup_column_and_fk_per_setup(tmp_path, truth):
     for name, code in (("A", 0), ("B", 1)):
         rows = data["setup"] == code
         q = data["q_deg"][rows]
-        (tmp_path / "q.csv").write_text("q1,q2,q3,q4,q5,q6\n" + "".join(",".join(map(str, x)) + "\n" for x in q))
+        # a target column: the points of the identified reflector, not the (nominal) TCP
+        (tmp_path / "q.csv").write_text("target,q1,q2,q3,q4,q5,q6\n" + "".join("0," + ",".join(map(str, x)) + "\n"
+                                                                                for x in q))
         extra = ["--setup", name] if name == "B" else []
         r = run("kincal", "fk", "--robot", str(tmp_path / "model.json"), "--joints", str(tmp_path / "q.csv"),
                 "--out", str(tmp_path / "p.csv"), "--frame", "instrument", *extra)
         assert r.returncode == 0, r.stderr
         p = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
-        assert _rms(np.linalg.norm(p[:, :3] - data["xyz"][rows], axis=1)) < 1.2 * NOISE
+        assert _rms(np.linalg.norm(p[:, 1:4] - data["xyz"][rows], axis=1)) < 1.2 * NOISE
     r = run("kincal", "fk", "--robot", str(tmp_path / "model.json"), "--joints", str(tmp_path / "q.csv"),
             "--out", str(tmp_path / "x.csv"), "--frame", "instrument", "--setup", "Z")
     assert r.returncode != 0 and "no setup 'Z' (setups: A, B)" in r.stderr and not (tmp_path / "x.csv").exists()

@@ -62,6 +62,8 @@ struct Parameter {
   std::string name, kind, unit;
   int joint = 0;    ///< from 1; 0 when the parameter concerns no joint (or link)
   int target = -1;  ///< from 0; -1 when not a target offset
+  int setup = -1;   ///< the setup (code, from 0) of a base frame parameter; -1 for the others
+  std::string setup_name;  ///< its name ("" with a single setup)
   int index = 0;
   std::optional<Effect> effect;  ///< the effect (of the layout's effect list) it belongs to
 };
@@ -83,6 +85,8 @@ std::vector<Parameter> parameters_of(const ParamLayout& L) {
       p.kind = "tool";
     } else if (i < L.targets) {
       p.kind = "base";
+      p.setup = (i - L.base) / 6;
+      if (!L.setup_names.empty()) p.setup_name = L.setup_names[static_cast<size_t>(p.setup)];
     } else if (i < L.effects) {
       p.kind = "target";
       p.target = (i - L.targets) / 3;
@@ -106,6 +110,24 @@ struct PyIdentifyResult {
 };
 
 py::array_t<double> vec(const std::vector<double>& v) { return py::array_t<double>(v.size(), v.data()); }
+
+/// Every instrument placement of a model: [(name, xyz_mm, abc_deg)], its base_in_instrument (name "")
+/// when it has no setups.
+std::vector<std::tuple<std::string, Vec3, Vec3>> placements(const ModelSpec& s) {
+  std::vector<std::tuple<std::string, Vec3, Vec3>> out;
+  if (s.setups.empty()) out.emplace_back("", s.base_in_instrument.xyz, s.base_in_instrument.abc);
+  for (const SetupFrame& f : s.setups) out.emplace_back(f.name, f.base_in_instrument.xyz, f.base_in_instrument.abc);
+  return out;
+}
+
+/// The setup names of a PointModel: those given, else the model's own setups (a calibrated model
+/// identified on several setups predicts them with their frames).
+std::vector<std::string> setup_names_or_model(const std::optional<std::vector<std::string>>& given, const Model& m) {
+  if (given) return *given;
+  std::vector<std::string> names;
+  for (const SetupFrame& f : m.spec().setups) names.push_back(f.name);
+  return names;
+}
 
 /// joint_compliance effects in the options' effect list are the compliance switches of the core
 IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
@@ -143,8 +165,9 @@ void define_identify(py::module_& m) {
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
          const RowMatrix& targets, double limit_margin, const std::vector<std::pair<Effect, std::vector<double>>>& effects,
-         double t_ref, double orientation_noise_deg) {
+         double t_ref, double orientation_noise_deg, double duration_s) {
         SimulationOptions o;
+        o.duration_s = duration_s;
         o.poses = poses, o.seed = seed, o.limit_margin = limit_margin;
         o.noise_mm = noise_mm, o.orientation_noise_deg = orientation_noise_deg;
         o.outlier_fraction = outlier_fraction, o.outlier_mm = outlier_mm;
@@ -154,9 +177,10 @@ void define_identify(py::module_& m) {
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
       py::arg("effects") = std::vector<std::pair<Effect, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
-      py::arg("orientation_noise_deg") = -1.0,
+      py::arg("orientation_noise_deg") = -1.0, py::arg("duration_s") = 0.0,
       "A measurement campaign on the calibrated (true) model of a robot; effects: (Effect, values in core\n"
-      "units) hidden in the truth");
+      "units) hidden in the truth. duration_s > 0: a time_s column, the campaign running from 0 to\n"
+      "duration_s in pose order (a hidden drift without it: 3 h, centred on the mean time)");
   m.def(
       "point_errors",
       [](const Robot& r, const RowMatrix& targets, const py::dict& d) {
@@ -164,7 +188,17 @@ void define_identify(py::module_& m) {
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("targets"), py::arg("data"),
-      "Distance (mm) between every measured point and the calibrated model's prediction (its effects acting)");
+      "Distance (mm) between every measured point and the calibrated model's prediction (its effects acting,\n"
+      "each row seen from its setup's placement, the model's drift at the row's time)");
+  m.def(
+      "orientation_errors",
+      [](const Robot& r, const py::dict& d) {
+        const auto e = orientation_errors(*r.calibrated, measurements_from_dict(d, r.calibrated->dof()));
+        return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
+      },
+      py::arg("robot"), py::arg("data"),
+      "Angle (deg) between every measured orientation (a 6-D set) and the calibrated model's (its effects\n"
+      "acting, each row seen from its setup's placement at its time)");
 
   py::class_<Parameter>(m, "Parameter", "One parameter of the identification vector")
       .def_readonly("name", &Parameter::name, "e.g. 'joint3.tilt_u', 'base.ry', 'joint2.te_sin1'")
@@ -172,6 +206,8 @@ void define_identify(py::module_& m) {
                     "'joint_geometry', 'compliance', 'tool', 'base', 'target' or the effect's name")
       .def_readonly("joint", &Parameter::joint, "joint (or link) from 1; 0 when none")
       .def_readonly("target", &Parameter::target, "target from 0; -1 when none")
+      .def_readonly("setup", &Parameter::setup, "setup code (from 0) of a base frame parameter; -1 for the others")
+      .def_readonly("setup_name", &Parameter::setup_name, "its setup's name ('' with a single setup)")
       .def_readonly("unit", &Parameter::unit, "'rad', 'mm', 'deg/kNm', '1/degC'")
       .def_readonly("index", &Parameter::index, "position in the parameter vector")
       .def_readonly("effect", &Parameter::effect, "the effect it belongs to (None for the others)")
@@ -182,11 +218,13 @@ void define_identify(py::module_& m) {
   const std::tuple<const char*, int ParamLayout::*, const char*> sizes_and_offsets[] = {
       {"dof", &ParamLayout::dof, "number of joints"},
       {"n_targets", &ParamLayout::n_targets, "number of targets"},
+      {"n_setups", &ParamLayout::n_setups, "number of instrument placements (6 base parameters each)"},
+      {"drift", &ParamLayout::drift, "offset of the drift's 6 parameters (-1: none)"},
       {"size", &ParamLayout::size, "number of parameters"},
       {"joints", &ParamLayout::joints, "offset of the joint geometry (4 per joint)"},
       {"compliance", &ParamLayout::compliance, "offset of the compliances (1 per gravity-loaded joint)"},
       {"tool", &ParamLayout::tool, "offset of the tool frame (6)"},
-      {"base", &ParamLayout::base, "offset of the base frame in the instrument frame (6)"},
+      {"base", &ParamLayout::base, "offset of the base frames in the instrument frame (6 per setup)"},
       {"targets", &ParamLayout::targets, "offset of the target offsets (3 per target)"},
       {"effects", &ParamLayout::effects, "offset of the extra effects' parameters"}};
   for (const auto& [name, field, doc] : sizes_and_offsets) layout.def_readonly(name, field, doc);
@@ -194,6 +232,8 @@ void define_identify(py::module_& m) {
       .def_readonly("effect_list", &ParamLayout::effect_list, "the extra effects, in order")
       .def_readonly("effect_offset", &ParamLayout::effect_offset, "offset of each extra effect")
       .def_readonly("t_ref", &ParamLayout::t_ref, "reference temperature of thermal_expansion (degC)")
+      .def_readonly("t_mean", &ParamLayout::t_mean, "reference time of the drift (s)")
+      .def_readonly("setup_names", &ParamLayout::setup_names, "the setups by code (empty: a single one)")
       .def_property_readonly("loaded", [](const ParamLayout& L) { return joints_to_one(L.loaded); },
                              "joints (from 1) with a compliance parameter: the gravity-loaded ones")
       .def_readonly("names", &ParamLayout::names, "one per parameter, e.g. 'joint3.tilt_u', 'base.ry'")
@@ -282,6 +322,12 @@ void define_identify(py::module_& m) {
       .def_property_readonly("effects", [](const PyIdentifyResult& r) { return effect_values_to(r.r.effects); },
                              "(Effect, values in core units) of every extra effect")
       .def_property_readonly("t_ref", [](const PyIdentifyResult& r) { return r.r.t_ref; })
+      .def_property_readonly("t_mean_s", [](const PyIdentifyResult& r) { return r.r.t_mean_s; },
+                             "reference time of the drift (s): the data's mean time")
+      .def_property_readonly("setups", [](const PyIdentifyResult& r) { return placements(r.r.calibrated); },
+                             "every instrument placement: (name, xyz_mm, abc_deg); name '' for a single one")
+      .def_property_readonly("nominal_setups", [](const PyIdentifyResult& r) { return placements(r.r.nominal_fitted); },
+                             "the placements fitted on the nominal geometry")
       .def_property_readonly("iterations", [](const PyIdentifyResult& r) { return r.r.iterations; })
       .def_property_readonly("initial_cost", [](const PyIdentifyResult& r) { return r.r.initial_cost; })
       .def_property_readonly("final_cost", [](const PyIdentifyResult& r) { return r.r.final_cost; })
@@ -333,11 +379,17 @@ void define_identify(py::module_& m) {
 
   py::class_<PointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
       .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
-                       bool from_calibrated) {
-             return new PointModel(from_calibrated ? *r.calibrated : *r.nominal, n_targets, effects, t_ref);
+                       bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
+                       std::optional<double> t_mean_s) {
+             const Model& m = from_calibrated ? *r.calibrated : *r.nominal;
+             return new PointModel(m, n_targets, effects, t_ref, setup_names_or_model(setups, m),
+                                   t_mean_s ? *t_mean_s : m.spec().t_mean_s);
            }),
            py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
-           py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::keep_alive<1, 2>())
+           py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
+           py::arg("t_mean_s") = py::none(), py::keep_alive<1, 2>(),
+           "setups: the data's setup names (default: the model's setups); t_mean_s: the drift's reference\n"
+           "time (default: the model's)")
       .def_property_readonly("layout", [](const PointModel& p) -> const ParamLayout& { return p.layout(); },
                              py::return_value_policy::reference_internal)
       .def_property_readonly("names", [](const PointModel& p) { return p.layout().names; })
@@ -348,6 +400,9 @@ void define_identify(py::module_& m) {
           [](PointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
             const MeasurementSet data = measurements_from_dict(d, p.layout().dof);
             if (static_cast<int>(x.size()) != p.layout().size) throw InputError("PointModel: wrong parameter count");
+            if (!p.layout().setup_names.empty() && data.setup_names != p.layout().setup_names)
+              throw InputError(data.source + ": the data's setups are not the layout's (" +
+                               std::to_string(p.layout().n_setups) + " setups in that order)");
             p.prepare_payloads(data);
             p.set_params(x);
             const size_t n = residual_size(residual_kind(data)) * data.rows.size();

@@ -1,15 +1,52 @@
 // Bindings of measurement files. A measurement set crosses the boundary as a dict of numpy arrays:
 // pose (n), q_deg (n x dof), xyz (n x 3), target (n), payload_kg (n, NaN for the model's payload),
 // line (n: source line, 0 when simulated), source; when the set has them also temperature_c (n),
-// abc (n x 3: the measured orientations) and dir (n x dof: the joints' directions of motion).
+// abc (n x 3: the measured orientations), dir (n x dof: the joints' directions of motion), time_s
+// (n), config (n int64 codes) with config_names (the values by code, in order of first appearance)
+// and setup (n int64 codes) with setup_names.
 #include "common.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 
 #include "kincal/io/measurements.hpp"
 
 using namespace kincal;
+
+namespace {
+
+using Codes = Eigen::Matrix<int64_t, Eigen::Dynamic, 1>;
+
+/// The codes and names of a text column (config, setup) from the dict; names default to the codes'
+/// numbers. InputError for a code out of range or a name a CSV cannot hold.
+std::vector<std::string> codes_from(const py::dict& d, const char* key, size_t n, const std::string& source,
+                                    Codes& codes) {
+  codes = d[key].cast<Codes>();
+  if (static_cast<size_t>(codes.size()) != n)
+    throw InputError(source + ": " + key + " of a different length");
+  const std::string names_key = std::string(key) + "_names";
+  std::vector<std::string> names;
+  if (d.contains(names_key.c_str())) {
+    names = d[names_key.c_str()].cast<std::vector<std::string>>();
+  } else {
+    const int64_t top = n ? codes.maxCoeff() : -1;
+    for (int64_t k = 0; k <= top; ++k) names.push_back(std::to_string(k));
+  }
+  for (const auto& name : names)
+    if (name.empty() || name.find_first_of(",\n\r\"") != std::string::npos ||
+        std::isspace(static_cast<unsigned char>(name.front())) || std::isspace(static_cast<unsigned char>(name.back())))
+      throw InputError(source + ": " + names_key + ": '" + name +
+                       "' is not a CSV value (empty, a comma, quote or line break, or spaces around it)");
+  for (size_t i = 0; i < n; ++i)
+    if (codes[i] < 0 || codes[i] >= static_cast<int64_t>(names.size()))
+      throw InputError(source + ": " + key + " code " + std::to_string(codes[i]) + " at row " + std::to_string(i) +
+                       " is not one of 0.." + std::to_string(static_cast<int64_t>(names.size()) - 1));
+  return names;
+}
+
+}  // namespace
 
 py::dict measurements_to_dict(const MeasurementSet& m, int dof) {
   const size_t n = m.rows.size();
@@ -38,6 +75,23 @@ py::dict measurements_to_dict(const MeasurementSet& m, int dof) {
     d["abc"] = abc;
   }
   if (dir) d["dir"] = dirs;
+  if (m.has_time()) {
+    Eigen::VectorXd t(n);
+    for (size_t i = 0; i < n; ++i) t[i] = m.rows[i].time_s;
+    d["time_s"] = t;
+  }
+  if (!m.config_names.empty()) {
+    Codes c(n);
+    for (size_t i = 0; i < n; ++i) c[i] = m.rows[i].config;
+    d["config"] = c;
+    d["config_names"] = m.config_names;
+  }
+  if (!m.setup_names.empty()) {
+    Codes c(n);
+    for (size_t i = 0; i < n; ++i) c[i] = m.rows[i].setup;
+    d["setup"] = c;
+    d["setup_names"] = m.setup_names;
+  }
   return d;
 }
 
@@ -88,6 +142,23 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
     const auto dd = d["dir"].cast<RowMatrix>();
     if (static_cast<size_t>(dd.rows()) != n || dd.cols() != dof) throw InputError(m.source + ": dir of a different shape");
     for (size_t i = 0; i < n; ++i) m.rows[i].dir = dd.row(i).transpose();
+  }
+  if (d.contains("time_s")) {
+    const auto t = d["time_s"].cast<Eigen::VectorXd>();
+    if (static_cast<size_t>(t.size()) != n) throw InputError(m.source + ": time_s of a different length");
+    for (size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(t[i])) throw InputError(m.source + ": time_s at row " + std::to_string(i) + " is not finite");
+      m.rows[i].time_s = t[i];
+    }
+  }
+  Codes codes;
+  if (d.contains("config")) {
+    m.config_names = codes_from(d, "config", n, m.source, codes);
+    for (size_t i = 0; i < n; ++i) m.rows[i].config = static_cast<int>(codes[i]);
+  }
+  if (d.contains("setup")) {
+    m.setup_names = codes_from(d, "setup", n, m.source, codes);
+    for (size_t i = 0; i < n; ++i) m.rows[i].setup = static_cast<int>(codes[i]);
   }
   m.n_targets = nt;
   return m;

@@ -7,6 +7,7 @@
 #include "kincal/model/robots.hpp"
 
 #include <array>
+#include <tuple>
 #include <optional>
 
 using namespace kincal;
@@ -40,6 +41,33 @@ void define_model(py::module_& m) {
           },
           "the calibrated model's effects besides compliance: (Effect, values in core units)")
       .def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated->spec().t_ref_c; })
+      .def_property_readonly(
+          "placements",
+          [](const Robot& r) {
+            std::vector<std::tuple<std::string, Vec3, Vec3>> out;
+            const ModelSpec& s = r.calibrated->spec();
+            if (s.setups.empty()) out.emplace_back("", s.base_in_instrument.xyz, s.base_in_instrument.abc);
+            for (const SetupFrame& f : s.setups) out.emplace_back(f.name, f.base_in_instrument.xyz, f.base_in_instrument.abc);
+            return out;
+          },
+          "the instrument placements the calibrated model knows: (name, xyz_mm, abc_deg) per setup; one\n"
+          "named '' (its base_in_instrument) without setups. fk and compensate use the first.")
+      .def_property_readonly("t_mean_s", [](const Robot& r) { return r.calibrated->spec().t_mean_s; },
+                             "the drift's reference time (s), when the model carries a drift")
+      .def(
+          "with_placements",
+          [](const Robot& r, const std::vector<std::tuple<std::string, Vec3, Vec3>>& setups) {
+            if (setups.empty()) throw InputError("with_placements: at least one placement");
+            ModelSpec s = r.calibrated->spec();
+            s.base_in_instrument = Pose6{std::get<1>(setups[0]), std::get<2>(setups[0])};
+            s.setups.clear();
+            if (setups.size() > 1)
+              for (const auto& [name, xyz, abc] : setups) s.setups.push_back(SetupFrame{name, Pose6{xyz, abc}});
+            return Robot{r.nominal, std::make_shared<Model>(s)};
+          },
+          py::arg("setups"),
+          "The robot with its calibrated model seen from these placements: (name, xyz_mm, abc_deg) per\n"
+          "setup, the first its base_in_instrument (one: no setups)")
       .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated->needs_dir(); },
                              "backlash: the direction of motion into each pose is needed")
       .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated->needs_temperature(); },

@@ -20,6 +20,7 @@ from . import fivebar
 from . import identify as ident
 from .csv_text import format_rows
 from .kinematics_files import fk_file, ik_file
+from .setups import robot_for_setup
 from .urdf import spec_urdf, urdf_left_out
 
 
@@ -28,7 +29,12 @@ def _robot(args) -> _core.Robot:
 
 
 def cmd_fk(args) -> None:
-    fk_file(_robot(args), args.robot, args.joints, args.out, args.frame, args.temperature)
+    robot = _robot(args)
+    if args.setup is not None:
+        if args.frame != "instrument":
+            raise ValueError("--setup NAME chooses an instrument placement: it needs --frame instrument")
+        robot = robot_for_setup(robot, args.setup, args.robot)
+    fk_file(robot, args.robot, args.joints, args.out, args.frame, args.temperature)
 
 
 def _directions(text: Optional[str]) -> list:
@@ -113,7 +119,7 @@ def cmd_simulate(args) -> None:
     data = ident.simulate(truth, pool, seed=args.seed, noise_mm=args.noise, targets=args.targets,
                           outlier_fraction=args.outliers, outlier_mm=args.outlier_mm,
                           effects=[ident.parse_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide],
-                          orientation_noise_deg=args.orientation_noise)
+                          orientation_noise_deg=args.orientation_noise, duration_h=args.duration)
     if args.select == "observability":
         data = ident.select_observable(robot, data, args.poses)
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
@@ -145,6 +151,15 @@ def cmd_identify(args) -> None:
                   f"(in {args.out})", file=sys.stderr)
     _core.write_file_atomic(args.out, text)
     print(res.summary())
+
+
+def cmd_validate(args) -> None:
+    robot = load_robot(args.model)
+    data = ident.read_measurements(args.data, robot)
+    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
+    v["model"] = str(args.model)
+    _core.write_file_atomic(args.out, json.dumps(v, indent=1, sort_keys=True) + "\n")
+    print(ident.validation_summary(v))
 
 
 def cmd_hr_fit(args) -> None:
@@ -337,7 +352,11 @@ def build_parser() -> argparse.ArgumentParser:
     robot_opts(sp)
     sp.add_argument("--joints", required=True, help="CSV q1..qN (or a G-code joint program)")
     sp.add_argument("--out", required=True, help="CSV x,y,z,a,b,c")
-    sp.add_argument("--frame", choices=["base", "instrument"], default="base")
+    sp.add_argument("--frame", choices=["base", "instrument"], default="base",
+                    help="instrument: the identified model's instrument frame (its first setup's placement "
+                         "unless --setup)")
+    sp.add_argument("--setup", metavar="NAME", help="with --frame instrument: the placement of this setup of a "
+                                                    "model identified from several")
     sp.add_argument("--temperature", type=float, help="thermal expansion: the temperature (C), instead of a "
                                                        "temperature_c column")
     sp.set_defaults(func=cmd_fk)
@@ -389,7 +408,11 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
                     help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg; a sine and a cosine "
                          "amplitude per order of --harmonics), backlash:J:b (deg per direction sign), "
-                         "thermal_expansion:0:alpha (1/C, about 20 C); repeatable")
+                         "thermal_expansion:0:alpha (1/C, about 20 C), drift:0:vx,vy,vz,wx,wy,wz (the "
+                         "instrument's drift: mm/h and deg/h about the campaign's mean time; 3 h unless "
+                         "--duration); repeatable")
+    sp.add_argument("--duration", type=float, metavar="HOURS",
+                    help="a time_s column: the campaign runs from 0 to HOURS in pose order")
     sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                     help="harmonic orders of a hidden transmission_error (default 1,2)")
     sp.add_argument("--seed", type=int, default=1)
@@ -397,7 +420,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     sp = sub.add_parser("identify", help="parameter identification from measurements")
     robot_opts(sp)
-    sp.add_argument("--data", required=True, help="measurement CSV (pose, q1..qN, x, y, z[, target, payload_kg])")
+    sp.add_argument("--data", required=True, help="measurement CSV (pose, q1..qN, x, y, z[, target, payload_kg, "
+                                                  "time_s, config, setup]; a setup column: one placement each)")
     sp.add_argument("--out", required=True, help="model JSON")
     effect_opts(sp, "joint_compliance", "non-geometric effects to identify")
     loss_opts(sp)
@@ -411,6 +435,14 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
     model_opts(sp)
     sp.set_defaults(func=cmd_identify)
+
+    sp = sub.add_parser("validate", help="check a calibration on new measurements (placements and targets refitted)")
+    sp.add_argument("--model", required=True, help="model JSON (kincal identify or diagnose), or any --robot")
+    sp.add_argument("--data", required=True, help="measurement CSV of the new campaign (a setup column: one "
+                                                  "placement per setup)")
+    sp.add_argument("--out", required=True, help="V.json: points, rms_mm, mean_mm, max_mm, before_rms_mm, ...")
+    loss_opts(sp)
+    sp.set_defaults(func=cmd_validate)
 
     sp = sub.add_parser("feed", help="derivative analysis of joint programs (Samak section III)")
     robot_opts(sp)

@@ -1,7 +1,9 @@
 """Measurement campaigns and parameter identification (the Samak paper's calibration step 3).
 
 A measurement set is a dict of numpy arrays (``pose``, ``q_deg``, ``xyz``, ``target``,
-``payload_kg``, ``line``, ``source``), the rows of the contract's measurement CSV.
+``payload_kg``, ``line``, ``source``), the rows of the contract's measurement CSV; with the optional
+columns also ``temperature_c``, ``dir``, ``abc``, ``time_s``, ``config`` (int64 codes) with
+``config_names`` and ``setup`` (int64 codes, one instrument placement each) with ``setup_names``.
 The heavy work (residuals, analytic Jacobian, Ceres) runs in the C++ core.
 """
 
@@ -16,6 +18,7 @@ import numpy as np
 
 from . import _core, grouping
 from ._core import Robot
+from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 
 #: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
 DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
@@ -34,7 +37,8 @@ def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg:
 
 def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
              outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence = (),
-             t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None) -> dict:
+             t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None,
+             duration_h: Optional[float] = None) -> dict:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
     model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
     ``effects`` hides more effects in the truth: (Effect, values) or (name, joint from 1 or 0, values),
@@ -42,7 +46,9 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
     and cosine amplitudes and backlash's offset per direction sign, 1/degC for thermal_expansion about
     t_ref). Every row gets dir1..dirN and
     temperature_c (drifting from 18 to 30 C over the campaign). With ``orientation_noise_deg`` the
-    tool frame's orientation is measured too (a 6-D probe): columns a, b, c."""
+    tool frame's orientation is measured too (a 6-D probe): columns a, b, c. With ``duration_h`` the
+    rows get time_s, the campaign running from 0 to that many hours in pose order; a hidden drift
+    (mm/h and rad/h) without it gets a 3 h campaign, the drift centred on its mean time."""
     if poses < 1:
         raise ValueError(f"the number of poses must be positive, not {poses}")
     if not 1 <= targets <= len(DEFAULT_TARGETS):
@@ -51,9 +57,12 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
         raise ValueError(f"the noise must be a finite non-negative number, not {noise_mm}")
     if not 0.0 <= outlier_fraction <= 1.0:
         raise ValueError(f"the outlier fraction must be in 0..1, not {outlier_fraction}")
+    if duration_h is not None and not (duration_h > 0 and math.isfinite(duration_h)):
+        raise ValueError(f"the campaign's duration must be a positive number of hours, not {duration_h}")
     return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets], 0.9,
                           [_effect_value(e) for e in effects], t_ref,
-                          -1.0 if orientation_noise_deg is None else float(orientation_noise_deg))
+                          -1.0 if orientation_noise_deg is None else float(orientation_noise_deg),
+                          0.0 if duration_h is None else 3600.0 * float(duration_h))
 
 
 def _effect_value(e: Sequence) -> tuple:
@@ -157,6 +166,8 @@ def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
                              "last motion into the pose)")
         if need == "temperature_c" and "temperature_c" not in data:
             raise ValueError(f"{src}: {e.label} needs the temperature_c column")
+        if need == "time_s" and "time_s" not in data:
+            raise ValueError(f"{src}: {e.label} needs the time_s column (when each point was measured, s)")
 
 
 def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
@@ -276,6 +287,11 @@ class Identification:
                     "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
         }
+        if f.layout.n_setups > 1:
+            d["identification"]["setups"] = setup_frames(f.setups)
+        drift = drift_report(f)
+        if drift:
+            d["identification"]["drift"] = drift
         return json.dumps(d, indent=1, sort_keys=True) + "\n"
 
     def summary(self) -> str:
@@ -296,6 +312,18 @@ class Identification:
         if "model_rows" in v:
             lines.append(f"model fitted on {v['fit_rows']} rows: {v['model_rows']}")
         lines.append("")
+        if f.layout.n_setups > 1:
+            lines.append(f"{f.layout.n_setups} instrument placements (base frame seen from the instrument; fk and "
+                         f"compensate --frame instrument use the first):")
+            for st in setup_frames(f.setups):
+                b = st["base_in_instrument"]
+                lines.append(f"  {st['name']:<12} xyz {' '.join(f'{v:.3f}' for v in b['xyz_mm'])} mm, "
+                             f"abc {' '.join(f'{v:.4f}' for v in b['abc_deg'])} deg")
+        drift = drift_report(f)
+        if drift:
+            rates = ", ".join("{} {:+.4g} {}".format(x["name"], x["value"], x["unit"]) for x in drift["parameters"])
+            lines.append(f"instrument drift about t = {drift['t_mean_s']:.0f} s (removed from the fit, never "
+                         f"compensated): {rates}")
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}")
         fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
         if fixed:
@@ -320,13 +348,9 @@ def _fit(robot: Robot, data: dict, opts: "_core.IdentifyOptions",
 
 
 def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
-    """Angle (deg) between the measured and the predicted tool orientation of every 6-D row."""
-    pred = _core.fk(robot, np.asarray(data["q_deg"], dtype=float), True, True)
-    out = np.empty(len(pred))
-    for i, (p, m) in enumerate(zip(pred[:, 3:], data["abc"])):
-        r = _core.abc_to_rotation(m).T @ _core.abc_to_rotation(p)
-        out[i] = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2))))
-    return out
+    """Angle (deg) between the measured and the predicted tool orientation of every 6-D row (each
+    row seen from its setup's placement, the model's drift at its time)."""
+    return np.asarray(_core.orientation_errors(robot, data))
 
 
 def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> list:
@@ -419,19 +443,37 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
 
 
 def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
-    """Accuracy of an identified robot on another measurement series, where the instrument may stand
-    elsewhere and the probe may sit differently: only the base frame and the targets are refitted
-    (on the calibrated geometry, and on the nominal one for the "before")."""
-    layout = _core.PointModel(robot, int(np.max(data["target"])) + 1).layout
-    frames_only = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
-    opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=frames_only,
-                                 covariance=False)
-    cal = _core.identify(robot, data, opts, None, True)
-    nom = _core.identify(robot, data, opts, None, False)
-    ea = _core.point_errors(cal.robot, cal.targets, data)
-    eb = _core.point_errors(nom.robot, nom.targets, data)
-    return {"rows": int(len(ea)), "before_rms_mm": _rms(eb), "after_rms_mm": _rms(ea),
-            "before_max_mm": float(np.max(eb)), "after_max_mm": float(np.max(ea))}
+    """Accuracy of an identified robot on another measurement campaign, where the instrument stands
+    elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
+    differently: only the placements and the target offsets are refitted, on the calibrated
+    geometry (every effect it carries acting, its drift left out: that was the other campaign's)
+    and, for the "before", on the nominal one. Returns the contract's figures (``points``,
+    ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm``; with measured orientations ``rms_deg``,
+    ``mean_deg``), ``before_mean_mm``, ``before_max_mm``, per setup the same under ``setups`` and
+    the refitted ``placements``; ``rows``, ``after_rms_mm``, ``after_max_mm`` repeat them under the
+    names of earlier versions."""
+    if loss not in ("none", "huber", "cauchy"):
+        raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
+    def frames_only(calibrated: bool) -> "_core.IdentifyResult":
+        # the calibrated geometry may load a joint the nominal one does not: each its own names
+        layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, calibrated, []).layout
+        held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
+        opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
+                                     covariance=False)
+        return _core.identify(robot, data, opts, None, calibrated)
+
+    cal, nom = frames_only(True), frames_only(False)
+    ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data))
+    eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data))
+    oa = ob = None
+    if "abc" in data:
+        oa, ob = orientation_errors_deg(cal.robot, data), orientation_errors_deg(nom.robot, data)
+
+    v = validation_figures(ea, eb, oa, ob, data)
+    v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
+             refitted="the instrument placement of every setup and the target offsets; the model's geometry and "
+                      "effects held (its drift left out)", placements=setup_frames(cal.setups))
+    return v
 
 
 def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:

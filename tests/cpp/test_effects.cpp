@@ -56,7 +56,9 @@ TEST(Effects, RegistryNamesEveryEffectOnce) {
   std::vector<std::string> names;
   for (const auto& k : effect_kinds()) names.push_back(k.name);
   EXPECT_EQ(names, (std::vector<std::string>{"joint_compliance", "transmission_error", "backlash", "thermal_expansion",
-                                             "link_deflection"}));
+                                             "drift", "link_deflection"}));
+  EXPECT_EQ(effect_kind("drift").needs, "time_s");
+  EXPECT_EQ(Effect{"drift"}.file_units()[3], "deg/h");
   EXPECT_EQ(effect_kind("backlash").needs, "dir");
   EXPECT_EQ(effect_kind("link_deflection").domain, "fivebar");
   EXPECT_THROW(effect_kind("gear_wobble"), InputError);

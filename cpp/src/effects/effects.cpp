@@ -18,6 +18,10 @@ const std::vector<EffectKind>& effect_kinds() {
        "an offset of the joint angle that depends on the approach direction: b dir (deg)", false},
       {"thermal_expansion", "serial", "robot", "temperature_c", "length_scale",
        "the robot's lengths scale by 1 + alpha (T - t_ref) (alpha per deg C)", false},
+      {"drift", "serial", "robot", "time_s", "instrument",
+       "the instrument's placement moving linearly with time (a property of the measurement: removed from "
+       "the fit, never compensated): translation mm/h and rotation deg/h about the campaign's mean time",
+       false},
       {"link_deflection", "fivebar", "link", "", "link_length",
        "a link length that varies with the pose: p1 cos t1 + p2 sin t1 + p3 cos t2 + p4 sin t2 (mm)", false},
   };
@@ -35,6 +39,7 @@ const EffectKind& effect_kind(const std::string& name) {
 int Effect::size() const {
   if (name == "transmission_error") return 2 * static_cast<int>(harmonics.size());
   if (name == "link_deflection") return 4;
+  if (name == "drift") return 6;
   effect_kind(name);
   return 1;
 }
@@ -54,11 +59,13 @@ std::vector<std::string> Effect::parameter_names() const {
   if (name == "joint_compliance") return {"compliance"};
   if (name == "backlash") return {"backlash"};
   if (name == "thermal_expansion") return {"thermal_expansion"};
+  if (name == "drift") return {"drift_x", "drift_y", "drift_z", "drift_rx", "drift_ry", "drift_rz"};
   effect_kind(name);
   return {};
 }
 
 std::vector<std::string> Effect::units() const {
+  if (name == "drift") return {"mm/h", "mm/h", "mm/h", "rad/h", "rad/h", "rad/h"};
   std::string u = "rad";
   if (name == "joint_compliance") u = "deg/kNm";
   if (name == "thermal_expansion") u = "1/degC";
@@ -70,12 +77,13 @@ std::vector<std::string> Effect::file_units() const {
   std::vector<std::string> u = units();
   for (auto& s : u)
     if (s == "rad") s = "deg";
+    else if (s == "rad/h") s = "deg/h";
   return u;
 }
 
 std::vector<double> Effect::file_scale() const {
   std::vector<double> s;
-  for (const auto& u : units()) s.push_back(u == "rad" ? 1 / kDeg : 1.0);
+  for (const auto& u : units()) s.push_back(u == "rad" || u == "rad/h" ? 1 / kDeg : 1.0);
   return s;
 }
 

@@ -74,7 +74,7 @@ std::vector<int> preference_order(const ParamLayout& L, bool orientation) {
   // with measured orientations the tool's rotation is seen: keep it, hold the base's gauge instead
   if (orientation)
     for (int i = L.tool + 3; i < L.tool + 6; ++i) order.push_back(i);
-  for (int i = L.base; i < L.base + 6; ++i) order.push_back(i);
+  for (int i = L.base; i < L.targets; ++i) order.push_back(i);  // every setup's
   for (int k = 0; k < 4; ++k) order.push_back(k);
   for (int i = L.tool; i < L.tool + (orientation ? 3 : 6); ++i) order.push_back(i);
   return order;
@@ -126,13 +126,14 @@ void select_independent(const Eigen::MatrixXd& J, const std::vector<int>& order,
 }
 
 /// A generic campaign: 100 random poses in the joint limits, every measured target, the same kind
-/// of rows (J_r^-1 keeps the rank for any abc) and temperatures drawn from the data.
+/// of rows (J_r^-1 keeps the rank for any abc) and temperatures, times and setups drawn from the data.
 MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data) {
   const int dof = nominal.dof();
   const std::vector<bool> measured = measured_targets(data);
   MeasurementSet generic;
   generic.n_targets = data.n_targets;
   generic.orientation = data.orientation;
+  generic.setup_names = data.setup_names;
   std::mt19937_64 rng(12345);
   std::uniform_real_distribution<double> ud(-0.45, 0.45);
   for (int p = 0; p < 100; ++p) {
@@ -145,7 +146,10 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
     }
     row.dir.resize(dof);
     for (int j = 0; j < dof; ++j) row.dir[j] = ud(rng) < 0 ? -1.0 : 1.0;
-    row.temperature_c = data.rows[rng() % data.rows.size()].temperature_c;
+    const Measurement& like = data.rows[rng() % data.rows.size()];
+    row.temperature_c = like.temperature_c;
+    row.time_s = like.time_s;
+    row.setup = like.setup;
     row.has_abc = data.orientation;
     for (int t = 0; t < data.n_targets; ++t)
       if (measured[t]) row.target = t, generic.rows.push_back(row);
@@ -177,6 +181,12 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
   for (int t = 0; t < data.n_targets; ++t)
     if (!measured[t])
       for (int k = 0; k < 3; ++k) res.fix(L.targets + 3 * t + k, "target never measured");
+  std::vector<bool> placed(static_cast<size_t>(L.n_setups), false);
+  for (const auto& r : data.rows)
+    if (r.setup >= 0 && r.setup < L.n_setups) placed[static_cast<size_t>(r.setup)] = true;
+  for (int s = 0; s < L.n_setups; ++s)
+    if (!placed[static_cast<size_t>(s)])
+      for (int k = 0; k < 6; ++k) res.fix(L.base + 6 * s + k, "setup never measured");
   if (!opt.compliance)
     for (int i = L.compliance; i < L.tool; ++i) res.fix(i, "not asked for (--effects)");
   else if (!opt.compliance_joints.empty())

@@ -148,10 +148,12 @@ void check_rows(const Model& nominal, const MeasurementSet& data) {
 
 bool same_effect(const Effect& a, const Effect& b) { return a.name == b.name && a.joint == b.joint; }
 
-/// The extra effects: those asked for, then those the starting model carries (held at their values).
+/// The extra effects: those asked for, then those the starting model carries (held at their values),
+/// but its drift: a property of the campaign it was measured on, not of the robot.
 std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt) {
   std::vector<Effect> effects = opt.effects;
   for (const EffectValue& ev : nominal.spec().effects) {
+    if (ev.effect.name == "drift") continue;
     bool asked = false;
     for (const Effect& e : effects) asked = asked || same_effect(e, ev.effect);
     if (!asked) effects.push_back(ev.effect);
@@ -172,6 +174,10 @@ void check_effect_columns(const Model& nominal, const MeasurementSet& data, cons
       if (std::isnan(r.temperature_c))
         throw InputError(where(data, r) + ": thermal_expansion needs the temperature_c column");
   for (const Effect& e : effects)
+    if (e.name == "drift")
+      for (const auto& r : data.rows)
+        if (std::isnan(r.time_s)) throw InputError(where(data, r) + ": drift needs the time_s column");
+  for (const Effect& e : effects)
     if (e.name == "backlash")
       for (const auto& r : data.rows)
         if (r.dir.size() != nominal.dof())
@@ -188,12 +194,21 @@ double reference_temperature(const Model& nominal, const MeasurementSet& data, c
   return sum / data.rows.size();
 }
 
+/// The drift's reference time: the data's mean time (the placements are those of that moment).
+double reference_time(const MeasurementSet& data, const std::vector<Effect>& effects) {
+  if (std::none_of(effects.begin(), effects.end(), [](const Effect& e) { return e.name == "drift"; })) return 0;
+  double sum = 0;
+  for (const auto& r : data.rows) sum += r.time_s;
+  return sum / data.rows.size();
+}
+
 /// Effects the starting model carries start from its values; those not asked for are held there.
 void start_carried_effects(const Model& nominal, const IdentifyOptions& opt, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
   for (size_t e = 0; e < L.effect_list.size(); ++e)
     for (const EffectValue& ev : nominal.spec().effects)
-      if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size()) {
+      if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size() &&
+          ev.effect.name != "drift") {
         const bool asked = e < opt.effects.size();
         for (size_t k = 0; k < ev.p.size(); ++k) {
           const int i = L.effect_offset[e] + static_cast<int>(k);
@@ -208,9 +223,9 @@ Vec3 target_of(const ParamLayout& L, const std::vector<double>& x, int t) {
   return Vec3(x[L.targets + 3 * t], x[L.targets + 3 * t + 1], x[L.targets + 3 * t + 2]);
 }
 
-/// Stage 1: the base frame and targets fitted on the nominal geometry (the "before" of the summary,
-/// and a start where the targets are where they are, so that the identifiability analysis sees the
-/// real geometry). x: from the start to the fitted frames.
+/// Stage 1: the base frame of every setup, the targets and the drift fitted on the nominal geometry
+/// (the "before" of the summary, and a start where the targets are where they are, so that the
+/// identifiability analysis sees the real geometry). x: from the start to the fitted frames.
 void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
                 std::vector<double>& x, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
@@ -218,8 +233,11 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   // with measured orientations the probe's mounting (the tool frame's rotation) is a frame too
   if (data.orientation)
     for (int i = L.tool + 3; i < L.tool + 6; ++i) frames.push_back(i);
-  for (int i = L.base; i < L.effects; ++i)
-    if (i < L.targets || !res.fixed[i]) frames.push_back(i);
+  for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
+    if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != "setup never measured")) frames.push_back(i);
+  if (L.drift >= 0)  // the instrument's own motion belongs to the frames
+    for (int i = L.drift; i < L.drift + 6; ++i)
+      if (!res.fixed[i]) frames.push_back(i);
   ceres::Solver::Summary summary;
   AllRows all(pm, data, x, frames, opt.orientation_weight);
   ceres::Problem problem(problem_options(all));
@@ -232,6 +250,10 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   pm.set_params(x);
   res.nominal_fitted = pm.spec();
   res.nominal_fitted.name = nominal.spec().name;
+  if (L.drift >= 0) {  // the "before" model sees the points from the same drifting instrument
+    res.nominal_fitted.effects.push_back({Effect{"drift", -1, {}}, std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)});
+    res.nominal_fitted.t_mean_s = L.t_mean;
+  }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
   double ss = 0;
   for (const auto& r : data.rows) {
@@ -266,12 +288,14 @@ void store_solution(PointModel& pm, const Model& nominal, const MeasurementSet& 
   res.calibrated.name = nominal.spec().name + "-calibrated";
   for (int t = 0; t < data.n_targets; ++t) res.targets.push_back(target_of(L, x, t));
   res.t_ref = L.t_ref;
+  res.t_mean_s = L.t_mean;
   for (size_t e = 0; e < L.effect_list.size(); ++e) {
     const auto first = x.begin() + L.effect_offset[e];
     res.effects.push_back({L.effect_list[e], std::vector<double>(first, first + L.effect_list[e].size())});
   }
-  res.calibrated.effects = res.effects;  // the model carries every identified effect
+  res.calibrated.effects = res.effects;  // the model carries every identified effect (the drift inert)
   res.calibrated.t_ref_c = L.t_ref;
+  res.calibrated.t_mean_s = L.t_mean;
   const std::vector<double> e = point_errors(Model(res.calibrated), res.targets, data);
   double ss = 0;
   for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
@@ -314,8 +338,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   const std::vector<Effect> effects = effects_to_identify(nominal, opt);
   check_effect_columns(nominal, data, effects);
   const double t_ref = reference_temperature(nominal, data, effects);
-  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref));
-  PointModel pm(nominal, data.n_targets, effects, t_ref);
+  const double t_mean = reference_time(data, effects);
+  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean));
+  PointModel pm(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean);
   pm.prepare_payloads(data);
   res.start = pm.start(data);
   res.fixed.assign(res.layout.size, false);

@@ -1,6 +1,7 @@
 // kincal: the identification's measurement model: the parameter layout, PointModel's prediction
 // of a row with its analytic Jacobian (geometry, compliance through the gravity torque, tool and
-// base frames, targets, extra effects) and the residuals of a row and of a whole measurement set.
+// base frames of every setup, targets, extra effects, the instrument's drift) and the residuals of a
+// row and of a whole measurement set.
 #include "kincal/identify/point_model.hpp"
 
 #include "kincal/identify/so3.hpp"
@@ -28,7 +29,7 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
     if (e.name == "thermal_expansion") {
       if (std::isnan(m.temperature_c)) throw InputError("thermal_expansion needs the temperature_c column");
       scale *= 1.0 + p[0] * (m.temperature_c - t_ref);
-    } else {
+    } else if (e.name != "drift") {  // the drift moves the instrument, not the robot
       if (e.name == "backlash" && m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
       joint_basis(e, m.q_deg[e.joint] * kDeg, e.name == "backlash" ? m.dir[e.joint] : 0.0, b);
       for (int k = 0; k < e.size(); ++k) dq[e.joint] += p[k] * b[k];
@@ -39,21 +40,28 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
 
 }  // namespace
 
-ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr)
-    : dof(nominal.dof()), n_targets(nt), effect_list(eff), t_ref(tr) {
+ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr,
+                         const std::vector<std::string>& setups, double tm)
+    : dof(nominal.dof()), n_targets(nt), effect_list(eff), t_ref(tr), t_mean(tm) {
+  if (setups.size() > 1) setup_names = setups;
+  n_setups = setup_names.empty() ? 1 : static_cast<int>(setup_names.size());
   for (int j = 0; j < dof; ++j)
     if (nominal.gravity_loaded(j)) loaded.push_back(j);
   joints = 0;
   compliance = 4 * dof;
   tool = compliance + static_cast<int>(loaded.size());
   base = tool + 6;
-  targets = base + 6;
+  targets = base + 6 * n_setups;
   effects = targets + 3 * n_targets;
   size = effects;
   for (const Effect& e : effect_list) {
     check_effect(e, dof, "");
     if (e.name == "joint_compliance")
       throw InputError("joint_compliance is identified through IdentifyOptions::compliance, not as an extra effect");
+    if (e.name == "drift") {
+      if (drift >= 0) throw InputError("drift is given twice");
+      drift = size;
+    }
     effect_offset.push_back(size);
     size += e.size();
   }
@@ -63,7 +71,10 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
     for (const char* s : {".move_u", ".move_v"}) names.push_back(p + s), units.push_back("mm");
   }
   for (int j : loaded) names.push_back("joint" + std::to_string(j + 1) + ".compliance"), units.push_back("deg/kNm");
-  for (const std::string f : {"tool", "base"}) {
+  std::vector<std::string> frames = {"tool"};
+  if (setup_names.empty()) frames.push_back("base");
+  for (const std::string& sn : setup_names) frames.push_back("base[" + sn + "]");
+  for (const std::string& f : frames) {
     for (const char* s : {".x", ".y", ".z"}) names.push_back(f + s), units.push_back("mm");
     for (const char* s : {".rx", ".ry", ".rz"}) names.push_back(f + s), units.push_back("rad");
   }
@@ -76,9 +87,20 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
   }
 }
 
-PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects, double t_ref)
-    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref) {
+PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects, double t_ref,
+                       const std::vector<std::string>& setups, double t_mean)
+    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref, setups, t_mean) {
   const int n = nominal.dof();
+  // every setup's corrections are relative to the model's frame of that name, or its base frame
+  place_.resize(static_cast<size_t>(layout_.n_setups));
+  for (int s = 0; s < layout_.n_setups; ++s) {
+    Eigen::Isometry3d f = nominal.base_in_instrument();
+    if (!layout_.setup_names.empty())
+      for (const SetupFrame& sf : nominal.spec().setups)
+        if (sf.name == layout_.setup_names[static_cast<size_t>(s)]) f = pose_to_iso(sf.base_in_instrument);
+    place_[static_cast<size_t>(s)].r0 = f.linear();
+    place_[static_cast<size_t>(s)].t0 = f.translation();
+  }
   for (int j = 0; j < n; ++j) {
     const Vec3 w = nominal.axis(j);
     u_.push_back(w.unitOrthogonal());
@@ -111,17 +133,24 @@ void PointModel::set_params(const std::vector<double>& x) {
   rm_ = nominal_.tool().linear() * so3::exp(phim);
   jrm_ = so3::right_jacobian(phim);
   tm_ = nominal_.tool().translation() + Vec3(x[layout_.tool], x[layout_.tool + 1], x[layout_.tool + 2]);
-  const Vec3 phib(x[layout_.base + 3], x[layout_.base + 4], x[layout_.base + 5]);
-  rb_ = nominal_.base_in_instrument().linear() * so3::exp(phib);
-  jrb_ = so3::right_jacobian(phib);
-  tb_ = nominal_.base_in_instrument().translation() + Vec3(x[layout_.base], x[layout_.base + 1], x[layout_.base + 2]);
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = rm_;
   t.translation() = tm_;
   spec_.tool = iso_to_pose(t);
-  t.linear() = rb_;
-  t.translation() = tb_;
-  spec_.base_in_instrument = iso_to_pose(t);
+  spec_.setups.clear();
+  for (int s = 0; s < layout_.n_setups; ++s) {
+    Placement& b = place_[static_cast<size_t>(s)];
+    const double* xb = &x[layout_.base + 6 * s];
+    const Vec3 phib(xb[3], xb[4], xb[5]);
+    b.r = b.r0 * so3::exp(phib);
+    b.jr = so3::right_jacobian(phib);
+    b.t = b.t0 + Vec3(xb[0], xb[1], xb[2]);
+    t.linear() = b.r;
+    t.translation() = b.t;
+    // the first setup's frame is the model's base_in_instrument; several are listed by name
+    if (s == 0) spec_.base_in_instrument = iso_to_pose(t);
+    if (!layout_.setup_names.empty()) spec_.setups.push_back({layout_.setup_names[static_cast<size_t>(s)], iso_to_pose(t)});
+  }
   current_ = std::make_shared<const Model>(spec_);
   for (auto& pm : payload_models_) {
     ModelSpec s = spec_;
@@ -234,8 +263,30 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   const Mat3& rn = gr[n];
   const Vec3 xr = rn * x0 + gt[n];  // the point of the unscaled robot
   const Vec3 x = scale * xr;
-  const Vec3 y = rb_ * x + tb_;
-  if (rot) *rot = rb_ * rn * rm_;
+  // the row's placement: its setup's frame, moved by the drift at the row's time
+  if (m.setup < 0 || m.setup >= layout_.n_setups)
+    throw InputError("a row of setup code " + std::to_string(m.setup) + " but the layout has " +
+                     std::to_string(layout_.n_setups) + " setup(s)");
+  const Placement& pl = place_[static_cast<size_t>(m.setup)];
+  const bool drift = layout_.drift >= 0;
+  double tau = 0;
+  Vec3 dw = Vec3::Zero();  // the drift's rotation vector at the row's time
+  Mat3 rb_drift;
+  Vec3 tb_drift;
+  if (drift) {
+    if (std::isnan(m.time_s)) throw InputError("drift needs the time_s column");
+    tau = (m.time_s - layout_.t_mean) / 3600.0;
+    const double* d = &x_[layout_.drift];
+    dw = tau * Vec3(d[3], d[4], d[5]);
+    rb_drift = so3::exp(dw) * pl.r;
+    tb_drift = pl.t + tau * Vec3(d[0], d[1], d[2]);
+  }
+  const Mat3& rb = drift ? rb_drift : pl.r;
+  const Vec3& tb = drift ? tb_drift : pl.t;
+  const Mat3& jrb = pl.jr;
+  const int base = layout_.base + 6 * m.setup;
+  const Vec3 y = rb * x + tb;
+  if (rot) *rot = rb * rn * rm_;
   if (!jac) return y;
   const int P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
@@ -246,11 +297,18 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(ang ? jac_rot : dummy, 3, ang ? P : 1);
   if (ang) {
     W.setZero();
-    W.block<3, 3>(0, layout_.base + 3) = rb_ * jrb_;
+    W.block<3, 3>(0, base + 3) = rb * jrb;
   }
-  const Mat3 rbn = rb_ * rn;
-  J.block<3, 3>(0, layout_.base) = Mat3::Identity();
-  J.block<3, 3>(0, layout_.base + 3) = -rb_ * so3::skew(x) * jrb_;
+  const Mat3 rbn = rb * rn;
+  J.block<3, 3>(0, base) = Mat3::Identity();
+  J.block<3, 3>(0, base + 3) = -rb * so3::skew(x) * jrb;
+  if (drift) {
+    // y = Exp(tau w) R x + t + tau v: Exp(a + d) = Exp(Jl(a) d) Exp(a), Jl(a) = Jr(-a)
+    const Mat3 jl = so3::right_jacobian(-dw);
+    J.block<3, 3>(0, layout_.drift) = tau * Mat3::Identity();
+    J.block<3, 3>(0, layout_.drift + 3) = -tau * so3::skew(rb * x) * jl;
+    if (ang) W.block<3, 3>(0, layout_.drift + 3) = tau * jl;
+  }
   J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
   if (frames_only_) {
     J.block<3, 3>(0, layout_.tool + 3) = -scale * rbn * rm_ * so3::skew(tkv) * jrm_;
@@ -268,10 +326,10 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
       const Vec3 dw = (d - w_[j] * w_[j].dot(d)) / nn;
       const Vec3 om = w_[j].cross(dw);  // the line turns about p_j
       const Vec3 dx = gr[j] * om.cross(xl[j] - p_[j]) - gr[j + 1] * om.cross(xl[j + 1] - p_[j]);
-      J.col(4 * j + k) = rb_ * dx;
-      if (ang) W.col(4 * j + k) = rb_ * (gr[j] * om - gr[j + 1] * om);
+      J.col(4 * j + k) = rb * dx;
+      if (ang) W.col(4 * j + k) = rb * (gr[j] * om - gr[j + 1] * om);
       const Vec3 dxt = gr[j] * d - gr[j + 1] * d;  // the line moves along d
-      J.col(4 * j + 2 + k) = rb_ * dxt;
+      J.col(4 * j + 2 + k) = rb * dxt;
     }
   }
   // velocity of the point per unit rotation of each joint (current configuration, base frame)
@@ -280,33 +338,36 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   for (size_t i = 0; i < layout_.loaded.size(); ++i) {
     const int j = layout_.loaded[i];
     const double dq = gs.tau[j] * kDeg / 1e6;  // per deg/kNm
-    J.col(layout_.compliance + static_cast<int>(i)) = rb_ * jp[j] * dq;
-    if (ang) W.col(layout_.compliance + static_cast<int>(i)) = rb_ * (gr[j] * w_[j]) * dq;
+    J.col(layout_.compliance + static_cast<int>(i)) = rb * jp[j] * dq;
+    if (ang) W.col(layout_.compliance + static_cast<int>(i)) = rb * (gr[j] * w_[j]) * dq;
   }
   J.block<3, 3>(0, layout_.tool) = rbn;
   J.block<3, 3>(0, layout_.tool + 3) = -rbn * rm_ * so3::skew(tkv) * jrm_;
   if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
   std::array<Vec3, kMaxJoints> jw;  // angular velocity per unit rotation of each joint (base frame)
   for (int j = 0; j < n; ++j) jw[j] = gr[j] * w_[j];
-  if (!layout_.loaded.empty() && model.has_compliance()) add_torque_terms(model, gs, jp, jw, J.data(), ang ? W.data() : nullptr);
+  if (!layout_.loaded.empty() && model.has_compliance())
+    add_torque_terms(model, gs, jp, jw, rb, J.data(), ang ? W.data() : nullptr);
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
+    if (ef.name == "drift") continue;  // the instrument's, above
     if (ef.name != "thermal_expansion") {  // joint-angle effects: dq_j = p . basis
       double b[128];
       joint_basis(ef, q[ef.joint], ef.name == "backlash" ? m.dir[ef.joint] : 0.0, b);
-      for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb_ * jp[ef.joint] * b[k];
+      for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb * jp[ef.joint] * b[k];
       if (ang)
-        for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb_ * jw[ef.joint] * b[k];
+        for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb * jw[ef.joint] * b[k];
     } else {
-      J.col(c) = rb_ * xr * (m.temperature_c - layout_.t_ref);
+      J.col(c) = rb * xr * (m.temperature_c - layout_.t_ref);
     }
   }
   if (scale != 1.0) {
-    // every column through the robot's point scales with it (not the base's, not thermal's own)
+    // every column through the robot's point scales with it (not the bases', not thermal's own, not
+    // the drift's)
     J.leftCols(layout_.base) *= scale;
     for (size_t e = 0; e < layout_.effect_list.size(); ++e)
-      if (layout_.effect_list[e].name != "thermal_expansion")
+      if (layout_.effect_list[e].name != "thermal_expansion" && layout_.effect_list[e].name != "drift")
         J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
   }
   return y;
@@ -316,23 +377,31 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
   std::vector<double> x(layout_.size, 0.0);
   for (size_t i = 0; i < layout_.loaded.size(); ++i)
     x[layout_.compliance + i] = nominal_.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
-  // nominal prediction of the tool point in the base frame, matched to the measurements (Horn)
-  const size_t m = data.rows.size();
-  Eigen::Matrix3Xd a(3, m), b(3, m);
-  for (size_t i = 0; i < m; ++i) {
-    a.col(i) = fk_compliant(nominal_, data.rows[i].q_deg * kDeg).translation();
-    b.col(i) = data.rows[i].xyz;
+  // nominal prediction of the tool point in the base frame, matched to each setup's measurements (Horn)
+  for (int s = 0; s < layout_.n_setups; ++s) {
+    std::vector<size_t> rows;
+    for (size_t i = 0; i < data.rows.size(); ++i)
+      if (data.rows[i].setup == s) rows.push_back(i);
+    if (rows.size() < 3) continue;  // too few to place: the setup's frame starts at its reference
+    const size_t m = rows.size();
+    Eigen::Matrix3Xd a(3, m), b(3, m);
+    for (size_t k = 0; k < m; ++k) {
+      a.col(k) = fk_compliant(nominal_, data.rows[rows[k]].q_deg * kDeg).translation();
+      b.col(k) = data.rows[rows[k]].xyz;
+    }
+    const Vec3 ca = a.rowwise().mean(), cb = b.rowwise().mean();
+    const Mat3 h = (a.colwise() - ca) * (b.colwise() - cb).transpose();
+    Eigen::JacobiSVD<Mat3> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3 d = Mat3::Identity();
+    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+    const Mat3 r = svd.matrixV() * d * svd.matrixU().transpose();
+    const Vec3 t = cb - r * ca;
+    const Placement& pl = place_[static_cast<size_t>(s)];
+    const Vec3 dt = t - pl.t0;
+    const Vec3 phi = so3::log(pl.r0.transpose() * r);
+    const int o = layout_.base + 6 * s;
+    for (int k = 0; k < 3; ++k) x[o + k] = dt[k], x[o + 3 + k] = phi[k];
   }
-  const Vec3 ca = a.rowwise().mean(), cb = b.rowwise().mean();
-  const Mat3 h = (a.colwise() - ca) * (b.colwise() - cb).transpose();
-  Eigen::JacobiSVD<Mat3> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Mat3 d = Mat3::Identity();
-  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-  const Mat3 r = svd.matrixV() * d * svd.matrixU().transpose();
-  const Vec3 t = cb - r * ca;
-  const Vec3 dt = t - nominal_.base_in_instrument().translation();
-  const Vec3 phi = so3::log(nominal_.base_in_instrument().linear().transpose() * r);
-  for (int k = 0; k < 3; ++k) x[layout_.base + k] = dt[k], x[layout_.base + 3 + k] = phi[k];
   return x;
 }
 

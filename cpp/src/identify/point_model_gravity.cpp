@@ -36,7 +36,8 @@ void PointModel::gravity_state(const Model& model, const Measurement& m, Gravity
 }
 
 void PointModel::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
-                                  const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const {
+                                  const std::array<Vec3, kMaxJoints>& jw, const Mat3& rb, double* jac,
+                                  double* jac_rot) const {
   const int n = layout_.dof, P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
   double dummy[3];
@@ -61,8 +62,8 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
   // the sum of rb K_j jp_j dtau_j, those vectors formed once per pose
   std::array<Vec3, kMaxJoints> kp, kw;
   for (int j : layout_.loaded) {
-    kp[j] = rb_ * jp[j] * model.compliance(j);
-    if (jac_rot) kw[j] = rb_ * jw[j] * model.compliance(j);
+    kp[j] = rb * jp[j] * model.compliance(j);
+    if (jac_rot) kw[j] = rb * jw[j] * model.compliance(j);
   }
   auto apply = [&](int col, const std::array<double, kMaxJoints>& dtau) {
     Vec3 dx = Vec3::Zero(), dw = Vec3::Zero();

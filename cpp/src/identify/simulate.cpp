@@ -5,6 +5,7 @@
 #include "kincal/identify/so3.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -24,11 +25,53 @@ EffectContext row_context(const Measurement& row) {
 
 }  // namespace
 
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target) {
+std::vector<Eigen::Isometry3d> setup_frames(const Model& model, const MeasurementSet& data) {
+  const auto& known = model.spec().setups;
+  std::vector<Eigen::Isometry3d> out;
+  if (known.empty()) {
+    if (data.setup_names.size() > 1)
+      throw InputError(data.source + ": " + std::to_string(data.setup_names.size()) +
+                       " setups but the model knows one instrument placement (identify them together, or "
+                       "validate, which refits the placements)");
+    out.push_back(model.base_in_instrument());
+    return out;
+  }
+  if (data.setup_names.empty()) {
+    out.push_back(model.base_in_instrument());  // a set without a setup column: the first placement
+    return out;
+  }
+  for (const std::string& name : data.setup_names) {
+    const auto it = std::find_if(known.begin(), known.end(), [&](const SetupFrame& f) { return f.name == name; });
+    if (it == known.end()) {
+      std::string names;
+      for (const SetupFrame& f : known) names += (names.empty() ? "" : ", ") + f.name;
+      throw InputError(data.source + ": setup '" + name + "' is not one of the model's (" + names + ")");
+    }
+    out.push_back(pose_to_iso(it->base_in_instrument));
+  }
+  return out;
+}
+
+Eigen::Isometry3d drifted(const Model& model, const Eigen::Isometry3d& frame, double time_s) {
+  const EffectValue* d = model.drift();
+  if (!d) return frame;
+  if (std::isnan(time_s)) throw InputError("the model's drift needs the time of every measured point (time_s)");
+  const double tau = (time_s - model.spec().t_mean_s) / 3600.0;
+  Eigen::Isometry3d out = frame;
+  out.linear() = so3::exp(tau * Vec3(d->p[3], d->p[4], d->p[5])) * frame.linear();
+  out.translation() += tau * Vec3(d->p[0], d->p[1], d->p[2]);
+  return out;
+}
+
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target, const Eigen::Isometry3d& base) {
   const EffectContext ctx = row_context(row);
   const Eigen::Isometry3d tool = fk(truth, joint_angles(truth, row.q_deg * kDeg, ctx));
   // thermal expansion: every length of the robot, the target's offset included, scales
-  return truth.base_in_instrument() * (length_scale(truth, ctx) * (tool * target));
+  return drifted(truth, base, row.time_s) * (length_scale(truth, ctx) * (tool * target));
+}
+
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target) {
+  return simulate_point(truth, row, target, truth.base_in_instrument());
 }
 
 ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref) {
@@ -43,7 +86,17 @@ ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& e
 
 MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
   if (opt.poses < 1) throw InputError("simulate: the number of poses must be positive");
-  const Model truth(with_effects(truth_in.spec(), opt.effects, opt.t_ref));
+  if (!(opt.duration_s >= 0) || !std::isfinite(opt.duration_s))
+    throw InputError("simulate: the campaign's duration must be a finite non-negative number of seconds");
+  bool hidden_drift = false;
+  for (const auto& e : opt.effects) hidden_drift = hidden_drift || e.effect.name == "drift";
+  // a drift hidden without a duration: the campaign lasts 3 h; the drift is centred on its mean time
+  const double duration = opt.duration_s > 0 ? opt.duration_s : (hidden_drift ? kDefaultDriftDuration_s : 0.0);
+  ModelSpec truth_spec = with_effects(truth_in.spec(), opt.effects, opt.t_ref);
+  if (hidden_drift && !truth_in.drift()) truth_spec.t_mean_s = 0.5 * duration;
+  const Model truth(truth_spec);
+  if (truth.drift() && duration <= 0)
+    throw InputError("simulate: the truth drifts: the campaign needs a duration (time_s)");
   if (opt.targets.empty()) throw InputError("simulate: at least one target");
   MeasurementSet m;
   m.source = "simulated";
@@ -67,13 +120,15 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
     // the temperature drifts through [t_min, t_max] over the campaign (a warm-up, then noise)
     const double frac = opt.poses > 1 ? static_cast<double>(p) / (opt.poses - 1) : 0.0;
     row.temperature_c = opt.t_min + (opt.t_max - opt.t_min) * std::sqrt(frac) + 0.3 * nd(rng);
+    if (duration > 0) row.time_s = duration * frac;  // drawn from nothing: the noise stream is unchanged
     for (int t = 0; t < m.n_targets; ++t) {
       row.target = t;
       row.xyz = simulate_point(truth, row, opt.targets[t]);
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
       if (opt.orientation_noise_deg >= 0) {
         // the measured tool frame (a 6-D probe): truth orientation, then a small random rotation
-        const Mat3 r = truth.base_in_instrument().linear() * fk_model(truth, row.q_deg * kDeg, row_context(row)).linear();
+        const Mat3 r = drifted(truth, truth.base_in_instrument(), row.time_s).linear() *
+                       fk_model(truth, row.q_deg * kDeg, row_context(row)).linear();
         const Vec3 e = Vec3(nd(rng), nd(rng), nd(rng)) * opt.orientation_noise_deg * kDeg;
         row.has_abc = true;
         row.abc = rotation_to_abc(so3::exp(e) * r);
@@ -86,23 +141,54 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
   return m;
 }
 
+namespace {
+
+/// The model of a row's payload (variants built once per payload).
+const Model& payload_model(const Model& model, double payload, std::map<double, std::shared_ptr<const Model>>& variants) {
+  if (std::isnan(payload) || payload == model.spec().payload_kg) return model;
+  auto& v = variants[payload];
+  if (!v) {
+    ModelSpec s = model.spec();
+    s.payload_kg = payload;
+    v = std::make_shared<const Model>(s);
+  }
+  return *v;
+}
+
+const Eigen::Isometry3d& row_frame(const std::vector<Eigen::Isometry3d>& frames, const MeasurementSet& data,
+                                   const Measurement& r) {
+  if (r.setup < 0 || r.setup >= static_cast<int>(frames.size()))
+    throw InputError(data.source + ": a row of setup code " + std::to_string(r.setup) + " but " +
+                     std::to_string(frames.size()) + " setup(s)");
+  return frames[static_cast<size_t>(r.setup)];
+}
+
+}  // namespace
+
+std::vector<double> orientation_errors(const Model& model, const MeasurementSet& data) {
+  const std::vector<Eigen::Isometry3d> frames = setup_frames(model, data);
+  std::map<double, std::shared_ptr<const Model>> variants;
+  std::vector<double> e;
+  e.reserve(data.rows.size());
+  for (const auto& r : data.rows) {
+    if (!r.has_abc) throw InputError(data.source + ":" + std::to_string(r.line) + ": no measured orientation (a, b, c)");
+    const Model& m = payload_model(model, r.payload_kg, variants);
+    const Mat3 rot = drifted(m, row_frame(frames, data, r), r.time_s).linear() *
+                     fk_model(m, r.q_deg * kDeg, row_context(r)).linear();
+    e.push_back(so3::log(abc_to_rotation(r.abc).transpose() * rot).norm() / kDeg);
+  }
+  return e;
+}
+
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data) {
+  const std::vector<Eigen::Isometry3d> frames = setup_frames(model, data);
   std::vector<double> e;
   e.reserve(data.rows.size());
   std::map<double, std::shared_ptr<const Model>> variants;
   for (const auto& r : data.rows) {
-    const Model* m = &model;
-    if (!std::isnan(r.payload_kg) && r.payload_kg != model.spec().payload_kg) {
-      auto& v = variants[r.payload_kg];
-      if (!v) {
-        ModelSpec s = model.spec();
-        s.payload_kg = r.payload_kg;
-        v = std::make_shared<const Model>(s);
-      }
-      m = v.get();
-    }
+    const Model& m = payload_model(model, r.payload_kg, variants);
     const Vec3 t = r.target < static_cast<int>(targets.size()) ? targets[r.target] : Vec3::Zero();
-    e.push_back((simulate_point(*m, r, t) - r.xyz).norm());
+    e.push_back((simulate_point(m, r, t, row_frame(frames, data, r)) - r.xyz).norm());
   }
   return e;
 }

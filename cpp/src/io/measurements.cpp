@@ -18,6 +18,21 @@ std::string fmt(double v) {
   return buf;
 }
 
+/// The code of a text value (a config or setup name): its index in names, appended when new.
+int code_of(const std::string& value, std::vector<std::string>& names) {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == value) return static_cast<int>(i);
+  names.push_back(value);
+  return static_cast<int>(names.size()) - 1;
+}
+
+/// A non-empty text cell of a column (config, setup).
+const std::string& text_cell(const CsvTable& t, size_t r, int c) {
+  const std::string& v = t.cells[r][static_cast<size_t>(c)];
+  if (v.empty()) throw InputError(t.where(r) + ": column '" + t.header[c] + "': empty value");
+  return v;
+}
+
 MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
   const std::string& source = t.source;
   MeasurementSet m;
@@ -35,6 +50,7 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
     throw InputError(source + ":1: an orientation needs all three columns a, b, c");
   m.orientation = abc;
   const int ctarget = t.find("target"), cpay = t.find("payload_kg"), ctemp = t.find("temperature_c");
+  const int ctime = t.find("time_s"), cconfig = t.find("config"), csetup = t.find("setup");
   std::vector<int> cdir;
   for (int j = 0; j < dof; ++j) cdir.push_back(t.find("dir" + std::to_string(j + 1)));
   const bool have_dir = std::all_of(cdir.begin(), cdir.end(), [](int c) { return c >= 0; });
@@ -63,6 +79,9 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
       if (row.payload_kg < 0) throw InputError(t.where(r) + ": column 'payload_kg': negative mass");
     }
     if (ctemp >= 0) row.temperature_c = t.number(r, ctemp);
+    if (ctime >= 0) row.time_s = t.number(r, ctime);
+    if (cconfig >= 0) row.config = code_of(text_cell(t, r, cconfig), m.config_names);
+    if (csetup >= 0) row.setup = code_of(text_cell(t, r, csetup), m.setup_names);
     if (have_dir) {
       row.dir.resize(dof);
       for (int j = 0; j < dof; ++j) {
@@ -99,6 +118,10 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
   const bool dir = !m.rows.empty() && m.rows[0].dir.size() == dof;
   const bool temp = !m.rows.empty() && !std::isnan(m.rows[0].temperature_c);
   if (temp) s += ",temperature_c";
+  const bool time = m.has_time(), config = !m.config_names.empty(), setup = !m.setup_names.empty();
+  if (time) s += ",time_s";
+  if (config) s += ",config";
+  if (setup) s += ",setup";
   if (dir)
     for (int j = 0; j < dof; ++j) s += ",dir" + std::to_string(j + 1);
   s += "\n";
@@ -111,6 +134,9 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
     s += "," + std::to_string(r.target);
     if (pay) s += "," + fmt(r.payload_kg);
     if (temp) s += "," + fmt(r.temperature_c);
+    if (time) s += "," + fmt(r.time_s);
+    if (config) s += "," + m.config_names.at(static_cast<size_t>(r.config));
+    if (setup) s += "," + m.setup_names.at(static_cast<size_t>(r.setup));
     if (dir)
       for (int j = 0; j < dof; ++j) s += r.dir[j] > 0 ? ",1" : ",-1";
     s += "\n";

@@ -53,15 +53,25 @@ json spec_json(const ModelSpec& s) {
                           {"com_mm", v3(j.com)},
                           {"compliance_deg_per_knm", j.compliance_deg_per_knm}});
   }
-  return json{{"name", s.name},
-              {"joints", joints},
-              {"tool", pose_json(s.tool)},
-              {"payload", json{{"mass_kg", s.payload_kg}, {"com_mm", v3(s.payload_com)}}},
-              {"gravity_m_s2", v3(s.gravity)},
-              {"base_in_instrument", pose_json(s.base_in_instrument)},
-              {"home_deg", s.home_deg},
-              {"effects", effects_json(s)},
-              {"t_ref_c", s.t_ref_c}};
+  json o{{"name", s.name},
+         {"joints", joints},
+         {"tool", pose_json(s.tool)},
+         {"payload", json{{"mass_kg", s.payload_kg}, {"com_mm", v3(s.payload_com)}}},
+         {"gravity_m_s2", v3(s.gravity)},
+         {"base_in_instrument", pose_json(s.base_in_instrument)},
+         {"home_deg", s.home_deg},
+         {"effects", effects_json(s)},
+         {"t_ref_c", s.t_ref_c}};
+  // the measurement's side, only when there is one: the placements of several setups, the drift's centre
+  if (!s.setups.empty()) {
+    json setups = json::array();
+    for (const SetupFrame& f : s.setups)
+      setups.push_back(json{{"name", f.name}, {"base_in_instrument", pose_json(f.base_in_instrument)}});
+    o["setups"] = setups;
+  }
+  for (const EffectValue& ev : s.effects)
+    if (ev.effect.name == "drift") o["t_mean_s"] = s.t_mean_s;
+  return o;
 }
 
 struct Reader {
@@ -132,6 +142,17 @@ struct Reader {
       s.home_deg.push_back(h.get<double>());
     }
     if (o.contains("t_ref_c")) s.t_ref_c = num(o, "t_ref_c", where);
+    if (o.contains("t_mean_s")) s.t_mean_s = num(o, "t_mean_s", where);
+    if (o.contains("setups")) {
+      const json& setups = o["setups"];
+      if (!setups.is_array()) fail(where + ".setups", "needs a list");
+      for (size_t i = 0; i < setups.size(); ++i) {
+        const std::string w = where + ".setups[" + std::to_string(i) + "]";
+        const json& name = at(setups[i], "name", w);
+        if (!name.is_string()) fail(w + ".name", "not a string");
+        s.setups.push_back(SetupFrame{name.get<std::string>(), pose(setups[i], "base_in_instrument", w)});
+      }
+    }
     if (o.contains("effects")) {
       const json& effs = o["effects"];
       if (!effs.is_array()) fail(where + ".effects", "needs a list");

@@ -54,6 +54,8 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
       rest.push_back(ev);
       if (ev.effect.name == "thermal_expansion") {
         thermal_alpha_ = ev.p[0];
+      } else if (ev.effect.name == "drift") {
+        drift_ = static_cast<int>(rest.size()) - 1;  // carried for the measurement, never applied
       } else {
         joint_effects_.push_back(ev);
         needs_dir_ = needs_dir_ || ev.effect.name == "backlash";
@@ -61,6 +63,15 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
     }
     spec_.effects = rest;
     if (!std::isfinite(spec_.t_ref_c)) throw InputError(who + "the reference temperature is NaN or infinite");
+    if (!std::isfinite(spec_.t_mean_s)) throw InputError(who + "the drift's reference time is NaN or infinite");
+  }
+  for (size_t i = 0; i < spec_.setups.size(); ++i) {
+    const SetupFrame& f = spec_.setups[i];
+    if (f.name.empty()) throw InputError(who + "setup " + std::to_string(i + 1) + " has no name");
+    if (!finite(f.base_in_instrument.xyz) || !finite(f.base_in_instrument.abc))
+      throw InputError(who + "setup '" + f.name + "': a value is NaN or infinite");
+    for (size_t k = 0; k < i; ++k)
+      if (spec_.setups[k].name == f.name) throw InputError(who + "setup '" + f.name + "' is given twice");
   }
   for (int j = 0; j < n_; ++j) {
     const JointSpec& js = spec_.joints[j];

@@ -40,6 +40,9 @@ def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, li
         if col == "temperature_c" and (col not in data or np.ptp(data[col]) <= 0.5):
             notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
             continue
+        if col == "time_s" and (col not in data or np.ptp(data[col]) <= 0):
+            notes.append(f"{kind.name} skipped: no time_s column, or it does not vary")
+            continue
         if col and col not in data:
             notes.append(f"{kind.name} skipped: the data have no {col} column")
             continue

@@ -28,6 +28,8 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
             f"dir{joint} (sign of the last motion, jittered)"
     if effect == "thermal_expansion":
         return data["temperature_c"], "temperature (C)"
+    if effect == "drift":
+        return np.asarray(data["time_s"]) / 3600.0, "time of the measurement (h)"
     tau = np.array([_core.gravity_torque(robot, q)[0][j - 1] for q in data["q_deg"]]) / 1000.0
     return tau, f"gravity torque on joint {joint} (N m)"
 

@@ -12,6 +12,13 @@
 //                      reaches the pose: the compensated program then misses it by up to 2|b|)
 //   thermal_expansion  (serial, robot)      every length of the robot scales by 1 + alpha (T - t_ref):
 //                      the tool point in the base frame scales about the base origin alpha in 1/degC
+//   drift              (serial, robot, a property of the measurement) the instrument's placement
+//                      moves linearly with time: a point x of the robot base frame is seen at
+//                      Exp(tau w) R x + t + tau v instead of R x + t (R, t the placement: the
+//                      rotation turns about the robot base's origin, v and w in the instrument's
+//                      axes), tau = (t_s - t_mean) / 3600 s in hours, t_mean the campaign's mean time
+//                      (ModelSpec::t_mean_s). Removed from the fit and reported; a Model carries it
+//                      inert: FK and compensation never apply it.   v in mm/h, w in rad/h (deg/h in files)
 //   link_deflection    (five-bar, per link) the link's length varies as p1 cos t1 + p2 sin t1 +
 //                      p3 cos t2 + p4 sin t2                                          p in mm
 // The joint-angle effects act on the commanded angle q: the joint stands at q + dq(q, dir). Their
@@ -29,8 +36,8 @@ struct EffectKind {
   std::string name;
   std::string domain;        ///< "serial" or "fivebar"
   std::string concerns;      ///< "joint", "link" or "robot"
-  std::string needs;         ///< the data column the effect reads: "", "dir", "temperature_c"
-  std::string acts_on;       ///< "joint_angle", "length_scale", "link_length"
+  std::string needs;         ///< the data column the effect reads: "", "dir", "temperature_c", "time_s"
+  std::string acts_on;       ///< "joint_angle", "length_scale", "link_length", "instrument"
   std::string description;
   bool gravity_loaded_only;  ///< per joint only where gravity loads the joint (joint_compliance)
 };
@@ -49,8 +56,8 @@ struct Effect {
   std::string label() const;         ///< e.g. "transmission_error(joint 3)"
   /// parameter names without the joint prefix, e.g. te_sin1, te_cos1; and their core units
   std::vector<std::string> parameter_names() const;
-  std::vector<std::string> units() const;          ///< "rad", "1/degC", "deg/kNm", "mm"
-  std::vector<std::string> file_units() const;     ///< units in model files: "deg" for "rad"
+  std::vector<std::string> units() const;          ///< "rad", "1/degC", "deg/kNm", "mm", "mm/h", "rad/h"
+  std::vector<std::string> file_units() const;     ///< units in model files: "deg" for "rad", "deg/h" for "rad/h"
   std::vector<double> file_scale() const;          ///< file value = core value * scale
   bool operator==(const Effect& o) const {
     return name == o.name && joint == o.joint && (name != "transmission_error" || harmonics == o.harmonics);

@@ -1,6 +1,7 @@
 // kincal: parameter identification (step 3 of the Samak paper): its options, its result and
 // identify(), Ceres Levenberg-Marquardt on the measurement model of point_model.hpp with its analytic
-// Jacobian. First the base frame and targets are fitted on the nominal geometry (the "before"),
+// Jacobian. First the base frame of every setup, the targets and an instrument drift are fitted on
+// the nominal geometry (the "before"),
 // then parameters the data cannot determine are found from the scaled Jacobian (identifiability.hpp:
 // greedy column selection in a preferred order) and held at their start value, then everything
 // else is identified together; standard deviations and correlations from the Ceres covariance.
@@ -48,6 +49,7 @@ struct IdentifyResult {
   std::vector<Vec3> targets;
   std::vector<EffectValue> effects;       ///< identified values of the extra effects
   double t_ref = 20.0;                    ///< reference temperature of thermal_expansion
+  double t_mean_s = 0;                    ///< reference time of the drift (the data's mean time)
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
   double rms_mm = 0, max_mm = 0;          ///< on the fitted rows

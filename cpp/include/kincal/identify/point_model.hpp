@@ -3,20 +3,25 @@
 // for a parameter vector) and the residuals of a row and of a whole measurement set.
 //
 // Measurement model: a point measured in the instrument's frame is
-//   y = B * P(q + K tau(q)) * M * t_k
-// with B the robot base seen from the instrument, P the product of exponentials of the joint lines,
-// K tau the joint deflection under gravity, M the tool frame at the zero configuration and t_k the
-// offset of target (reflector) k in the tool frame.
+//   y = B_s * P(q + K tau(q)) * M * t_k
+// with B_s the robot base seen from the instrument in the row's setup s (one placement per value of
+// the setup column; one without it), P the product of exponentials of the joint lines, K tau the
+// joint deflection under gravity, M the tool frame at the zero configuration and t_k the offset of
+// target (reflector) k in the tool frame, shared by every setup. With the drift effect the
+// placement moves with the row's time: B_s(t) y = Exp(tau w) (R_s y) + t_s + tau v, tau = (t -
+// t_mean) / 3600 s (effects.hpp).
 //
 // Parameters (all relative to the nominal model, so zero is the nominal):
 //   per joint 4: axis tilt along u and v (rad; w' = normalise(w + a_u u + a_v v)) and the axis moved
 //                along u and v (mm), with u, v unit vectors normal to the nominal axis;
 //   per gravity-loaded joint 1: compliance (deg per kN m, absolute);
 //   tool 6: translation (mm) and rotation vector (rad, R = R0 Exp(phi));
-//   base 6: the same for the base frame in the instrument frame;
+//   base 6 per setup: the same for the base frame in the instrument frame ("base.x" for one setup,
+//        "base[NAME].x" for several), relative to the model's frame of that setup name (its setups)
+//        or to its base_in_instrument;
 //   per target 3: offset in the tool frame (mm, absolute);
-//   per extra effect (transmission_error 2 per harmonic order, backlash 1, thermal_expansion 1), see
-//   effects.hpp (the registry).
+//   per extra effect (transmission_error 2 per harmonic order, backlash 1, thermal_expansion 1,
+//   drift 6), see effects.hpp (the registry).
 // Rows with a measured orientation (a, b, c) add 3 residuals: the weighted rotation vector from the
 // measured to the predicted tool frame.
 #pragma once
@@ -32,23 +37,29 @@
 
 namespace kincal {
 
-/// Layout of the identification parameter vector for a model and a number of targets.
+/// Layout of the identification parameter vector for a model, a number of targets and the setups.
 struct ParamLayout {
-  int dof = 0, n_targets = 0;
+  int dof = 0, n_targets = 0, n_setups = 1;
   int joints = 0, compliance = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
+  int drift = -1;                     ///< offset of the drift's 6 parameters (-1: no drift)
   std::vector<int> loaded;            ///< joint of every compliance parameter
   std::vector<Effect> effect_list;    ///< extra effects, their parameters from `effects` on
   std::vector<int> effect_offset;
   double t_ref = 20.0;
-  std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry"
+  double t_mean = 0;                  ///< the drift's reference time (s)
+  std::vector<std::string> setup_names;  ///< by setup code (empty: one setup, no setup column)
+  std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry", "base[B].ry"
   std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm"
-  ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0);
+  /// setups: the names of the data's setups (by code); none or one: a single placement "base.*".
+  ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,
+              const std::vector<std::string>& setups = {}, double t_mean = 0);
 };
 
 /// Evaluates the measurement model and its analytic Jacobian for one parameter vector.
 class PointModel {
  public:
-  PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0);
+  PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,
+             const std::vector<std::string>& setups = {}, double t_mean = 0);
   const ParamLayout& layout() const { return layout_; }
   /// Set the parameters (size layout().size); builds the current model.
   void set_params(const std::vector<double>& x);
@@ -64,8 +75,8 @@ class PointModel {
   /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
   /// (instrument frame) per parameter.
   Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
-  /// Starting parameters: nominal geometry, base frame from the best rigid fit (Horn) of the
-  /// nominal prediction of target 0 at the tool point, targets at the tool point.
+  /// Starting parameters: nominal geometry, each setup's base frame from the best rigid fit (Horn)
+  /// of the nominal prediction of the tool point to that setup's rows, targets at the tool point.
   std::vector<double> start(const MeasurementSet& data) const;
 
  private:
@@ -85,8 +96,15 @@ class PointModel {
   ModelSpec spec_;
   std::shared_ptr<const Model> current_;
   std::vector<std::pair<double, std::shared_ptr<const Model>>> payload_models_;
-  Mat3 rb_, rm_, jrb_, jrm_;
-  Vec3 tb_, tm_;
+  /// One instrument placement: its reference frame (r0, t0) and, at the current parameters, its
+  /// frame (r, t) and the right Jacobian of its rotation vector.
+  struct Placement {
+    Mat3 r0, r, jr;
+    Vec3 t0, t;
+  };
+  std::vector<Placement> place_;
+  Mat3 rm_, jrm_;
+  Vec3 tm_;
   std::vector<Vec3> w_, p_;
   const Model& model_for(double payload) const;
   void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;
@@ -104,8 +122,10 @@ class PointModel {
   /// The joint frames G_0..G_n of row m with compliance and effects acting, and the thermal scale.
   void row_frames(const Model& model, const Measurement& m, GravityState& gs, std::array<Mat3, kMaxJoints + 1>& gr,
                   std::array<Vec3, kMaxJoints + 1>& gt, double& scale) const;
+  /// rb: the row's instrument placement (rotation).
   void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
-                        const std::array<Vec3, kMaxJoints>& jw, double* jac, double* jac_rot) const;
+                        const std::array<Vec3, kMaxJoints>& jw, const Mat3& rb, double* jac,
+                        double* jac_rot) const;
 };
 
 /// What the residual of a row holds: its point (3 position components, mm) or its full pose (the

@@ -23,18 +23,40 @@ struct SimulationOptions {
   double t_ref = 20.0;             ///< reference temperature of thermal_expansion
   double t_min = 18.0, t_max = 30.0;  ///< the temperature drifts through this range over the campaign
   double orientation_noise_deg = -1;  ///< >= 0: the tool frame's orientation is measured too (6-D)
+  /// > 0: every row gets time_s, the campaign running from 0 to duration_s in pose order (a hidden
+  /// drift without it: 3 h). A drift hidden in a truth that has none is centred on the mean time.
+  double duration_s = 0;
 };
+
+/// The campaign's length a hidden drift gets when SimulationOptions::duration_s is not set (3 h).
+constexpr double kDefaultDriftDuration_s = 3 * 3600.0;
+
+/// The base frame seen from the instrument for each setup of a measurement set (by code): the
+/// model's setup of the same name, or its base_in_instrument when the model has no setups (then the
+/// set may have at most one). InputError naming the setup the model does not know.
+std::vector<Eigen::Isometry3d> setup_frames(const Model& model, const MeasurementSet& data);
+/// A placement at the time a row was measured: frame moved by the model's drift (effects.hpp's
+/// definition: rotation Exp(tau w) R, translation t + tau v, tau in hours from the model's
+/// t_mean_s); the frame itself
+/// without a drift. InputError when the model drifts and the time is unknown (NaN).
+Eigen::Isometry3d drifted(const Model& model, const Eigen::Isometry3d& frame, double time_s);
 
 /// The point of target t (tool frame) in the instrument frame for the row's commanded joint angles
 /// on a model, every effect it carries acting (the row's dir and temperature), without noise.
 Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target);
+/// The same seen from the placement `base` (a setup's frame), the model's drift acting.
+Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target, const Eigen::Isometry3d& base);
 /// A campaign on the truth: its own effects and opt.effects (hidden) act.
 MeasurementSet simulate(const Model& truth, const SimulationOptions& opt);
 /// The truth's spec with the hidden effects of opt added (t_ref from opt when the truth has none).
 ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref);
 
-/// Position errors (mm) of every row of data predicted by a model (every effect it carries acting)
-/// with the given targets.
+/// Position errors (mm) of every row of data predicted by a model (every effect it carries acting,
+/// each row seen from its setup's placement, the model's drift at the row's time) with the given
+/// targets.
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data);
+/// Orientation errors (deg) of every row of a 6-D set: the angle between the measured tool frame
+/// and the model's (every effect acting, seen from the row's placement at its time).
+std::vector<double> orientation_errors(const Model& model, const MeasurementSet& data);
 
 }  // namespace kincal

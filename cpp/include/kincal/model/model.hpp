@@ -40,6 +40,13 @@ struct JointSpec {
   double compliance_deg_per_knm = 0;  ///< joint deflection per gravity torque (deg per kN m)
 };
 
+/// One instrument placement of a campaign measured from several (the `setup` column): its name
+/// and the robot base frame seen from the instrument there.
+struct SetupFrame {
+  std::string name;
+  Pose6 base_in_instrument;
+};
+
 /// Everything that defines one robot geometry; plain data, checked when a Model is built from it.
 struct ModelSpec {
   std::string name = "robot";
@@ -55,6 +62,11 @@ struct ModelSpec {
   /// joint's compliance_deg_per_knm)
   std::vector<EffectValue> effects;
   double t_ref_c = 20.0;           ///< reference temperature of thermal_expansion (deg C)
+  /// The measurement's side, carried for predicting measured points and never applied by FK or
+  /// compensation: every instrument placement of a campaign with several (by name; empty for one:
+  /// base_in_instrument, which is also the first's), and the time drift's centre (the drift effect).
+  std::vector<SetupFrame> setups;
+  double t_mean_s = 0;             ///< the drift's reference time (s, the campaign's mean time)
 };
 
 class Model {
@@ -77,6 +89,9 @@ class Model {
   bool needs_dir() const { return needs_dir_; }                  ///< backlash: dir1..dirN needed
   bool needs_temperature() const { return thermal_alpha_ != 0; }  ///< thermal expansion: T needed
   double thermal_alpha() const { return thermal_alpha_; }         ///< 1/degC (0: none)
+  /// The instrument's drift (a property of the measurement, never applied by FK or compensation):
+  /// translation mm/h and rotation rad/h (instrument frame), null without one.
+  const EffectValue* drift() const { return drift_ < 0 ? nullptr : &spec_.effects[static_cast<size_t>(drift_)]; }
   const Vec3& axis(int j) const { return w_[j]; }
   const Vec3& point(int j) const { return p_[j]; }
   const Eigen::Isometry3d& tool() const { return tool_; }
@@ -112,6 +127,7 @@ class Model {
   std::vector<EffectValue> joint_effects_;
   bool needs_dir_ = false;
   double thermal_alpha_ = 0;
+  int drift_ = -1;  ///< index of the drift in spec_.effects
   std::array<Vec3, kMaxJoints> w_, p_;
   std::array<double, kMaxJoints> k_{};
   Eigen::Isometry3d tool_, base_in_instrument_;

@@ -1,0 +1,141 @@
+"""Campaigns measured from several instrument placements (the ``setup`` column): simulated ones
+for tests and demos, the robot seen from a named placement, and the table of `kincal validate`.
+The joint identification of every placement and the validation itself are in identify.py."""
+
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+from . import _core
+from ._core import Robot
+
+
+def simulate_setups(truth: Robot, placements: dict, poses: int = 150, *, seed: int = 1, **options) -> dict:
+    """A campaign measured from several instrument placements: ``placements`` maps each setup's
+    name to the robot base frame seen from the instrument there, (x, y, z mm, a, b, c deg). Each
+    setup measures ``poses`` random configurations (its own seed, ``seed`` + its index) with the
+    options of simulate(); the rows are concatenated in the order of ``placements``, pose ids
+    running on, with the ``setup`` column (and time_s running on from setup to setup when the
+    options ask for a duration). The truth's own placement is not used."""
+    from .identify import simulate
+
+    if len(placements) < 1:
+        raise ValueError("simulate_setups: at least one placement")
+    parts = []
+    t0 = 0.0
+    for k, (name, frame) in enumerate(placements.items()):
+        f = [float(v) for v in frame]
+        if len(f) != 6:
+            raise ValueError(f"simulate_setups: placement {name}: x, y, z, a, b, c")
+        d = simulate(truth.with_placements([(str(name), f[:3], f[3:])]), poses, seed=seed + k, **options)
+        d["pose"] = d["pose"] + k * poses
+        d["setup"] = np.full(len(d["pose"]), k, dtype=np.int64)
+        if "time_s" in d:  # one setup after the other
+            d["time_s"] = d["time_s"] + t0
+            t0 = float(d["time_s"][-1]) + 60.0
+        parts.append(d)
+    out = {key: (np.concatenate([p[key] for p in parts]) if isinstance(parts[0][key], np.ndarray) else parts[0][key])
+           for key in parts[0]}
+    out["setup_names"] = [str(n) for n in placements]
+    return out
+
+
+def with_setups(truth: Robot, placements: dict) -> Robot:
+    """The truth seen from the placements of simulate_setups (by name): what its points are
+    compared with (point_errors)."""
+    return truth.with_placements([(str(n), [float(v) for v in f[:3]], [float(v) for v in f[3:]])
+                                  for n, f in placements.items()])
+
+
+def robot_for_setup(robot: Robot, name: str, source: str = "the model") -> Robot:
+    """The robot seen from its placement ``name`` (fk and compensate --frame instrument use the
+    model's first placement otherwise). ValueError naming the known setups when it has no such."""
+    known = [n for n, _, _ in robot.placements]
+    for n, xyz, abc in robot.placements:
+        if n == name:
+            return robot.with_placements([(n, xyz, abc)])
+    have = ", ".join(known) if known != [""] else "none: it was identified from one placement"
+    raise ValueError(f"{source}: no setup '{name}' (setups: {have})")
+
+
+def validation_summary(v: dict) -> str:
+    """The table of identify's summary for a validation (validate()'s result): RMS and largest
+    position error before (the nominal model) and after (the calibrated one), the placements
+    refitted on both; per setup when there are several, and the orientation when measured."""
+    lines = [f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'max before':>12}{'max after':>12}"]
+
+    def row(label: str, f: dict) -> None:
+        lines.append(f"{label:<28}{f['before_rms_mm']:>12.4f}{f['rms_mm']:>12.4f}"
+                     f"{f['before_max_mm']:>12.4f}{f['max_mm']:>12.4f}")
+
+    row(f"new points ({v['points']})", v)
+    for name, f in v.get("setups", {}).items():
+        row(f"  setup {name} ({f['points']})", f)
+    if "rms_deg" in v:
+        lines.append(f"{'orientation (deg)':<28}{v['before_rms_deg']:>12.4f}{v['rms_deg']:>12.4f}"
+                     f"{v['before_max_deg']:>12.4f}{v['max_deg']:>12.4f}")
+    lines.append("")
+    lines.append(f"refitted: {v['refitted']}; mean error {v['mean_mm']:.4f} mm"
+                 + (f", {v['mean_deg']:.4f} deg" if "mean_deg" in v else ""))
+    return "\n".join(lines)
+
+
+
+def setup_frames(placements) -> list:
+    """Placements as (name, xyz, abc) (an IdentifyResult's or a Robot's) in files: {"name",
+    "base_in_instrument": {"xyz_mm", "abc_deg"}} per setup, in the data's order."""
+    return [{"name": n, "base_in_instrument": {"xyz_mm": [float(v) for v in xyz], "abc_deg": [float(v) for v in abc]}}
+            for n, xyz, abc in placements]
+
+
+def drift_report(fit: "_core.IdentifyResult") -> Optional[dict]:
+    """The instrument's drift an identification found (a property of the measurement: removed from
+    the fit, never compensated), in the model file's units with standard deviations, or None."""
+    names = [e.name for e in fit.layout.effect_list]
+    if "drift" not in names:
+        return None
+    e = fit.layout.effect_list[names.index("drift")]
+    off = fit.layout.effect_offset[names.index("drift")]
+    vals, sd = np.asarray(fit.x)[off:off + 6], np.asarray(fit.stddev)[off:off + 6]
+    return {"t_mean_s": fit.t_mean_s,
+            "note": "the instrument's placement moving with time_s about t_mean_s (a base point x is seen at "
+                    "Exp(tau w) R x + t + tau v, tau in hours, v and w in the instrument's axes): removed from the "
+                    "fit, never applied by fk or compensate",
+            "parameters": [{"name": n, "value": float(v * sc), "stddev": None if math.isnan(d) else float(d * sc),
+                            "unit": u}
+                           for n, v, d, sc, u in zip(e.parameter_names, vals, sd, e.file_scale, e.file_units)]}
+
+
+def _rms(e: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(e ** 2))) if len(e) else float("nan")
+
+
+def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[np.ndarray],
+                       o_before: Optional[np.ndarray], data: dict) -> dict:
+    """The figures of `kincal validate` from the position errors (mm) after (the calibrated model)
+    and before (the nominal one) and, with measured orientations, the orientation errors (deg):
+    ``points``, ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm`` (``before_mean_mm``,
+    ``before_max_mm``; ``rms_deg``, ``mean_deg``, ``max_deg``, ``before_rms_deg``,
+    ``before_max_deg``), the same per setup under ``setups`` when the data have several, and
+    ``rows``, ``after_rms_mm``, ``after_max_mm`` (the names of earlier versions)."""
+    ea, eb = np.asarray(after), np.asarray(before)
+
+    def figures(mask: np.ndarray) -> dict:
+        out = {"points": int(mask.sum()), "rms_mm": _rms(ea[mask]), "mean_mm": float(np.mean(ea[mask])),
+               "max_mm": float(np.max(ea[mask])), "before_rms_mm": _rms(eb[mask]),
+               "before_mean_mm": float(np.mean(eb[mask])), "before_max_mm": float(np.max(eb[mask]))}
+        if o_after is not None and o_before is not None:
+            oa, ob = np.asarray(o_after)[mask], np.asarray(o_before)[mask]
+            out.update(rms_deg=_rms(oa), mean_deg=float(np.mean(oa)), max_deg=float(np.max(oa)),
+                       before_rms_deg=_rms(ob), before_max_deg=float(np.max(ob)))
+        return out
+
+    v = figures(np.ones(len(ea), dtype=bool))
+    v.update(rows=v["points"], after_rms_mm=v["rms_mm"], after_max_mm=v["max_mm"])
+    if "setup" in data and len(data.get("setup_names", [])) > 1:
+        codes = np.asarray(data["setup"])
+        v["setups"] = {name: figures(codes == k) for k, name in enumerate(data["setup_names"]) if np.any(codes == k)}
+    return v

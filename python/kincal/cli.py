@@ -252,6 +252,7 @@ def build_parser() -> argparse.ArgumentParser:
         names = ", ".join(k.name for k in _core.effect_kinds() if k.domain == "serial")
         sp.add_argument("--effects", default=default,
                         help=f"{what}, comma separated: NAME (every joint where it applies) or NAME:J (joint J); "
+                             f"joint_map:J:K a joint_map of order K (default {ident.DEFAULT_MAP_ORDER}); "
                              f"'none' for the geometry alone (default: {default}; known: {names})")
         sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                         help="harmonic orders of transmission_error (default 1,2)")
@@ -323,7 +324,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="poses drawn at random inside the limits, or the most observable of 10 times as many")
     sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
                     help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg; a sine and a cosine "
-                         "amplitude per order of --harmonics), backlash:J:b (deg per direction sign), "
+                         "amplitude per order of --harmonics), joint_map:J:s1,c1,..,sK,cK (deg; orders 1..K), "
+                         "backlash:J:b (deg per direction sign), "
                          "thermal_expansion:0:alpha (1/C, about 20 C); repeatable")
     sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                     help="harmonic orders of a hidden transmission_error (default 1,2)")

@@ -23,6 +23,8 @@ DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -2
 DEFAULT_INSTRUMENT = (3500.0, -1500.0, -400.0, 35.0, 1.5, -0.8)
 #: harmonic orders of transmission_error unless --harmonics says otherwise
 DEFAULT_HARMONICS = (1, 2)
+#: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
+DEFAULT_MAP_ORDER = 4
 
 
 def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
@@ -61,7 +63,10 @@ def _effect_value(e: Sequence) -> tuple:
     if len(e) == 2 and isinstance(e[0], _core.Effect):
         return e[0], [float(v) for v in e[1]]
     name, joint, vals = e
-    return _core.Effect(str(name), int(joint)), [float(v) for v in vals]
+    vals = [float(v) for v in vals]
+    if name == "joint_map":  # its order from the number of values: a sine and a cosine per order
+        return _core.Effect("joint_map", int(joint), order=max(1, len(vals) // 2)), vals
+    return _core.Effect(str(name), int(joint)), vals
 
 
 def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
@@ -75,9 +80,10 @@ def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
 def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS,
                   option: str = "--effects") -> list:
     """The effects of ``--effects``: comma separated ``NAME`` (every joint where it applies: joint
-    compliance only on the gravity-loaded joints) or ``NAME:J`` (joint J, from 1); ``none`` or an
-    empty text is the geometry alone. ``harmonics``: transmission_error's orders. Errors name the
-    bad item and what the registry knows."""
+    compliance only on the gravity-loaded joints) or ``NAME:J`` (joint J, from 1); ``joint_map:J:K``
+    gives joint_map's order K (default DEFAULT_MAP_ORDER); ``none`` or an empty text is the geometry
+    alone. ``harmonics``: transmission_error's orders. Errors name the bad item and what the registry
+    knows."""
     items = [t.strip() for t in (text or "").split(",") if t.strip()]
     if items == ["none"]:
         return []
@@ -87,6 +93,13 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     for item in items:
         name, _, joint = item.partition(":")
         name = name.strip()
+        order = DEFAULT_MAP_ORDER
+        if name == "joint_map" and ":" in joint:
+            joint, _, k = joint.partition(":")
+            try:
+                order = int(k)
+            except ValueError:
+                raise ValueError(f"{option}: '{item}': joint_map's order must be a number 1..64") from None
         kind = next((k for k in _core.effect_kinds() if k.name == name), None)
         if kind is None:
             raise ValueError(f"{option}: unknown effect '{item}' (known: {known})")
@@ -110,8 +123,9 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
         else:
             joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
         for j in joints:
-            e = _core.Effect(name, j, list(harmonics))
             try:
+                e = (_core.Effect(name, j, order=order) if name == "joint_map"
+                     else _core.Effect(name, j, list(harmonics)))
                 e.check(robot.dof)
             except ValueError as err:
                 raise ValueError(f"{option}: '{item}': {err}") from None
@@ -123,7 +137,8 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
 def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> tuple:
     """NAME:JOINT:V1,V2.. of `kincal simulate --hide`: (Effect, values in core units). The values are
     in the model file's units (degrees for angles, 1/C for thermal_expansion: joint 0); their number
-    comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order)."""
+    comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order;
+    joint_map: its order is half their number)."""
     parts = text.split(":")
     if len(parts) != 3:
         raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
@@ -139,7 +154,13 @@ def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_
         raise ValueError(f"--hide {text}: joint and values must be numbers") from None
     if kind.concerns == "joint" and not 1 <= j <= dof:
         raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
-    e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
+    if name == "joint_map":
+        if len(v) < 2 or len(v) % 2 or len(v) > 128:
+            raise ValueError(f"--hide {text}: joint_map takes a sine and a cosine amplitude (deg) per order "
+                             "1..K: an even number of values, 2 to 128")
+        e = _core.Effect(name, j, order=len(v) // 2)
+    else:
+        e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
     if len(v) != e.size or not all(math.isfinite(x) for x in v):
         raise ValueError(f"--hide {text}: {e.label} takes {e.size} finite value(s) "
                          f"({', '.join(f'{n} ({u})' for n, u in zip(e.parameter_names, e.file_units))})")

@@ -9,6 +9,11 @@ residual of a linear fit (the same folds). The best significant candidate is add
 refitted, and its cross-validated RMS must fall; otherwise, or when no candidate is significant, the
 search stops.
 
+A candidate may come in nested orders (a joint_map of order 1..K: the columns of order k are the
+first ones of order k + 1): the Problem's ``variants`` lists them; the order is chosen by the same
+cross-validation (the lowest whose held-out residual is within ORDER_MARGIN of the best order's),
+then that variant is scored as any candidate.
+
 A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
 candidates; effects are _core.Effect objects.
 """
@@ -26,6 +31,10 @@ from .. import _core
 #: how many of a round's candidates (best cross-validated gain first) the history lists and the
 #: verdict weighs
 LISTED = 8
+
+#: nested orders: a higher order is kept only when it lowers the held-out residual sum of squares by
+#: more than this share of the best order's
+ORDER_MARGIN = 0.01
 
 #: residual r (dims per point), the current model's free columns Jc and a candidate's columns R
 Linearisation = Callable[["_core.Effect"], tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -75,15 +84,28 @@ def cv_rms(problem: Problem, effects: list) -> float:
     return math.sqrt(sq / n)
 
 
-def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray]) -> dict:
-    """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
-    (``row_folds``: the held-out residual rows of each fold). Columns the span absorbs are dropped;
-    a candidate absorbed whole scores nothing."""
-    from scipy.stats import f as fdist
-
+def _basis(Jc: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of the current model's columns."""
     Q, _ = np.linalg.qr(Jc)
+    return Q
+
+
+def _projected(Q: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R projected off the span of Q, and which columns survive (those the span does not absorb)."""
     Rp = R - Q @ (Q.T @ R)
     keep = np.linalg.norm(Rp, axis=0) > 1e-9 * max(1.0, float(np.linalg.norm(R)))
+    return Rp, keep
+
+
+def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray],
+          Q: Optional[np.ndarray] = None) -> dict:
+    """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
+    (``row_folds``: the held-out residual rows of each fold; ``Q``: an orthonormal basis of Jc's
+    span, when the caller has it). Columns the span absorbs are dropped; a candidate absorbed whole
+    scores nothing."""
+    from scipy.stats import f as fdist
+
+    Rp, keep = _projected(_basis(Jc) if Q is None else Q, R)
     if not keep.any():
         return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": True}
     Rp = Rp[:, keep]
@@ -100,6 +122,33 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
         after += float(np.sum((r[h] - Rp[h] @ b) ** 2))
     gain = 1.0 - math.sqrt(after / before) if before > 0 else 0.0
     return {"F": float(F), "p_value": p, "cv_gain": gain, "absorbed": False, "parameters": int(k)}
+
+
+def choose_order(r: np.ndarray, R: np.ndarray, sizes: Sequence[int], row_folds: Sequence[np.ndarray],
+                 Q: np.ndarray) -> tuple[int, list]:
+    """The order of nested regressors (the first ``sizes[i]`` columns of R, off the span of Q) by
+    cross-validation: the held-out residual sum of squares of each; the lowest order within
+    ORDER_MARGIN of the best. Returns its index in ``sizes`` and the cross-validated gain of each."""
+    Rp, keep = _projected(Q, R)
+    norms = np.where(keep, np.linalg.norm(Rp, axis=0), 1.0)
+    Rp = Rp / norms
+    G, g = Rp.T @ Rp, Rp.T @ r
+    held = [(Rp[h], r[h]) for h in row_folds]
+    before = sum(float(rh @ rh) for _, rh in held)
+    after = np.zeros(len(sizes))
+    for Rh, rh in held:
+        Gt, gt = G - Rh.T @ Rh, g - Rh.T @ rh
+        for i, m in enumerate(sizes):
+            cols = np.flatnonzero(keep[:m])
+            if not len(cols):
+                after[i] += float(rh @ rh)
+                continue
+            b = np.linalg.lstsq(Gt[np.ix_(cols, cols)], gt[cols], rcond=1e-12)[0]
+            after[i] += float(np.sum((rh - Rh[:, cols] @ b) ** 2))
+    best = float(np.min(after))
+    choice = int(np.flatnonzero(after <= best * (1.0 + ORDER_MARGIN) + 1e-300)[0])
+    gains = [1.0 - math.sqrt(a / before) if before > 0 else 0.0 for a in after]
+    return choice, gains
 
 
 @dataclass
@@ -127,14 +176,29 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
     history: list[dict[str, Any]] = [{"model": problem.model_label(effects), "cv_rms_mm": cur}]
     steps: list[dict[str, Any]] = []
     scored: list[dict[str, Any]] = []
+    variants = getattr(problem, "variants", None)
+    covered = getattr(problem, "covered", None)
     for _ in range(max_steps):
         regressors = problem.linearise(effects)
         scored = []
+        basis: tuple = (None, None)  # the current model's columns and their orthonormal basis
         for c in candidates:
             if any(e.name == c.name and e.joint == c.joint for e in effects):
                 continue
-            s = score(*regressors(c), row_folds)
+            r, Jc, R = regressors(c)
+            if basis[0] is not Jc:
+                basis = (Jc, _basis(Jc))
+            order: dict = {}
+            nested = variants(c) if variants else None
+            if nested:
+                i, gains = choose_order(r, R, [m for _, m in nested], row_folds, basis[1])
+                c, R = nested[i][0], R[:, :nested[i][1]]
+                if covered and covered(c, candidates):
+                    continue
+                order = {"order_cv_gain": [round(x, 6) for x in gains]}
+            s = score(r, Jc, R, row_folds, basis[1])
             s.update(problem.describe(c))
+            s.update(order)
             s["_cand"] = c
             scored.append(s)
         scored.sort(key=lambda s: -s["cv_gain"])
@@ -152,10 +216,11 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             break
         runners_up = [dict(problem.describe(s["_cand"]), cv_gain_linear=s["cv_gain"], p_value=s["p_value"])
                       for s in scored[1:4]]
-        steps.append(dict(problem.describe(cand),
-                          evidence={"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
-                                    "cv_gain_linear": best["cv_gain"], "runners_up": runners_up},
-                          rms_before_mm=cur, rms_after_mm=new))
+        evidence = {"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
+                    "cv_gain_linear": best["cv_gain"], "runners_up": runners_up}
+        if "order_cv_gain" in best:  # the order chosen, and the cross-validated gain of each order
+            evidence.update(order=best.get("order"), order_cv_gain=best["order_cv_gain"])
+        steps.append(dict(problem.describe(cand), evidence=evidence, rms_before_mm=cur, rms_after_mm=new))
         effects, cur = effects + [cand], new
         history.append({"model": problem.model_label(effects), "cv_rms_mm": cur})
         scored = []

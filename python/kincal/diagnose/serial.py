@@ -1,8 +1,10 @@
 """The diagnosis of a serial robot (`kincal diagnose --robot R`): its candidate effects from the
-registry (joint_compliance, transmission_error, backlash, thermal_expansion, per joint where it
-concerns one), its refit (Ceres, C++ core) and its linearisation (the columns a candidate's
-parameters would add to the identification Jacobian at the current fit), for the engine's search;
-then the final model identified on all the data, and the files of the command.
+registry (joint_compliance, transmission_error, backlash, thermal_expansion, joint_map, per joint
+where it concerns one; joint_map's order 1..MAX_MAP_ORDER chosen by the engine's cross-validation),
+its refit (Ceres, C++ core) and its linearisation (the columns a candidate's parameters would add to
+the identification Jacobian at the current fit, every candidate's in one evaluation), for the
+engine's search; then what the final model still misses against every candidate variable
+(residual_vars), the final model identified on all the data, and the files of the command.
 """
 
 from __future__ import annotations
@@ -16,7 +18,10 @@ import numpy as np
 from .. import _core
 from .. import identify as ident
 from .._core import Robot
-from . import engine
+from . import engine, residual_vars
+
+#: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
+MAX_MAP_ORDER = 8
 
 
 def _needs_column(kind) -> str:
@@ -44,7 +49,10 @@ def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, li
             notes.append(f"{kind.name} skipped: the data have no {col} column")
             continue
         joints = ident.applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
-        out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
+        if kind.name == "joint_map":  # the highest order: the engine chooses among its variants
+            out += [_core.Effect(kind.name, j, order=MAX_MAP_ORDER) for j in joints if (kind.name, j) not in have]
+        else:
+            out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
     return out, notes
 
 
@@ -79,27 +87,55 @@ def _key(p) -> tuple:
     return (p.kind, p.joint, p.target, p.name)
 
 
-def _regressors(robot: Robot, res, data: dict, spec: Spec, cand):
-    """Residual r (3n), the current model's free columns and the candidate's columns at the fit."""
+def evaluate(res, data: dict, extra: Sequence) -> tuple:
+    """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
+    parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
+    parameter index by key)."""
     layout = res.layout
-    extra = list(layout.effect_list) + ([cand] if cand.name != "joint_compliance" else [])
-    pm = _core.PointModel(res.robot, len(res.targets), extra, res.t_ref, True)
+    pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True)
     new = pm.layout.parameters
     old = {_key(p): p.index for p in layout.parameters}
     x = np.zeros(len(new))
     fit_x = np.asarray(res.x)
-    for p in new:
+    for p in new[:len(layout.parameters)]:
         # geometry, tool and base are corrections to the calibrated model (zero); compliances,
         # targets and effect values are absolute
         if p.kind not in ("joint_geometry", "tool", "base") and _key(p) in old:
             x[p.index] = fit_x[old[_key(p)]]
     r, J = pm.residuals(list(x), data, True)
+    J = np.asarray(J)
     fixed = np.asarray(res.fixed)
-    cur_cols = [p.index for p in new if _key(p) in old and not fixed[old[_key(p)]]]
-    kind = "compliance" if cand.name == "joint_compliance" else cand.name
-    cand_cols = [p.index for p in new if p.kind == kind and p.joint == cand.joint
-                 and (kind == "compliance" or _key(p) not in old)]
-    return np.asarray(r), np.asarray(J)[:, cur_cols], np.asarray(J)[:, cand_cols]
+    cur = J[:, [p.index for p in new[:len(layout.parameters)] if _key(p) in old and not fixed[old[_key(p)]]]]
+    return np.asarray(r), cur, J, new, old
+
+
+class _Linearised:
+    """The model fitted on every point, linearised for the candidates: the residual r (3n), the
+    current model's free columns and each candidate's columns at the fit, from one evaluation of the
+    identification Jacobian with every candidate's parameters appended (made on the first call)."""
+
+    def __init__(self, res, data: dict, candidates: Sequence):
+        self.res, self.data = res, data
+        have = {(e.name, e.joint) for e in res.layout.effect_list}
+        self.extra = [c for c in candidates if c.name != "joint_compliance" and (c.name, c.joint) not in have]
+        self.cols: Optional[dict] = None
+
+    def __call__(self, cand) -> tuple:
+        if self.cols is None:
+            self.r, self.cur, self.J, self.new, self.old = evaluate(self.res, self.data, self.extra)
+            self.cols = {}
+        key = (cand.name, cand.joint, tuple(cand.harmonics))
+        if key not in self.cols:
+            if cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
+                r, cur, J, new, old = evaluate(self.res, self.data, [cand])  # not among the round's candidates
+            else:
+                r, cur, J, new, old = self.r, self.cur, self.J, self.new, self.old
+            kind = "compliance" if cand.name == "joint_compliance" else cand.name
+            n_fit = len(self.res.layout.parameters)
+            idx = [p.index for p in new if p.kind == kind and p.joint == cand.joint
+                   and (kind == "compliance" or (p.index >= n_fit and p.effect == cand))]
+            self.cols[key] = (r, cur, J[:, idx])
+        return self.cols[key]
 
 
 class SerialProblem:
@@ -108,8 +144,9 @@ class SerialProblem:
 
     dims = 3
 
-    def __init__(self, robot: Robot, data: dict, folds: list, fit_options: dict):
+    def __init__(self, robot: Robot, data: dict, folds: list, fit_options: dict, candidates: Sequence = ()):
         self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit_options
+        self.candidates = list(candidates)
 
     def spec(self, effects: Sequence) -> Spec:
         return Spec(effects, **self.fit_options)
@@ -122,10 +159,26 @@ class SerialProblem:
     def linearise(self, effects: list) -> engine.Linearisation:
         spec = self.spec(effects)
         res = spec.fit(self.robot, self.data)
-        return lambda cand: _regressors(self.robot, res, self.data, spec, cand)
+        return _Linearised(res, self.data, self.candidates)
+
+    def variants(self, cand) -> Optional[list]:
+        """joint_map's orders 1..K (its columns: sine and cosine of each order, in order)."""
+        if cand.name != "joint_map":
+            return None
+        return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k) for k in range(1, cand.order + 1)]
+
+    def covered(self, cand, candidates: Sequence) -> bool:
+        """A joint_map of order 1 or 2 is the library's transmission_error (orders 1, 2) where that is a
+        candidate on the same joint: the library's name is kept."""
+        return cand.name == "joint_map" and cand.order <= 2 and any(
+            c.name == "transmission_error" and c.joint == cand.joint and set(range(1, cand.order + 1)) <= set(c.harmonics)
+            for c in candidates)
 
     def describe(self, effect) -> dict:
-        return {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
+        d = {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
+        if effect.name == "joint_map":
+            d["order"] = effect.order
+        return d
 
     def label(self, effect) -> str:
         return effect.label
@@ -150,18 +203,30 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
     ident.check_data_for(start_effects, data, robot)
     cands, notes = candidates(robot, data, start_effects)
     fit_options = dict(loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
-    problem = SerialProblem(robot, data, ident.folds(data, folds, seed), fit_options)
+    problem = SerialProblem(robot, data, ident.folds(data, folds, seed), fit_options, cands)
     found = engine.search(problem, start_effects, cands, alpha=alpha, min_gain=min_gain, max_steps=max_steps, say=say)
     spec = problem.spec(found.effects)
     final = spec.fit(robot, data)
     concl = engine.conclude(problem, found, spec.errors(final, data), int(np.sum(~np.asarray(final.fixed))), noise_mm,
                             alpha, say)
-    final_model = {"effects": [{"effect": x.name, "joint": x.joint or None, "label": x.label} for x in spec.effects],
+    say("scoring what remains against every candidate variable")
+    rest = residual_vars.score(*residual_vars.carriers(final, data), residual_vars.variables(robot, data),
+                               problem.folds)
+    say(residual_vars.summary(rest))
+    final_model = {"effects": [dict(problem.describe(x), label=x.label) for x in spec.effects],
                    "started_from": [x.label for x in start_effects]}
     return {"steps": found.steps, "final_rms_mm": found.cv_rms_mm, "noise_rms_mm": concl["noise_rms_mm"],
             "noise_known": concl["noise_known"], "fit_scatter_mm": concl["fit_scatter_mm"],
-            "verdict": concl["verdict"], "notes": notes, "history": found.history, "folds": folds,
+            "verdict": concl["verdict"], "residual_variables": rest, "residual_summary": residual_vars.summary(rest),
+            "notes": notes, "history": found.history, "folds": folds,
             "final_model": final_model, "_final_fit": final, "_spec": spec, "_start": problem.spec(start_effects)}
+
+
+def step_effect(step: dict):
+    """The _core.Effect a step of diagnosis.json names (joint_map with its order)."""
+    if step["effect"] == "joint_map":
+        return _core.Effect("joint_map", step["joint"], order=step["order"])
+    return _core.Effect(step["effect"], step["joint"] or 0)
 
 
 def final_identification(robot: Robot, data: dict, diag: dict,

@@ -198,6 +198,7 @@ class IdentifyOptions:
     compliance_joints: list[int]
     effects: list[Effect]
     orientation_weight: float
+    penalties: list[tuple[str, float]]
     def __init__(self, compliance: bool = ..., loss: str = ..., loss_scale_mm: float = ..., max_iterations: int = ...,
                  fix: Sequence[str] = ..., compliance_joints: Sequence[int] = ..., effects: Sequence[Effect] = ...,
                  covariance: bool = ..., orientation_weight: float = ..., rank_tolerance: float = ...,

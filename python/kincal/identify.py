@@ -182,13 +182,17 @@ def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
 
 def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
             orientation_weight: float = 100.0, max_iterations: int = 100,
-            fix: Sequence[str] = ()) -> "_core.IdentifyOptions":
+            fix: Sequence[str] = (), penalties: Sequence = ()) -> "_core.IdentifyOptions":
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
-    joints on; without any, the compliances stay at their start value)."""
+    joints on; without any, the compliances stay at their start value). ``penalties``: ridge
+    penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
+    joint_map roughness penalty."""
     effects = list(effects)
-    return _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
-                                 loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
-                                 effects=effects, covariance=covariance, orientation_weight=orientation_weight)
+    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
+                              loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
+                              effects=effects, covariance=covariance, orientation_weight=orientation_weight)
+    o.penalties = [(str(n), float(w)) for n, w in penalties]
+    return o
 
 
 def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
@@ -365,14 +369,16 @@ def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARM
 def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: str = "huber",
              loss_scale_mm: float = 0.1, holdout: float = 0.25, k_folds: int = 0, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
-             orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> Identification:
+             orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
+             penalties: Sequence = ()) -> Identification:
     """Identify the robot's parameters from measurements.
 
     ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
     ``--effects`` (``"joint_compliance"``, ``"transmission_error:3"``, ``"backlash:2"``,
     ``"thermal_expansion"``, or one comma-separated text). Validation: ``k_folds`` > 1 fits k times,
     each time predicting the fold it did not see; otherwise a share ``holdout`` of the poses is held
-    out. The returned model is fitted on all rows (k-fold) or on the fitted rows (split)."""
+    out. The returned model is fitted on all rows (k-fold) or on the fitted rows (split).
+    ``penalties``: ridge penalties (parameter name, weight in mm per unit of the parameter)."""
     effects = check_effects(effects, robot, harmonics)
     check_data_for(effects, data, robot)
     if loss not in ("none", "huber", "cauchy"):
@@ -381,7 +387,8 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
         raise ValueError("--folds must be 0 (a split) or at least 2")
     if not 0.0 <= holdout < 1.0:
         raise ValueError(f"--holdout must be in [0, 1), not {holdout}")
-    opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
+    opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
+                   penalties=penalties)
     val: dict = {}
     if k_folds > 1:
         e_before, e_after = [], []

@@ -9,10 +9,12 @@ residual of a linear fit (the same folds). The best significant candidate is add
 refitted, and its cross-validated RMS must fall; otherwise, or when no candidate is significant, the
 search stops.
 
-A candidate may come in nested orders (a joint_map of order 1..K: the columns of order k are the
-first ones of order k + 1): the Problem's ``variants`` lists them; the order is chosen by the same
-cross-validation (the lowest whose held-out residual is within ORDER_MARGIN of the best order's),
-then that variant is scored as any candidate.
+A candidate may come in variants: nested orders (a joint_map of order 1..K: the columns of order k
+are the first ones of order k + 1), each with a ridge penalty on its parameters (a roughness penalty:
+weights growing with the order), from the Problem's ``variants``; the variant is chosen by the same
+cross-validation (the simplest, in the order listed, whose held-out residual is within ORDER_MARGIN
+of the best variant's), told to the Problem (``chosen``: its refits use the same penalty), then
+scored as any candidate.
 
 A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
 candidates; effects are _core.Effect objects.
@@ -98,11 +100,12 @@ def _projected(Q: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray],
-          Q: Optional[np.ndarray] = None) -> dict:
+          Q: Optional[np.ndarray] = None, ridge: Optional[np.ndarray] = None) -> dict:
     """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
     (``row_folds``: the held-out residual rows of each fold; ``Q``: an orthonormal basis of Jc's
-    span, when the caller has it). Columns the span absorbs are dropped; a candidate absorbed whole
-    scores nothing."""
+    span, when the caller has it; ``ridge``: a penalty weight per column, in the fits of the
+    cross-validation). Columns the span absorbs are dropped; a candidate absorbed whole scores
+    nothing."""
     from scipy.stats import f as fdist
 
     Rp, keep = _projected(_basis(Jc) if Q is None else Q, R)
@@ -117,33 +120,37 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
     p = float(fdist.sf(F, k, dof)) if math.isfinite(F) else 0.0
     before = after = 0.0
     for h in row_folds:
-        b, *_ = np.linalg.lstsq(Rp[~h], r[~h], rcond=None)
+        if ridge is None:
+            b, *_ = np.linalg.lstsq(Rp[~h], r[~h], rcond=None)
+        else:
+            A = Rp[~h]
+            b = np.linalg.solve(A.T @ A + np.diag(np.asarray(ridge)[keep] ** 2), A.T @ r[~h])
         before += float(r[h] @ r[h])
         after += float(np.sum((r[h] - Rp[h] @ b) ** 2))
     gain = 1.0 - math.sqrt(after / before) if before > 0 else 0.0
     return {"F": float(F), "p_value": p, "cv_gain": gain, "absorbed": False, "parameters": int(k)}
 
 
-def choose_order(r: np.ndarray, R: np.ndarray, sizes: Sequence[int], row_folds: Sequence[np.ndarray],
-                 Q: np.ndarray) -> tuple[int, list]:
-    """The order of nested regressors (the first ``sizes[i]`` columns of R, off the span of Q) by
-    cross-validation: the held-out residual sum of squares of each; the lowest order within
-    ORDER_MARGIN of the best. Returns its index in ``sizes`` and the cross-validated gain of each."""
+def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, np.ndarray]],
+                   row_folds: Sequence[np.ndarray], Q: np.ndarray) -> tuple[int, list]:
+    """The variant of nested regressors (each: the first ``m`` columns of R and a ridge weight per
+    column; off the span of Q) by cross-validation: the held-out residual sum of squares of each;
+    the first listed within ORDER_MARGIN of the best. Returns its index and the cross-validated gain
+    of each."""
     Rp, keep = _projected(Q, R)
-    norms = np.where(keep, np.linalg.norm(Rp, axis=0), 1.0)
-    Rp = Rp / norms
     G, g = Rp.T @ Rp, Rp.T @ r
     held = [(Rp[h], r[h]) for h in row_folds]
     before = sum(float(rh @ rh) for _, rh in held)
-    after = np.zeros(len(sizes))
+    after = np.zeros(len(variants))
     for Rh, rh in held:
         Gt, gt = G - Rh.T @ Rh, g - Rh.T @ rh
-        for i, m in enumerate(sizes):
+        for i, (m, ridge) in enumerate(variants):
             cols = np.flatnonzero(keep[:m])
             if not len(cols):
                 after[i] += float(rh @ rh)
                 continue
-            b = np.linalg.lstsq(Gt[np.ix_(cols, cols)], gt[cols], rcond=1e-12)[0]
+            A = Gt[np.ix_(cols, cols)] + np.diag(np.asarray(ridge, dtype=float)[cols] ** 2)
+            b = np.linalg.lstsq(A, gt[cols], rcond=1e-14)[0]
             after[i] += float(np.sum((rh - Rh[:, cols] @ b) ** 2))
     best = float(np.min(after))
     choice = int(np.flatnonzero(after <= best * (1.0 + ORDER_MARGIN) + 1e-300)[0])
@@ -178,6 +185,7 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
     scored: list[dict[str, Any]] = []
     variants = getattr(problem, "variants", None)
     covered = getattr(problem, "covered", None)
+    chosen = getattr(problem, "chosen", None)
     for _ in range(max_steps):
         regressors = problem.linearise(effects)
         scored = []
@@ -189,14 +197,18 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             if basis[0] is not Jc:
                 basis = (Jc, _basis(Jc))
             order: dict = {}
-            nested = variants(c) if variants else None
+            ridge = None
+            nested = variants(c, R) if variants else None
             if nested:
-                i, gains = choose_order(r, R, [m for _, m in nested], row_folds, basis[1])
-                c, R = nested[i][0], R[:, :nested[i][1]]
+                i, gains = choose_variant(r, R, [(m, w) for _, m, w in nested], row_folds, basis[1])
+                c, m, ridge = nested[i]
+                R = R[:, :m]
                 if covered and covered(c, candidates):
                     continue
-                order = {"order_cv_gain": [round(x, 6) for x in gains]}
-            s = score(r, Jc, R, row_folds, basis[1])
+                if chosen:
+                    chosen(c, ridge)
+                order = {"variant_cv_gain": [round(x, 6) for x in gains], "variant": i}
+            s = score(r, Jc, R, row_folds, basis[1], ridge)
             s.update(problem.describe(c))
             s.update(order)
             s["_cand"] = c
@@ -218,8 +230,11 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
                       for s in scored[1:4]]
         evidence = {"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
                     "cv_gain_linear": best["cv_gain"], "runners_up": runners_up}
-        if "order_cv_gain" in best:  # the order chosen, and the cross-validated gain of each order
-            evidence.update(order=best.get("order"), order_cv_gain=best["order_cv_gain"])
+        if "variant_cv_gain" in best:  # the variant chosen, and the cross-validated gain of each
+            if hasattr(problem, "variant_evidence"):
+                evidence.update(problem.variant_evidence(cand, best["variant"], best["variant_cv_gain"]))
+            else:
+                evidence.update(variant=best["variant"], variant_cv_gain=best["variant_cv_gain"])
         steps.append(dict(problem.describe(cand), evidence=evidence, rms_before_mm=cur, rms_after_mm=new))
         effects, cur = effects + [cand], new
         history.append({"model": problem.model_label(effects), "cv_rms_mm": cur})

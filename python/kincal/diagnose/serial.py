@@ -22,6 +22,11 @@ from . import engine, residual_vars
 
 #: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
 MAX_MAP_ORDER = 8
+#: joint_map's roughness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k^2
+#: (s: the mean squared norm of the joint's order-1 columns, so lambda is relative to what the data
+#: see); the cross-validation chooses lambda among these, together with the order. A map the data
+#: see over part of a turn only stays smooth there and small beyond.
+MAP_SMOOTHING = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 
 
 def _needs_column(kind) -> str:
@@ -59,12 +64,18 @@ def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, li
 class Spec:
     """The model under test: its effects (joint_compliance per joint included) and the fit's options."""
 
-    def __init__(self, effects: Sequence = (), **fit_options):
+    def __init__(self, effects: Sequence = (), penalties: Sequence = (), **fit_options):
         self.effects: list = list(effects)
+        self.penalties: list = list(penalties)  # (parameter name, weight): ridge penalties of the fit
         self.fit_options = dict(fit_options)
 
-    def with_(self, cand) -> "Spec":
-        return Spec(self.effects + [cand], **self.fit_options)
+    def with_(self, cand, penalties: Sequence = ()) -> "Spec":
+        return Spec(self.effects + [cand], self.penalties + list(penalties), **self.fit_options)
+
+    def penalties_of(self, effect) -> list:
+        """The penalties on an effect's parameters."""
+        names = {f"joint{effect.joint}.{n}" for n in effect.parameter_names}
+        return [p for p in self.penalties if p[0] in names]
 
     def has(self, cand) -> bool:
         return any(e.name == cand.name and e.joint == cand.joint for e in self.effects)
@@ -77,7 +88,8 @@ class Spec:
         return " + ".join(["geometry"] + [e.label for e in self.effects])
 
     def fit(self, robot: Robot, data: dict) -> "_core.IdentifyResult":
-        return _core.identify(robot, data, ident.options(self.effects, covariance=False, **self.fit_options))
+        return _core.identify(robot, data, ident.options(self.effects, covariance=False, penalties=self.penalties,
+                                                         **self.fit_options))
 
     def errors(self, res, data: dict) -> np.ndarray:
         return _core.point_errors(res.robot, res.targets, data)
@@ -147,9 +159,11 @@ class SerialProblem:
     def __init__(self, robot: Robot, data: dict, folds: list, fit_options: dict, candidates: Sequence = ()):
         self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit_options
         self.candidates = list(candidates)
+        self.penalty: dict = {}  # (name, joint, order) -> the penalties of the variant chosen
 
     def spec(self, effects: Sequence) -> Spec:
-        return Spec(effects, **self.fit_options)
+        pen = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]
+        return Spec(effects, pen, **self.fit_options)
 
     def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
         spec = self.spec(effects)
@@ -161,11 +175,27 @@ class SerialProblem:
         res = spec.fit(self.robot, self.data)
         return _Linearised(res, self.data, self.candidates)
 
-    def variants(self, cand) -> Optional[list]:
-        """joint_map's orders 1..K (its columns: sine and cosine of each order, in order)."""
+    def variants(self, cand, R: np.ndarray) -> Optional[list]:
+        """joint_map's orders 1..K (its columns R: sine and cosine of each order, in order), each with
+        each roughness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights)."""
         if cand.name != "joint_map":
             return None
-        return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k) for k in range(1, cand.order + 1)]
+        s = float(np.mean(np.sum(R[:, :2] ** 2, axis=0)))
+        k2 = np.repeat(np.arange(1, cand.order + 1, dtype=float) ** 2, 2)
+        return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * k2[:2 * k])
+                for k in range(1, cand.order + 1) for lam in MAP_SMOOTHING]
+
+    def variant_evidence(self, cand, i: int, gains: Sequence[float]) -> dict:
+        """A joint_map step's evidence: the order and smoothing chosen, and the best cross-validated
+        gain of each order 1..MAX_MAP_ORDER."""
+        g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
+        return {"order": cand.order, "smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)],
+                "order_cv_gain": [round(float(x), 6) for x in g.max(axis=1)]}
+
+    def chosen(self, cand, ridge: np.ndarray) -> None:
+        """The variant chosen for a candidate: its fits carry that penalty (weights in mm per rad)."""
+        names = [f"joint{cand.joint}.{n}" for n in cand.parameter_names]
+        self.penalty[(cand.name, cand.joint, cand.order)] = [(n, float(w)) for n, w in zip(names, ridge)]
 
     def covered(self, cand, candidates: Sequence) -> bool:
         """A joint_map of order 1 or 2 is the library's transmission_error (orders 1, 2) where that is a
@@ -236,7 +266,7 @@ def final_identification(robot: Robot, data: dict, diag: dict,
     ``tool_targets`` (the targets' offsets in the tool frame) the TCP is placed as identify's
     --tool-targets does."""
     spec: Spec = diag["_spec"]
-    res = ident.identify(robot, data, effects=spec.effects, holdout=0.0, **spec.fit_options)
+    res = ident.identify(robot, data, effects=spec.effects, holdout=0.0, penalties=spec.penalties, **spec.fit_options)
     res.validation = {"scheme": f"fitted on every row; cross-validated ({diag['folds']} folds) in the diagnosis",
                       "held_rows": 0, "fit_rows": int(len(data["pose"])),
                       "diagnosis_cv_rms_mm": diag["final_rms_mm"]}

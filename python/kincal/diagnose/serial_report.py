@@ -159,7 +159,8 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     spec = start
     before = spec.fit(robot, data)
     for k, st in enumerate(diag["steps"]):
-        spec = spec.with_(step_effect(st))
+        eff = step_effect(st)
+        spec = spec.with_(eff, diag["_spec"].penalties_of(eff))
         after = spec.fit(robot, data)
         name = f"step{k + 1}.png"
         _step_figure(plt, robot, data, k, st, before, after, out / name)

@@ -30,7 +30,7 @@ from .. import _core
 KNOTS = 8
 #: ridge on the normal equations, relative to their mean diagonal (the carriers are near collinear:
 #: joint 1's rotation is the instrument's about the base z axis)
-RIDGE = 1e-4
+RIDGE = 1e-2
 #: a variable "carries" the rest when its held-out share is at least this
 CARRIES = 0.05
 
@@ -45,7 +45,7 @@ def variables(robot, data: dict) -> list:
     loaded = list(_core.PointModel(robot, 1).layout.loaded)  # from 1
     if loaded:
         tau = gravity_torques(robot, q)
-        out += [{"variable": f"tau{j}", "label": f"gravity torque on joint {j} (N m)",
+        out += [{"variable": f"tau{j}", "label": f"gravity torque on joint {j} (kN m)",
                  "values": tau[:, j - 1] / 1000.0, "discrete": False} for j in loaded]
     for key, label in (("temperature_c", "temperature (deg C)"), ("time_s", "measurement time (s)")):
         if key in data and np.ptp(np.asarray(data[key], dtype=float)) > 0:
@@ -61,7 +61,7 @@ def variables(robot, data: dict) -> list:
 
 
 def gravity_torques(robot, q_deg: np.ndarray) -> np.ndarray:
-    """Gravity torque (N mm) on every joint at each row of joint angles (deg)."""
+    """Gravity torque (N m) on every joint at each row of joint angles (deg)."""
     return np.array([_core.gravity_torque(robot, qq)[0] for qq in np.asarray(q_deg, dtype=float)])
 
 

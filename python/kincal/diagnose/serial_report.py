@@ -31,7 +31,7 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
     if effect == "thermal_expansion":
         return data["temperature_c"], "temperature (C)"
     tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, j - 1] / 1000.0
-    return tau, f"gravity torque on joint {joint} (N m)"
+    return tau, f"gravity torque on joint {joint} (kN m)"
 
 
 def _joint_error(res, data: dict, joint: int) -> np.ndarray:
@@ -50,11 +50,11 @@ def _effect_curve(res, data: dict, effect, var: np.ndarray):
     if effect.name == "joint_compliance":
         c = [float(x) for p, x in zip(res.layout.parameters, res.x) if p.kind == "compliance" and p.joint == effect.joint]
         xs = np.sort(var)
-        return (xs, c[0] * xs / 1000.0) if c else None  # deg/kNm * N m
+        return (xs, c[0] * xs) if c else None  # deg/kNm * kN m
     vals = next((v for e, v in res.robot.effects if e == effect), None)
     if vals is None or effect.name == "thermal_expansion":
         return None
-    if effect.name == "backlash":
+    if effect.name == "backlash":  # drawn at the two directions only
         return np.array([-1.0, 1.0]), np.degrees(vals[0]) * np.array([-1.0, 1.0])
     xs = np.linspace(float(np.min(var)), float(np.max(var)), 400)
     t = np.radians(xs)
@@ -75,7 +75,9 @@ def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, af
         ax.scatter(var, np.clip(b, -lim, lim) * 1000, s=6, alpha=0.5, label="before")
         ax.scatter(var, np.clip(a, -lim, lim) * 1000, s=6, alpha=0.5, label="after")
         curve = _effect_curve(after_fit, data, effect, var)
-        if curve is not None:
+        if curve is not None and effect.name == "backlash":  # one level per direction
+            ax.hlines(curve[1] * 1000, curve[0] - 0.15, curve[0] + 0.15, color="k", lw=2.5, label="identified effect")
+        elif curve is not None:
             ax.plot(curve[0], curve[1] * 1000, color="k", lw=1.5, label="identified effect")
         ax.set_ylabel(f"joint {effect.joint} angle error (mdeg)")
     else:
@@ -94,16 +96,18 @@ def _point_errors(res, data: dict) -> np.ndarray:
 
 
 def _variables_figure(plt, scores: list, path: Path) -> None:
-    """The held-out share of the residual each candidate variable explains, one bar each."""
+    """The held-out share of the residual each candidate variable explains, one bar each (a share at
+    or below zero: fitting the variable only adds noise; drawn as none, its value written)."""
     fig, ax = plt.subplots(figsize=(8, 1.0 + 0.28 * len(scores)), constrained_layout=True)
     y = np.arange(len(scores))[::-1]
     vals = [100 * s["share"] for s in scores]
-    ax.barh(y, vals, color=["tab:red" if v >= 100 * residual_vars.CARRIES else "tab:gray" for v in vals])
+    ax.barh(y, [max(v, 0.0) for v in vals],
+            color=["tab:red" if v >= 100 * residual_vars.CARRIES else "tab:gray" for v in vals])
     for yy, v in zip(y, vals):
-        ax.text(max(v, 0), yy, f" {v:.1f}%", va="center", fontsize=8)
+        ax.text(max(v, 0.0), yy, f" {v:.1f}%" if v > 0 else f" {v:.1f}% (nothing)", va="center", fontsize=8)
     ax.set_yticks(y, [s["variable"] for s in scores], fontsize=8)
-    ax.axvline(0, color="k", lw=0.8)
-    ax.set_xlim(min(0.0, min(vals)) - 1, max(5.0, max(vals)) * 1.2)
+    ax.set_xlim(0, max(10.0, max(vals)) * 1.25)
+    ax.axvline(100 * residual_vars.CARRIES, color="k", ls=":", lw=0.8)
     ax.set_xlabel("share of the final residual's variance a smooth function of the variable explains, held out (%)")
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -139,19 +139,29 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
     of each."""
     Rp, keep = _projected(Q, R)
     G, g = Rp.T @ Rp, Rp.T @ r
-    held = [(Rp[h], r[h]) for h in row_folds]
-    before = sum(float(rh @ rh) for _, rh in held)
+    groups: dict = {}  # variants of the same columns, solved together
+    for i, (m, ridge) in enumerate(variants):
+        groups.setdefault(m, []).append(i)
+    before = 0.0
     after = np.zeros(len(variants))
-    for Rh, rh in held:
-        Gt, gt = G - Rh.T @ Rh, g - Rh.T @ rh
-        for i, (m, ridge) in enumerate(variants):
+    for h in row_folds:
+        Rh, rh = Rp[h], r[h]
+        Gh, gh, ss = Rh.T @ Rh, Rh.T @ rh, float(rh @ rh)
+        before += ss
+        Gt, gt = G - Gh, g - gh
+        for m, idx in groups.items():
             cols = np.flatnonzero(keep[:m])
             if not len(cols):
-                after[i] += float(rh @ rh)
+                after[idx] += ss
                 continue
-            A = Gt[np.ix_(cols, cols)] + np.diag(np.asarray(ridge, dtype=float)[cols] ** 2)
-            b = np.linalg.lstsq(A, gt[cols], rcond=1e-14)[0]
-            after[i] += float(np.sum((rh - Rh[:, cols] @ b) ** 2))
+            w2 = np.array([np.asarray(variants[i][1], dtype=float)[cols] ** 2 for i in idx])
+            A = Gt[np.ix_(cols, cols)][None, :, :] + w2[:, :, None] * np.eye(len(cols))[None, :, :]
+            try:
+                b = np.linalg.solve(A, np.broadcast_to(gt[cols], (len(idx), len(cols)))[:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError:
+                b = np.array([np.linalg.lstsq(a, gt[cols], rcond=1e-14)[0] for a in A])
+            Ghc = Gh[np.ix_(cols, cols)]
+            after[idx] += ss - 2.0 * b @ gh[cols] + np.einsum("vi,ij,vj->v", b, Ghc, b)
     best = float(np.min(after))
     choice = int(np.flatnonzero(after <= best * (1.0 + ORDER_MARGIN) + 1e-300)[0])
     gains = [1.0 - math.sqrt(a / before) if before > 0 else 0.0 for a in after]

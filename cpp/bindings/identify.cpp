@@ -258,7 +258,7 @@ void define_identify(py::module_& m) {
                      "mm per rad: how orientation residuals weigh against positions")
       .def_readwrite("penalties", &IdentifyOptions::penalties,
                      "ridge penalties (parameter name, weight in mm per unit of the parameter), e.g. a joint_map's\n"
-                     "roughness penalty (assign a whole list)");
+                     "smoothness penalty (assign a whole list)");
 
   py::class_<PyIdentifyResult>(m, "IdentifyResult", "What identify() found")
       .def_property_readonly("robot", [](const PyIdentifyResult& r) { return r.robot; },

@@ -186,7 +186,7 @@ def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
-    joint_map roughness penalty."""
+    joint_map smoothness penalty."""
     effects = list(effects)
     o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
                               loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),

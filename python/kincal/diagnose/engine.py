@@ -10,11 +10,12 @@ refitted, and its cross-validated RMS must fall; otherwise, or when no candidate
 search stops.
 
 A candidate may come in variants: nested orders (a joint_map of order 1..K: the columns of order k
-are the first ones of order k + 1), each with a ridge penalty on its parameters (a roughness penalty:
-weights growing with the order), from the Problem's ``variants``; the variant is chosen by the same
+are the first ones of order k + 1), each with a ridge penalty on its parameters (a smoothness penalty:
+weights growing with the order), from the Problem's ``variants``; the variant is chosen by
 cross-validation (the simplest, in the order listed, whose held-out residual is within ORDER_MARGIN
-of the best variant's), told to the Problem (``chosen``: its refits use the same penalty), then
-scored as any candidate.
+of the best variant's; on the Problem's ``variant_folds`` when it has them, else the same folds),
+told to the Problem (``chosen``: its refits use the same penalty), then scored as any candidate on
+the same folds.
 
 A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
 candidates; effects are _core.Effect objects.
@@ -210,7 +211,9 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             ridge = None
             nested = variants(c, R) if variants else None
             if nested:
-                i, gains = choose_variant(r, R, [(m, w) for _, m, w in nested], row_folds, basis[1])
+                sel = getattr(problem, "variant_folds", None)
+                sel_folds = [np.repeat(f, problem.dims) for f in sel(c)] if sel else row_folds
+                i, gains = choose_variant(r, R, [(m, w) for _, m, w in nested], sel_folds, basis[1])
                 c, m, ridge = nested[i]
                 R = R[:, :m]
                 if covered and covered(c, candidates):

@@ -22,11 +22,14 @@ from . import engine, residual_vars
 
 #: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
 MAX_MAP_ORDER = 8
-#: joint_map's roughness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k^2
-#: (s: the mean squared norm of the joint's order-1 columns, so lambda is relative to what the data
-#: see); the cross-validation chooses lambda among these, together with the order. A map the data
-#: see over part of a turn only stays smooth there and small beyond.
-MAP_SMOOTHING = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
+#: joint_map's smoothness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k (the
+#: penalty is lambda s / pi times the integral of the map's squared slope over a turn; s: the mean
+#: squared norm of the joint's order-1 columns, so lambda is relative to what the data see); the
+#: cross-validation chooses lambda among these, together with the order. A map the data see over
+#: part of a turn only stays smooth there and small beyond.
+MAP_SMOOTHING = (1e-1, 1e-2, 1e-3)
+#: joint_map's variant (order, smoothing) is chosen leaving out each of this many ranges of its angle
+VARIANT_BLOCKS = 5
 
 
 def _needs_column(kind) -> str:
@@ -177,20 +180,34 @@ class SerialProblem:
 
     def variants(self, cand, R: np.ndarray) -> Optional[list]:
         """joint_map's orders 1..K (its columns R: sine and cosine of each order, in order), each with
-        each roughness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights)."""
-        if cand.name != "joint_map":
+        each smoothness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights);
+        transmission_error (a periodic error too) with each penalty on its orders."""
+        if cand.name not in ("joint_map", "transmission_error"):
             return None
         s = float(np.mean(np.sum(R[:, :2] ** 2, axis=0)))
-        k2 = np.repeat(np.arange(1, cand.order + 1, dtype=float) ** 2, 2)
-        return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * k2[:2 * k])
+        kw = np.repeat(np.asarray(cand.harmonics, dtype=float), 2)
+        if cand.name == "transmission_error":
+            return [(cand, R.shape[1], np.sqrt(lam * s) * kw) for lam in MAP_SMOOTHING]
+        return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * kw[:2 * k])
                 for k in range(1, cand.order + 1) for lam in MAP_SMOOTHING]
 
+    def variant_folds(self, cand) -> list:
+        """joint_map's order and smoothing (transmission_error's smoothing) are chosen holding out, in
+        turn, each of VARIANT_BLOCKS contiguous ranges of the joint's angle (equal numbers of points):
+        a map must predict angles it has not seen, as it will on the next campaign."""
+        q = np.asarray(self.data["q_deg"], dtype=float)[:, cand.joint - 1]
+        edges = np.quantile(q, np.linspace(0.0, 1.0, VARIANT_BLOCKS + 1))
+        block = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, VARIANT_BLOCKS - 1)
+        return [block == b for b in range(VARIANT_BLOCKS)]
+
     def variant_evidence(self, cand, i: int, gains: Sequence[float]) -> dict:
-        """A joint_map step's evidence: the order and smoothing chosen, and the best cross-validated
-        gain of each order 1..MAX_MAP_ORDER."""
+        """A periodic step's evidence: the smoothing chosen; for joint_map its order and the best gain of
+        each order 1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
         g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
-        return {"order": cand.order, "smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)],
-                "order_cv_gain": [round(float(x), 6) for x in g.max(axis=1)]}
+        out = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
+        if cand.name == "joint_map":
+            out.update(order=cand.order, order_range_cv_gain=[round(float(x), 6) for x in g.max(axis=1)])
+        return out
 
     def chosen(self, cand, ridge: np.ndarray) -> None:
         """The variant chosen for a candidate: its fits carry that penalty (weights in mm per rad)."""

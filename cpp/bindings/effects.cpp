@@ -24,17 +24,29 @@ void define_effects(py::module_& m) {
   m.def("effect_kind", &effect_kind, py::arg("name"), py::return_value_policy::copy);
 
   py::class_<Effect>(m, "Effect", "An effect on one joint (or link), or on the whole robot")
-      .def(py::init([](const std::string& name, int joint, std::vector<int> harmonics) {
-             Effect e{name, joint - 1, std::move(harmonics)};
+      .def(py::init([](const std::string& name, int joint, std::vector<int> harmonics, int order) {
              effect_kind(name);
+             if (order != 0 && name != "joint_map")
+               throw InputError(name + " has no order (only joint_map has: its highest harmonic)");
+             if (name == "joint_map") {
+               if (order < 0 || order > 64) throw InputError("joint_map: the order must be 1..64, not " + std::to_string(order));
+               if (order == 0) order = harmonics.empty() ? 0 : harmonics.back();
+               Effect e = joint_map(joint - 1, order);
+               if (e.harmonics != harmonics && harmonics != std::vector<int>{1, 2})
+                 throw InputError("joint_map carries every harmonic order 1..K: give its order K");
+               return e;
+             }
+             Effect e{name, joint - 1, std::move(harmonics)};
              if (name != "transmission_error") e.harmonics.clear();
              return e;
            }),
-           py::arg("name"), py::arg("joint") = 0, py::arg("harmonics") = std::vector<int>{1, 2},
-           "joint counted from 1; 0 for an effect on the whole robot")
+           py::arg("name"), py::arg("joint") = 0, py::arg("harmonics") = std::vector<int>{1, 2}, py::arg("order") = 0,
+           "joint counted from 1; 0 for an effect on the whole robot; harmonics: transmission_error's orders; "
+           "order: joint_map's order K (harmonics 1..K; default 2)")
       .def_readonly("name", &Effect::name)
       .def_property_readonly("joint", [](const Effect& e) { return e.joint + 1; }, "from 1; 0: the whole robot")
       .def_readonly("harmonics", &Effect::harmonics)
+      .def_property_readonly("order", &Effect::order, "joint_map: its order K; 0 for the others")
       .def_property_readonly("size", &Effect::size)
       .def_property_readonly("label", &Effect::label)
       .def_property_readonly("parameter_names", &Effect::parameter_names)
@@ -45,8 +57,8 @@ void define_effects(py::module_& m) {
       .def(py::self == py::self)
       .def("__hash__",
            [](const Effect& e) {
-             // consistent with ==: the harmonic orders count for the transmission error only
-             py::tuple h = py::tuple(py::cast(e.name == "transmission_error" ? e.harmonics : std::vector<int>{}));
+             // consistent with ==: the harmonic orders count for transmission_error and joint_map only
+             py::tuple h = py::tuple(py::cast(e.harmonic() ? e.harmonics : std::vector<int>{}));
              return py::hash(py::make_tuple(e.name, e.joint, h));
            })
       .def("__repr__", [](const Effect& e) { return "<Effect " + e.label() + ">"; });

@@ -295,7 +295,10 @@ void define_identify(py::module_& m) {
                      "effects identified with the rest (assign a whole list); joint_compliance entries turn\n"
                      "the compliance of their joints on")
       .def_readwrite("orientation_weight", &IdentifyOptions::orientation_weight,
-                     "mm per rad: how orientation residuals weigh against positions");
+                     "mm per rad: how orientation residuals weigh against positions")
+      .def_readwrite("penalties", &IdentifyOptions::penalties,
+                     "ridge penalties (parameter name, weight in mm per unit of the parameter), e.g. a joint_map's\n"
+                     "smoothness penalty (assign a whole list)");
 
   py::class_<PyIdentifyResult>(m, "IdentifyResult", "What identify() found")
       .def_property_readonly("robot", [](const PyIdentifyResult& r) { return r.robot; },

@@ -332,6 +332,7 @@ def build_parser() -> argparse.ArgumentParser:
         names = ", ".join(k.name for k in _core.effect_kinds() if k.domain == "serial")
         sp.add_argument("--effects", default=default,
                         help=f"{what}, comma separated: NAME (every joint where it applies) or NAME:J (joint J); "
+                             f"joint_map:J:K a joint_map of order K (default {ident.DEFAULT_MAP_ORDER}); "
                              f"'none' for the geometry alone (default: {default}; known: {names})")
         sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                         help="harmonic orders of transmission_error (default 1,2)")
@@ -407,10 +408,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="poses drawn at random inside the limits, or the most observable of 10 times as many")
     sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
                     help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg; a sine and a cosine "
-                         "amplitude per order of --harmonics), backlash:J:b (deg per direction sign), "
-                         "thermal_expansion:0:alpha (1/C, about 20 C), drift:0:vx,vy,vz,wx,wy,wz (the "
-                         "instrument's drift: mm/h and deg/h about the campaign's mean time; 3 h unless "
-                         "--duration); repeatable")
+                         "amplitude per order of --harmonics), joint_map:J:s1,c1,..,sK,cK (deg; orders 1..K), "
+                         "backlash:J:b (deg per direction sign), thermal_expansion:0:alpha (1/C, about 20 C), "
+                         "drift:0:vx,vy,vz,wx,wy,wz (the instrument's drift: mm/h and deg/h about the campaign's "
+                         "mean time; 3 h unless --duration); repeatable")
     sp.add_argument("--duration", type=float, metavar="HOURS",
                     help="a time_s column: the campaign runs from 0 to HOURS in pose order")
     sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",

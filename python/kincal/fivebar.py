@@ -187,7 +187,8 @@ def library() -> list:
         if kind.domain == "fivebar" and kind.concerns == "link":
             out += [_core.Effect(kind.name, i + 1) for i in range(len(LINKS))]
     for kind in _core.effect_kinds():
-        if kind.acts_on == "joint_angle" and not kind.needs and not kind.gravity_loaded_only:
+        # joint_map (any order) is the serial diagnosis's; here the transmission error's two orders
+        if kind.acts_on == "joint_angle" and not kind.needs and not kind.gravity_loaded_only and kind.name != "joint_map":
             out += [_core.Effect(kind.name, j + 1) for j in range(2)]
     return out
 

@@ -26,6 +26,8 @@ DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -2
 DEFAULT_INSTRUMENT = (3500.0, -1500.0, -400.0, 35.0, 1.5, -0.8)
 #: harmonic orders of transmission_error unless --harmonics says otherwise
 DEFAULT_HARMONICS = (1, 2)
+#: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
+DEFAULT_MAP_ORDER = 4
 
 
 def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
@@ -70,7 +72,10 @@ def _effect_value(e: Sequence) -> tuple:
     if len(e) == 2 and isinstance(e[0], _core.Effect):
         return e[0], [float(v) for v in e[1]]
     name, joint, vals = e
-    return _core.Effect(str(name), int(joint)), [float(v) for v in vals]
+    vals = [float(v) for v in vals]
+    if name == "joint_map":  # its order from the number of values: a sine and a cosine per order
+        return _core.Effect("joint_map", int(joint), order=max(1, len(vals) // 2)), vals
+    return _core.Effect(str(name), int(joint)), vals
 
 
 def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
@@ -84,9 +89,10 @@ def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
 def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS,
                   option: str = "--effects") -> list:
     """The effects of ``--effects``: comma separated ``NAME`` (every joint where it applies: joint
-    compliance only on the gravity-loaded joints) or ``NAME:J`` (joint J, from 1); ``none`` or an
-    empty text is the geometry alone. ``harmonics``: transmission_error's orders. Errors name the
-    bad item and what the registry knows."""
+    compliance only on the gravity-loaded joints) or ``NAME:J`` (joint J, from 1); ``joint_map:J:K``
+    gives joint_map's order K (default DEFAULT_MAP_ORDER); ``none`` or an empty text is the geometry
+    alone. ``harmonics``: transmission_error's orders. Errors name the bad item and what the registry
+    knows."""
     items = [t.strip() for t in (text or "").split(",") if t.strip()]
     if items == ["none"]:
         return []
@@ -96,6 +102,13 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     for item in items:
         name, _, joint = item.partition(":")
         name = name.strip()
+        order = DEFAULT_MAP_ORDER
+        if name == "joint_map" and ":" in joint:
+            joint, _, k = joint.partition(":")
+            try:
+                order = int(k)
+            except ValueError:
+                raise ValueError(f"{option}: '{item}': joint_map's order must be a number 1..64") from None
         kind = next((k for k in _core.effect_kinds() if k.name == name), None)
         if kind is None:
             raise ValueError(f"{option}: unknown effect '{item}' (known: {known})")
@@ -119,8 +132,9 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
         else:
             joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
         for j in joints:
-            e = _core.Effect(name, j, list(harmonics))
             try:
+                e = (_core.Effect(name, j, order=order) if name == "joint_map"
+                     else _core.Effect(name, j, list(harmonics)))
                 e.check(robot.dof)
             except ValueError as err:
                 raise ValueError(f"{option}: '{item}': {err}") from None
@@ -132,7 +146,8 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
 def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> tuple:
     """NAME:JOINT:V1,V2.. of `kincal simulate --hide`: (Effect, values in core units). The values are
     in the model file's units (degrees for angles, 1/C for thermal_expansion: joint 0); their number
-    comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order)."""
+    comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order;
+    joint_map: its order is half their number)."""
     parts = text.split(":")
     if len(parts) != 3:
         raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
@@ -148,7 +163,13 @@ def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_
         raise ValueError(f"--hide {text}: joint and values must be numbers") from None
     if kind.concerns == "joint" and not 1 <= j <= dof:
         raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
-    e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
+    if name == "joint_map":
+        if len(v) < 2 or len(v) % 2 or len(v) > 128:
+            raise ValueError(f"--hide {text}: joint_map takes a sine and a cosine amplitude (deg) per order "
+                             "1..K: an even number of values, 2 to 128")
+        e = _core.Effect(name, j, order=len(v) // 2)
+    else:
+        e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
     if len(v) != e.size or not all(math.isfinite(x) for x in v):
         raise ValueError(f"--hide {text}: {e.label} takes {e.size} finite value(s) "
                          f"({', '.join(f'{n} ({u})' for n, u in zip(e.parameter_names, e.file_units))})")
@@ -172,13 +193,17 @@ def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
 
 def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
             orientation_weight: float = 100.0, max_iterations: int = 100,
-            fix: Sequence[str] = ()) -> "_core.IdentifyOptions":
+            fix: Sequence[str] = (), penalties: Sequence = ()) -> "_core.IdentifyOptions":
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
-    joints on; without any, the compliances stay at their start value)."""
+    joints on; without any, the compliances stay at their start value). ``penalties``: ridge
+    penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
+    joint_map smoothness penalty."""
     effects = list(effects)
-    return _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
-                                 loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
-                                 effects=effects, covariance=covariance, orientation_weight=orientation_weight)
+    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
+                              loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
+                              effects=effects, covariance=covariance, orientation_weight=orientation_weight)
+    o.penalties = [(str(n), float(w)) for n, w in penalties]
+    return o
 
 
 def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
@@ -392,7 +417,8 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
              loss_scale_mm: float = 0.1, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
-             fold_progress: Optional[Callable[[int, int], None]] = None) -> Identification:
+             fold_progress: Optional[Callable[[int, int], None]] = None,
+             penalties: Sequence = ()) -> Identification:
     """Identify the robot's parameters from measurements.
 
     ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
@@ -402,7 +428,8 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     The model returned is fitted on every row. Its validation figures come from ``k_folds``-fold
     cross-validation (whole configurations per fold; 0: no validation). With ``holdout`` (a share in
     (0, 1)) a random share of the configurations is held out instead, and the model then excludes
-    those rows (the validation says so). ``fold_progress(fold, folds)`` reports each validation fit."""
+    those rows (the validation says so). ``fold_progress(fold, folds)`` reports each validation fit.
+    ``penalties``: ridge penalties (parameter name, weight in mm per unit of the parameter)."""
     effects = check_effects(effects, robot, harmonics)
     check_data_for(effects, data, robot)
     if loss not in ("none", "huber", "cauchy"):
@@ -412,9 +439,10 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     if holdout is not None and not 0.0 <= holdout < 1.0:
         raise ValueError(f"--holdout must be a share in (0, 1), not {holdout}")
     holdout = holdout or None  # a share of 0 holds nothing out
-    opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight)
+    opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
+                   penalties=penalties)
     cv_opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
-                      covariance=False)
+                      covariance=False, penalties=penalties)
     every_row = np.ones(len(data["pose"]), dtype=bool)
     if holdout is not None:
         fit_mask, held = split_poses(data, holdout, seed)

@@ -25,7 +25,8 @@ namespace {
 // Truth of these tests: kr500 with 1 mm / 0.05 deg geometric errors and compliance 0.003 deg/kNm
 // (seed 11), transmission error on joints 2 and 3 (harmonics 1, 2 and, on joint 3, 3), backlash
 // of 0.01-0.02 deg on joints 1, 2 and 4 (negative: the joint lags behind the command, as a gear's
-// play makes it), thermal expansion 12e-6 per deg C about 20 C.
+// play makes it), a joint_map of order 5 on joint 5 (0.004-0.012 deg per order), thermal expansion
+// 12e-6 per deg C about 20 C.
 ModelSpec effects_spec(bool thermal = true) {
   ModelSpec s = perturbed_spec(kr500_spec(), 11, 1.0, 0.05, 0.003);
   const double d = kDeg;
@@ -35,6 +36,8 @@ ModelSpec effects_spec(bool thermal = true) {
   s.effects.push_back({Effect{"backlash", 0, {}}, {-0.01 * d}});
   s.effects.push_back({Effect{"backlash", 1, {}}, {-0.02 * d}});
   s.effects.push_back({Effect{"backlash", 3, {}}, {-0.015 * d}});
+  s.effects.push_back({joint_map(4, 5), {0.012 * d, -0.004 * d, 0.006 * d, 0.008 * d, -0.005 * d, 0.004 * d,
+                                         0.007 * d, -0.006 * d, 0.004 * d, 0.005 * d}});
   if (thermal) s.effects.push_back({Effect{"thermal_expansion", -1, {}}, {12e-6}});
   s.t_ref_c = 20.0;
   return s;
@@ -56,7 +59,7 @@ TEST(Effects, RegistryNamesEveryEffectOnce) {
   std::vector<std::string> names;
   for (const auto& k : effect_kinds()) names.push_back(k.name);
   EXPECT_EQ(names, (std::vector<std::string>{"joint_compliance", "transmission_error", "backlash", "thermal_expansion",
-                                             "drift", "link_deflection"}));
+                                             "drift", "joint_map", "link_deflection"}));
   EXPECT_EQ(effect_kind("drift").needs, "time_s");
   EXPECT_EQ(Effect{"drift"}.file_units()[3], "deg/h");
   EXPECT_EQ(effect_kind("backlash").needs, "dir");
@@ -69,6 +72,20 @@ TEST(Effects, RegistryNamesEveryEffectOnce) {
   EXPECT_THROW(check_effect(Effect{"backlash", 7, {}}, 6, ""), InputError);
   EXPECT_THROW(check_effect(Effect{"link_deflection", 0, {}}, 6, ""), InputError);
   EXPECT_THROW(check_effect(Effect{"transmission_error", 0, {2, 2}}, 6, ""), InputError);
+  // joint_map: every order 1..K, parameters map_sin1, map_cos1, ..., in degrees in files
+  const Effect jm = joint_map(3, 4);
+  EXPECT_EQ(jm.order(), 4);
+  EXPECT_EQ(jm.size(), 8);
+  EXPECT_EQ(jm.label(), "joint_map(joint 4)");
+  EXPECT_EQ(jm.parameter_names()[6], "map_sin4");
+  EXPECT_EQ(jm.file_units()[7], "deg");
+  EXPECT_NO_THROW(check_effect(jm, 6, ""));
+  EXPECT_THROW(check_effect(Effect{"joint_map", 0, {1, 3}}, 6, ""), InputError);
+  EXPECT_THROW(check_effect(Effect{"joint_map", 0, {}}, 6, ""), InputError);
+  EXPECT_THROW(check_effect(joint_map(6, 2), 6, ""), InputError);
+  EXPECT_FALSE(joint_map(3, 4) == joint_map(3, 5));
+  EXPECT_FALSE(joint_map(3, 2) == (Effect{"transmission_error", 3, {1, 2}}));
+  EXPECT_EQ((Effect{"backlash", 3, {}}.order()), 0);
   // the harmonic basis against libm: sin(k q), cos(k q) and their derivatives
   double b[6], db[6];
   joint_basis(te, 0.7, 0.0, b, db);
@@ -100,6 +117,17 @@ TEST(Effects, ModelJsonVersion2RoundTripAndVersion1Reads) {
   v1.replace(v1.find("\"version\": 2"), 12, "\"version\": 1");
   const Robot r1 = robot_from_json(v1, "v1.json");
   EXPECT_TRUE(r1.calibrated->spec().effects.empty());
+  // joint_map is written with its order and read back from it; without it, an error naming where
+  EXPECT_NE(text.find("\"order\": 5"), std::string::npos);
+  std::string no_order = text;
+  no_order.replace(no_order.find("\"order\": 5"), 10, "\"orders\": 5");
+  try {
+    robot_from_json(no_order, "o.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("o.json: calibrated.effects["), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("order"), std::string::npos) << e.what();
+  }
   // a wrong unit is an error naming where
   std::string bad = text;
   bad.replace(bad.find("\"unit\": \"deg\""), 13, "\"unit\": \"rad\"");

@@ -89,14 +89,15 @@ TEST(PointModel, JacobianMatchesFiniteDifferencesCompliant) {
 
 TEST(PointModel, JacobianMatchesFiniteDifferencesWithEffects) {
   // truth: kr500 with compliance, transmission error on A3, backlash on A2, thermal expansion;
-  // the parameters at a random point (every effect non-zero) and 30 poses with dir and temperature
+  // the model adds a joint_map of order 6 on A5; the parameters at a random point (every effect
+  // non-zero) and 30 poses with dir and temperature
   SimulationOptions so;
   so.poses = 30;
   so.noise_mm = 0;
   so.targets = kTargets;
   const MeasurementSet d = simulate(Model(truth_spec(5, 0.003)), so);
   const Model nominal(kr500_spec());
-  const std::vector<Effect> eff = {{"transmission_error", 2}, {"backlash", 1}, {"thermal_expansion", -1}};
+  const std::vector<Effect> eff = {{"transmission_error", 2}, {"backlash", 1}, {"thermal_expansion", -1}, joint_map(4, 6)};
   PointModel pm(nominal, 3, eff, 24.0);
   std::vector<double> x = pm.start(d);
   std::mt19937_64 rng(8);

@@ -22,6 +22,9 @@ const std::vector<EffectKind>& effect_kinds() {
        "the instrument's placement moving linearly with time (a property of the measurement: removed from "
        "the fit, never compensated): translation mm/h and rotation deg/h about the campaign's mean time",
        false},
+      {"joint_map", "serial", "joint", "", "joint_angle",
+       "a smooth periodic error of the joint angle of any order K: sine and cosine amplitudes of orders 1..K (deg)",
+       false},
       {"link_deflection", "fivebar", "link", "", "link_length",
        "a link length that varies with the pose: p1 cos t1 + p2 sin t1 + p3 cos t2 + p4 sin t2 (mm)", false},
   };
@@ -37,11 +40,19 @@ const EffectKind& effect_kind(const std::string& name) {
 }
 
 int Effect::size() const {
-  if (name == "transmission_error") return 2 * static_cast<int>(harmonics.size());
+  if (harmonic()) return 2 * static_cast<int>(harmonics.size());
   if (name == "link_deflection") return 4;
   if (name == "drift") return 6;
   effect_kind(name);
   return 1;
+}
+
+int Effect::order() const { return name == "joint_map" && !harmonics.empty() ? harmonics.back() : 0; }
+
+Effect joint_map(int joint, int order) {
+  Effect e{"joint_map", joint, {}};
+  for (int k = 1; k <= order; ++k) e.harmonics.push_back(k);
+  return e;
 }
 
 std::string Effect::label() const {
@@ -50,9 +61,10 @@ std::string Effect::label() const {
 }
 
 std::vector<std::string> Effect::parameter_names() const {
-  if (name == "transmission_error") {
+  if (harmonic()) {
+    const std::string p = name == "joint_map" ? "map_" : "te_";
     std::vector<std::string> n;
-    for (int k : harmonics) n.push_back("te_sin" + std::to_string(k)), n.push_back("te_cos" + std::to_string(k));
+    for (int k : harmonics) n.push_back(p + "sin" + std::to_string(k)), n.push_back(p + "cos" + std::to_string(k));
     return n;
   }
   if (name == "link_deflection") return {"p1_cos_t1", "p2_sin_t1", "p3_cos_t2", "p4_sin_t2"};
@@ -107,6 +119,14 @@ void check_effect(const Effect& e, int dof, const std::string& who) {
         throw InputError(who + "transmission_error: harmonic order " + std::to_string(e.harmonics[i]) + " twice");
     }
   }
+  if (e.name == "joint_map") {
+    const int k = static_cast<int>(e.harmonics.size());
+    if (k < 1 || k > 64) throw InputError(who + "joint_map: the order must be 1..64, not " + std::to_string(k));
+    for (int i = 0; i < k; ++i)
+      if (e.harmonics[i] != i + 1)
+        throw InputError(who + "joint_map carries every harmonic order 1..K (its order K), not an order " +
+                         std::to_string(e.harmonics[i]) + " at place " + std::to_string(i + 1));
+  }
 }
 
 void joint_basis(const Effect& e, double q, double dir, double* b, double* db) {
@@ -115,7 +135,7 @@ void joint_basis(const Effect& e, double q, double dir, double* b, double* db) {
     if (db) db[0] = 0;
     return;
   }
-  // transmission_error: sin(kq), cos(kq) of each order from sin q, cos q by the angle-addition rule
+  // transmission_error, joint_map: sin(kq), cos(kq) of each order from sin q, cos q by the angle-addition rule
   double s1, c1;
   fastmath::sincos(q, s1, c1);
   int have = 1;

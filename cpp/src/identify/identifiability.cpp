@@ -206,7 +206,14 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
 Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
-  const std::vector<int> order = preference_order(L, data.orientation);
+  // penalised parameters (a ridge determines them where the data do not) are left out of the
+  // analysis: always free, they never make another parameter look redundant
+  std::vector<int> order;
+  for (int i : preference_order(L, data.orientation)) {
+    bool penalised = false;
+    for (const auto& [name, w] : opt.penalties) penalised = penalised || (w > 0 && L.names[i] == name);
+    if (!penalised) order.push_back(i);
+  }
   // what the generic campaign determines but the data do not means the data are too few or too alike
   IdentifyResult generic = res;
   select_independent(linearize(pm, generic_campaign(nominal, data), x, opt.orientation_weight).jacobian, order, opt,

@@ -85,6 +85,43 @@ class RowCost : public ceres::CostFunction {
   size_t i_;
 };
 
+/// Ridge penalties: residual w_k z_k for the free parameters that carry a weight.
+class PenaltyCost : public ceres::CostFunction {
+ public:
+  PenaltyCost(std::vector<std::pair<int, double>> terms, int size) : terms_(std::move(terms)), size_(size) {
+    set_num_residuals(static_cast<int>(terms_.size()));
+    mutable_parameter_block_sizes()->push_back(size);
+  }
+  bool Evaluate(double const* const* z, double* residuals, double** jacobians) const override {
+    for (size_t i = 0; i < terms_.size(); ++i) residuals[i] = terms_[i].second * z[0][terms_[i].first];
+    if (jacobians && jacobians[0]) {
+      std::fill_n(jacobians[0], terms_.size() * size_, 0.0);
+      for (size_t i = 0; i < terms_.size(); ++i) jacobians[0][i * size_ + terms_[i].first] = terms_[i].second;
+    }
+    return true;
+  }
+
+ private:
+  std::vector<std::pair<int, double>> terms_;  // (index among the free parameters, weight)
+  int size_;
+};
+
+/// The penalty terms of the free parameters (index among them, weight); InputError for a name the
+/// layout does not have or a weight that is negative or not finite.
+std::vector<std::pair<int, double>> penalty_terms(const ParamLayout& L, const std::vector<int>& free_idx,
+                                                  const IdentifyOptions& opt) {
+  std::vector<std::pair<int, double>> out;
+  for (const auto& [name, w] : opt.penalties) {
+    const auto it = std::find(L.names.begin(), L.names.end(), name);
+    if (it == L.names.end()) throw InputError("identify: a penalty on '" + name + "', which is no parameter of the model");
+    if (!(w >= 0) || !std::isfinite(w)) throw InputError("identify: the penalty on '" + name + "' must be finite and >= 0");
+    const int i = static_cast<int>(it - L.names.begin());
+    const auto f = std::find(free_idx.begin(), free_idx.end(), i);
+    if (f != free_idx.end() && w > 0) out.emplace_back(static_cast<int>(f - free_idx.begin()), w);
+  }
+  return out;
+}
+
 class Progress : public ceres::IterationCallback {
  public:
   explicit Progress(const std::function<void(int, double)>& f) : f_(f) {}
@@ -118,8 +155,9 @@ enum class Report { silent, progress };
 
 /// Levenberg-Marquardt on the free parameters of all (written back into its x by finish()).
 void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, const IdentifyOptions& opt,
-           ceres::Solver::Summary& summary, Report report) {
+           ceres::Solver::Summary& summary, Report report, const std::vector<std::pair<int, double>>& penalties = {}) {
   for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, all.z());
+  if (!penalties.empty()) problem.AddResidualBlock(new PenaltyCost(penalties, all.size()), nullptr, all.z());
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = opt.max_iterations;
@@ -359,7 +397,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   AllRows all(pm, data, x, free_idx, opt.orientation_weight);
   all.seed(at_start);
   ceres::Problem problem(problem_options(all));
-  solve(problem, all, loss.get(), opt, summary, Report::progress);
+  solve(problem, all, loss.get(), opt, summary, Report::progress, penalty_terms(res.layout, free_idx, opt));
   res.iterations = static_cast<int>(summary.iterations.size()) - 1;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;

@@ -25,6 +25,7 @@ json effect_json(const Effect& e, const std::vector<double>& p) {
     params.push_back(json{{"name", names[k]}, {"value", p[k] * scale[k]}, {"unit", units[k]}});
   json o{{"effect", e.name}, {"joint", e.joint >= 0 ? json(e.joint + 1) : json(nullptr)}, {"parameters", params}};
   if (e.name == "transmission_error") o["harmonics"] = e.harmonics;
+  if (e.name == "joint_map") o["order"] = e.order();
   return o;
 }
 
@@ -187,7 +188,15 @@ struct Reader {
         ev.effect.harmonics.push_back(k.get<int>());
       }
     }
-    if (ev.effect.name != "transmission_error") ev.effect.harmonics.clear();
+    if (ev.effect.name == "joint_map") {
+      // joint_map: harmonics 1..K from its order K
+      const json& k = at(eo, "order", w);
+      if (!k.is_number_integer() || k.get<int>() < 1 || k.get<int>() > 64)
+        fail(w + ".order", "joint_map needs its order K, an integer 1..64");
+      ev.effect = joint_map(ev.effect.joint, k.get<int>());
+    } else if (ev.effect.name != "transmission_error") {
+      ev.effect.harmonics.clear();
+    }
     const json& params = at(eo, "parameters", w);
     if (!params.is_array()) fail(w + ".parameters", "needs a list");
     const auto names = ev.effect.parameter_names();

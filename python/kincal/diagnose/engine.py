@@ -9,6 +9,14 @@ residual of a linear fit (the same folds). The best significant candidate is add
 refitted, and its cross-validated RMS must fall; otherwise, or when no candidate is significant, the
 search stops.
 
+A candidate may come in variants: nested orders (a joint_map of order 1..K: the columns of order k
+are the first ones of order k + 1), each with a ridge penalty on its parameters (a smoothness penalty:
+weights growing with the order), from the Problem's ``variants``; the variant is chosen by
+cross-validation (the simplest, in the order listed, whose held-out residual is within ORDER_MARGIN
+of the best variant's; on the Problem's ``variant_folds`` when it has them, else the same folds),
+told to the Problem (``chosen``: its refits use the same penalty), then scored as any candidate on
+the same folds.
+
 A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
 candidates; effects are _core.Effect objects.
 """
@@ -26,6 +34,10 @@ from .. import _core
 #: how many of a round's candidates (best cross-validated gain first) the history lists and the
 #: verdict weighs
 LISTED = 8
+
+#: nested orders: a higher order is kept only when it lowers the held-out residual sum of squares by
+#: more than this share of the best order's
+ORDER_MARGIN = 0.01
 
 #: residual r (dims per point), the current model's free columns Jc and a candidate's columns R
 Linearisation = Callable[["_core.Effect"], tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -75,15 +87,29 @@ def cv_rms(problem: Problem, effects: list) -> float:
     return math.sqrt(sq / n)
 
 
-def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray]) -> dict:
-    """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
-    (``row_folds``: the held-out residual rows of each fold). Columns the span absorbs are dropped;
-    a candidate absorbed whole scores nothing."""
-    from scipy.stats import f as fdist
-
+def _basis(Jc: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of the current model's columns."""
     Q, _ = np.linalg.qr(Jc)
+    return Q
+
+
+def _projected(Q: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R projected off the span of Q, and which columns survive (those the span does not absorb)."""
     Rp = R - Q @ (Q.T @ R)
     keep = np.linalg.norm(Rp, axis=0) > 1e-9 * max(1.0, float(np.linalg.norm(R)))
+    return Rp, keep
+
+
+def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray],
+          Q: Optional[np.ndarray] = None, ridge: Optional[np.ndarray] = None) -> dict:
+    """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
+    (``row_folds``: the held-out residual rows of each fold; ``Q``: an orthonormal basis of Jc's
+    span, when the caller has it; ``ridge``: a penalty weight per column, in the fits of the
+    cross-validation). Columns the span absorbs are dropped; a candidate absorbed whole scores
+    nothing."""
+    from scipy.stats import f as fdist
+
+    Rp, keep = _projected(_basis(Jc) if Q is None else Q, R)
     if not keep.any():
         return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": True}
     Rp = Rp[:, keep]
@@ -95,11 +121,52 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
     p = float(fdist.sf(F, k, dof)) if math.isfinite(F) else 0.0
     before = after = 0.0
     for h in row_folds:
-        b, *_ = np.linalg.lstsq(Rp[~h], r[~h], rcond=None)
+        if ridge is None:
+            b, *_ = np.linalg.lstsq(Rp[~h], r[~h], rcond=None)
+        else:
+            A = Rp[~h]
+            b = np.linalg.solve(A.T @ A + np.diag(np.asarray(ridge)[keep] ** 2), A.T @ r[~h])
         before += float(r[h] @ r[h])
         after += float(np.sum((r[h] - Rp[h] @ b) ** 2))
     gain = 1.0 - math.sqrt(after / before) if before > 0 else 0.0
     return {"F": float(F), "p_value": p, "cv_gain": gain, "absorbed": False, "parameters": int(k)}
+
+
+def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, np.ndarray]],
+                   row_folds: Sequence[np.ndarray], Q: np.ndarray) -> tuple[int, list]:
+    """The variant of nested regressors (each: the first ``m`` columns of R and a ridge weight per
+    column; off the span of Q) by cross-validation: the held-out residual sum of squares of each;
+    the first listed within ORDER_MARGIN of the best. Returns its index and the cross-validated gain
+    of each."""
+    Rp, keep = _projected(Q, R)
+    G, g = Rp.T @ Rp, Rp.T @ r
+    groups: dict = {}  # variants of the same columns, solved together
+    for i, (m, ridge) in enumerate(variants):
+        groups.setdefault(m, []).append(i)
+    before = 0.0
+    after = np.zeros(len(variants))
+    for h in row_folds:
+        Rh, rh = Rp[h], r[h]
+        Gh, gh, ss = Rh.T @ Rh, Rh.T @ rh, float(rh @ rh)
+        before += ss
+        Gt, gt = G - Gh, g - gh
+        for m, idx in groups.items():
+            cols = np.flatnonzero(keep[:m])
+            if not len(cols):
+                after[idx] += ss
+                continue
+            w2 = np.array([np.asarray(variants[i][1], dtype=float)[cols] ** 2 for i in idx])
+            A = Gt[np.ix_(cols, cols)][None, :, :] + w2[:, :, None] * np.eye(len(cols))[None, :, :]
+            try:
+                b = np.linalg.solve(A, np.broadcast_to(gt[cols], (len(idx), len(cols)))[:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError:
+                b = np.array([np.linalg.lstsq(a, gt[cols], rcond=1e-14)[0] for a in A])
+            Ghc = Gh[np.ix_(cols, cols)]
+            after[idx] += ss - 2.0 * b @ gh[cols] + np.einsum("vi,ij,vj->v", b, Ghc, b)
+    best = float(np.min(after))
+    choice = int(np.flatnonzero(after <= best * (1.0 + ORDER_MARGIN) + 1e-300)[0])
+    gains = [1.0 - math.sqrt(a / before) if before > 0 else 0.0 for a in after]
+    return choice, gains
 
 
 @dataclass
@@ -127,14 +194,36 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
     history: list[dict[str, Any]] = [{"model": problem.model_label(effects), "cv_rms_mm": cur}]
     steps: list[dict[str, Any]] = []
     scored: list[dict[str, Any]] = []
+    variants = getattr(problem, "variants", None)
+    covered = getattr(problem, "covered", None)
+    chosen = getattr(problem, "chosen", None)
     for _ in range(max_steps):
         regressors = problem.linearise(effects)
         scored = []
+        basis: tuple = (None, None)  # the current model's columns and their orthonormal basis
         for c in candidates:
             if any(e.name == c.name and e.joint == c.joint for e in effects):
                 continue
-            s = score(*regressors(c), row_folds)
+            r, Jc, R = regressors(c)
+            if basis[0] is not Jc:
+                basis = (Jc, _basis(Jc))
+            order: dict = {}
+            ridge = None
+            nested = variants(c, R) if variants else None
+            if nested:
+                sel = getattr(problem, "variant_folds", None)
+                sel_folds = [np.repeat(f, problem.dims) for f in sel(c)] if sel else row_folds
+                i, gains = choose_variant(r, R, [(m, w) for _, m, w in nested], sel_folds, basis[1])
+                c, m, ridge = nested[i]
+                R = R[:, :m]
+                if covered and covered(c, candidates):
+                    continue
+                if chosen:
+                    chosen(c, ridge)
+                order = {"variant_cv_gain": [round(x, 6) for x in gains], "variant": i}
+            s = score(r, Jc, R, row_folds, basis[1], ridge)
             s.update(problem.describe(c))
+            s.update(order)
             s["_cand"] = c
             scored.append(s)
         scored.sort(key=lambda s: -s["cv_gain"])
@@ -152,10 +241,14 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             break
         runners_up = [dict(problem.describe(s["_cand"]), cv_gain_linear=s["cv_gain"], p_value=s["p_value"])
                       for s in scored[1:4]]
-        steps.append(dict(problem.describe(cand),
-                          evidence={"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
-                                    "cv_gain_linear": best["cv_gain"], "runners_up": runners_up},
-                          rms_before_mm=cur, rms_after_mm=new))
+        evidence = {"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
+                    "cv_gain_linear": best["cv_gain"], "runners_up": runners_up}
+        if "variant_cv_gain" in best:  # the variant chosen, and the cross-validated gain of each
+            if hasattr(problem, "variant_evidence"):
+                evidence.update(problem.variant_evidence(cand, best["variant"], best["variant_cv_gain"]))
+            else:
+                evidence.update(variant=best["variant"], variant_cv_gain=best["variant_cv_gain"])
+        steps.append(dict(problem.describe(cand), evidence=evidence, rms_before_mm=cur, rms_after_mm=new))
         effects, cur = effects + [cand], new
         history.append({"model": problem.model_label(effects), "cv_rms_mm": cur})
         scored = []

@@ -11,17 +11,19 @@ import numpy as np
 from .. import _core
 from .. import report
 from .._core import Robot
-from .serial import Spec
+from . import residual_vars
+from .serial import Spec, step_effect
 
 
-def _label(effect: str, joint: Optional[int]) -> str:
-    return _core.Effect(effect, joint or 0).label
+def _label(step: dict) -> str:
+    e = step_effect(step)
+    return e.label + (f", order {e.order}" if e.name == "joint_map" else "")
 
 
 def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
     """The natural variable of an effect for plots: (values per point, axis label)."""
     j = joint or 1
-    if effect == "transmission_error":
+    if effect in ("transmission_error", "joint_map"):
         return data["q_deg"][:, j - 1], f"q{joint} (deg)"
     if effect == "backlash":
         return data["dir"][:, j - 1] + np.random.default_rng(0).uniform(-0.15, 0.15, len(data["pose"])), \
@@ -30,8 +32,87 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
         return data["temperature_c"], "temperature (C)"
     if effect == "drift":
         return np.asarray(data["time_s"]) / 3600.0, "time of the measurement (h)"
-    tau = np.array([_core.gravity_torque(robot, q)[0][j - 1] for q in data["q_deg"]]) / 1000.0
-    return tau, f"gravity torque on joint {joint} (N m)"
+    tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, j - 1] / 1000.0
+    return tau, f"gravity torque on joint {joint} (kN m)"
+
+
+def _joint_error(res, data: dict, joint: int) -> np.ndarray:
+    """The angle error of ``joint`` (deg) each row's residual implies: the least-squares joint-angle
+    change that would close it (-J_j . r / J_j . J_j, J_j the joint's column at the fit)."""
+    r, C = residual_vars.carriers(res, data)
+    n = len(data["pose"])
+    Jj = C[:, 6 + joint - 1].reshape(n, -1)
+    rr = r.reshape(n, -1)
+    return -np.degrees(np.sum(Jj * rr, axis=1) / np.maximum(np.sum(Jj * Jj, axis=1), 1e-300))
+
+
+def _effect_curve(res, data: dict, effect, var: np.ndarray):
+    """The identified effect as a joint-angle change (deg) along its variable, sorted, or None
+    (thermal_expansion)."""
+    if effect.name == "joint_compliance":
+        c = [float(x) for p, x in zip(res.layout.parameters, res.x) if p.kind == "compliance" and p.joint == effect.joint]
+        xs = np.sort(var)
+        return (xs, c[0] * xs) if c else None  # deg/kNm * kN m
+    vals = next((v for e, v in res.robot.effects if e == effect), None)
+    if vals is None or effect.name == "thermal_expansion":
+        return None
+    if effect.name == "backlash":  # drawn at the two directions only
+        return np.array([-1.0, 1.0]), np.degrees(vals[0]) * np.array([-1.0, 1.0])
+    xs = np.linspace(float(np.min(var)), float(np.max(var)), 400)
+    t = np.radians(xs)
+    dq = sum(vals[2 * i] * np.sin(k * t) + vals[2 * i + 1] * np.cos(k * t) for i, k in enumerate(effect.harmonics))
+    return xs, np.degrees(dq)
+
+
+def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, after_fit, path: Path) -> None:
+    """The residual against the variable that carries a step's effect, before and after it was
+    added: as the joint's implied angle error for a joint-angle effect (with the identified effect's
+    curve), as the point error otherwise."""
+    effect = step_effect(st)
+    var, lab = _variable(robot, data, st["effect"], st["joint"])
+    fig, ax = plt.subplots(figsize=(6.5, 3.4), constrained_layout=True)
+    if effect.joint > 0:
+        b, a = _joint_error(before_fit, data, effect.joint), _joint_error(after_fit, data, effect.joint)
+        lim = float(np.percentile(np.abs(b), 99.5)) * 1.3 or 1.0
+        ax.scatter(var, np.clip(b, -lim, lim) * 1000, s=6, alpha=0.5, label="before")
+        ax.scatter(var, np.clip(a, -lim, lim) * 1000, s=6, alpha=0.5, label="after")
+        curve = _effect_curve(after_fit, data, effect, var)
+        if curve is not None and effect.name == "backlash":  # one level per direction
+            ax.hlines(curve[1] * 1000, curve[0] - 0.15, curve[0] + 0.15, color="k", lw=2.5, label="identified effect")
+        elif curve is not None:
+            ax.plot(curve[0], curve[1] * 1000, color="k", lw=1.5, label="identified effect")
+        ax.set_ylabel(f"joint {effect.joint} angle error (mdeg)")
+    else:
+        ax.scatter(var, _point_errors(before_fit, data) * 1000, s=6, alpha=0.6, label="before")
+        ax.scatter(var, _point_errors(after_fit, data) * 1000, s=6, alpha=0.6, label="after")
+        ax.set_ylabel("point error (um)")
+    ax.set_xlabel(lab)
+    ax.set_title(f"step {k + 1}: {_label(st)}", fontsize=10)
+    ax.legend(fontsize=8, loc="best")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def _point_errors(res, data: dict) -> np.ndarray:
+    return _core.point_errors(res.robot, res.targets, data)
+
+
+def _variables_figure(plt, scores: list, path: Path) -> None:
+    """The held-out share of the residual each candidate variable explains, one bar each (a share at
+    or below zero: fitting the variable only adds noise; drawn as none, its value written)."""
+    fig, ax = plt.subplots(figsize=(8, 1.0 + 0.28 * len(scores)), constrained_layout=True)
+    y = np.arange(len(scores))[::-1]
+    vals = [100 * s["share"] for s in scores]
+    ax.barh(y, [max(v, 0.0) for v in vals],
+            color=["tab:red" if v >= 100 * residual_vars.CARRIES else "tab:gray" for v in vals])
+    for yy, v in zip(y, vals):
+        ax.text(max(v, 0.0), yy, f" {v:.1f}%" if v > 0 else f" {v:.1f}% (nothing)", va="center", fontsize=8)
+    ax.set_yticks(y, [s["variable"] for s in scores], fontsize=8)
+    ax.set_xlim(0, max(10.0, max(vals)) * 1.25)
+    ax.axvline(100 * residual_vars.CARRIES, color="k", ls=":", lw=0.8)
+    ax.set_xlabel("share of the final residual's variance a smooth function of the variable explains, held out (%)")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
 
 
 def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path], title: str = "kincal diagnose",
@@ -82,23 +163,21 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     files.append("residual_map.png")
     # 3. residuals against each named effect's variable, before and after it was added
     spec = start
+    before = spec.fit(robot, data)
     for k, st in enumerate(diag["steps"]):
-        before = spec.errors(spec.fit(robot, data), data)
-        spec = spec.with_(_core.Effect(st["effect"], st["joint"] or 0))
-        after = spec.errors(spec.fit(robot, data), data)
-        var, lab = _variable(robot, data, st["effect"], st["joint"])
-        fig, ax = plt.subplots(figsize=(6.5, 3.4), constrained_layout=True)
-        ax.scatter(var, before * 1000, s=6, alpha=0.6, label="before")
-        ax.scatter(var, after * 1000, s=6, alpha=0.6, label="after")
-        ax.set_xlabel(lab)
-        ax.set_ylabel("point error (um)")
-        ax.set_title(f"step {k + 1}: {_label(st['effect'], st['joint'])}", fontsize=10)
-        ax.legend()
+        eff = step_effect(st)
+        spec = spec.with_(eff, diag["_spec"].penalties_of(eff))
+        after = spec.fit(robot, data)
         name = f"step{k + 1}.png"
-        fig.savefig(out / name, dpi=100)
-        plt.close(fig)
+        _step_figure(plt, robot, data, k, st, before, after, out / name)
         files.append(name)
-    rows = [[k + 1, _label(s["effect"], s["joint"]), f"{s['evidence']['F']:.3g}", f"{s['evidence']['p_value']:.2g}",
+        before = after
+    # 4. what remains against every candidate variable
+    scores = diag.get("residual_variables", [])
+    if scores:
+        _variables_figure(plt, scores, out / "residual_variables.png")
+        files.append("residual_variables.png")
+    rows = [[k + 1, _label(s), f"{s['evidence']['F']:.3g}", f"{s['evidence']['p_value']:.2g}",
              f"{s['evidence']['cv_gain_linear']:.1%}", f"{s['rms_before_mm'] * 1000:.1f}",
              f"{s['rms_after_mm'] * 1000:.1f}"] for k, s in enumerate(diag["steps"])]
     notes = "".join(f"<li>{report.esc(n)}</li>" for n in diag["notes"])
@@ -119,7 +198,17 @@ the repeats of one of the {diag['validation']['configurations']} configurations 
 <ul>{notes}</ul>
 <h2>The gap, step by step</h2>{report.figure("gap.png", "gap")}
 <h2>Where the model and the measurements disagree</h2>{report.figure("residual_map.png", "residual map")}
-<h2>Residuals against each named effect</h2>{steps_img}
+<h2>Residuals against each named effect</h2>
+<p>Each step's residual against the variable of its effect, before and after the step (fitted on every point):
+for an effect on a joint angle, the angle error of that joint each point's residual implies, with the identified
+effect's curve.</p>{steps_img}
+<h2>What remains, against every candidate variable</h2>
+<p>The final model's residual fitted, held out on the same folds, as a smooth function of each variable acting on
+the instrument's placement and on every joint angle: {report.esc(diag.get("residual_summary", ""))}.</p>
+{report.table(["variable", "what", "share held out", "RMS explained (um)"],
+              [[s["variable"], s["label"], f"{s['share']:.1%}", f"{s['rms_explained_mm'] * 1000:.1f}"]
+               for s in scores], numeric=False)}
+{report.figure("residual_variables.png", "residual variables") if scores else ""}
 {model_note}
 <p>Files: diagnosis.json (the contract's summary), {", ".join(([model_file] if model_file else []) + files)}.</p>"""
     report.write(out / "report.html", title, body)

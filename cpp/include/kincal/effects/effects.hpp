@@ -12,6 +12,9 @@
 //                      reaches the pose: the compensated program then misses it by up to 2|b|)
 //   thermal_expansion  (serial, robot)      every length of the robot scales by 1 + alpha (T - t_ref):
 //                      the tool point in the base frame scales about the base origin alpha in 1/degC
+//   joint_map          (serial, per joint)  a smooth periodic error of the joint angle of any order K:
+//                      dq_j = sum_{k=1..K} s_k sin(k q_j) + c_k cos(k q_j) (harmonics = 1..K)
+//                                                                                amplitudes in deg
 //   drift              (serial, robot, a property of the measurement) the instrument's placement
 //                      moves linearly with time: a point x of the robot base frame is seen at
 //                      Exp(tau w) R x + t + tau v instead of R x + t (R, t the placement: the
@@ -51,8 +54,11 @@ const EffectKind& effect_kind(const std::string& name);
 struct Effect {
   std::string name;
   int joint = -1;                   ///< 0-based joint (or link) index; -1 for robot-wide effects
-  std::vector<int> harmonics{1, 2};  ///< transmission_error: the harmonic orders (1 = once per turn)
+  /// transmission_error: the harmonic orders (1 = once per turn); joint_map: 1..K (K its order)
+  std::vector<int> harmonics{1, 2};
   int size() const;                  ///< number of parameters
+  int order() const;                 ///< joint_map: its order K (the highest harmonic); 0 for the others
+  bool harmonic() const { return name == "transmission_error" || name == "joint_map"; }
   std::string label() const;         ///< e.g. "transmission_error(joint 3)"
   /// parameter names without the joint prefix, e.g. te_sin1, te_cos1; and their core units
   std::vector<std::string> parameter_names() const;
@@ -60,7 +66,7 @@ struct Effect {
   std::vector<std::string> file_units() const;     ///< units in model files: "deg" for "rad", "deg/h" for "rad/h"
   std::vector<double> file_scale() const;          ///< file value = core value * scale
   bool operator==(const Effect& o) const {
-    return name == o.name && joint == o.joint && (name != "transmission_error" || harmonics == o.harmonics);
+    return name == o.name && joint == o.joint && (!harmonic() || harmonics == o.harmonics);
   }
 };
 
@@ -70,11 +76,14 @@ struct EffectValue {
   std::vector<double> p;
 };
 
+/// The joint_map of order K on a joint (0-based): harmonics 1..K.
+Effect joint_map(int joint, int order);
+
 /// Checks an effect for a robot of dof joints (known name, serial domain, joint in range, harmonic
-/// orders positive and distinct); throws InputError with `who` in front of the cause.
+/// orders positive and distinct, joint_map's 1..K); throws InputError with `who` in front of the cause.
 void check_effect(const Effect& e, int dof, const std::string& who);
 
-/// The basis of a joint-angle effect (transmission_error, backlash): dq = sum_k p_k b_k(q, dir).
+/// The basis of a joint-angle effect (transmission_error, joint_map, backlash): dq = sum_k p_k b_k(q, dir).
 /// Writes size() values to b and, when db is not null, their derivatives with respect to q.
 void joint_basis(const Effect& e, double q_rad, double dir, double* b, double* db = nullptr);
 

@@ -31,6 +31,11 @@ struct IdentifyOptions {
   std::vector<std::string> fix;    ///< parameter names to hold in any case
   std::vector<int> compliance_joints;  ///< with compliance: only these joints (0-based; empty: all)
   std::vector<Effect> effects;     ///< extra effects identified with the rest
+  /// ridge penalties (parameter name, weight in mm per unit of the parameter): the residual
+  /// weight * value pulls that parameter towards zero (e.g. a joint_map's smoothness penalty, order k
+  /// weighted k, so that a map the data see only over part of a turn stays smooth); the
+  /// identifiability analysis leaves penalised parameters out (free, the ridge determines them)
+  std::vector<std::pair<std::string, double>> penalties;
   std::function<void(int iteration, double cost)> progress;
   double orientation_weight = 100.0;  ///< mm per rad: how orientation residuals weigh against positions
 };

@@ -164,14 +164,14 @@ def test_identify_penalties(kr500):
     truth_vals = D([0.02, -0.01, 0.004, 0.008, -0.006, 0.012])
     data = ident.simulate(_truth(kr500), 150, seed=5, targets=3, effects=[("joint_map", 2, truth_vals)])
     e = _core.Effect("joint_map", 2, order=3)
-    free = ident.identify(kr500, data, effects=[e], holdout=0.0)
+    free = ident.identify(kr500, data, effects=[e], k_folds=0)
     (_, got), = free.robot.effects
     assert np.max(np.abs(np.degrees(np.asarray(got)[4:] - truth_vals[4:]))) < 0.002
     assert free.fit.rms_mm < 1.1 * NOISE
     names = [f"joint2.{n}" for n in e.parameter_names]
-    held = ident.identify(kr500, data, effects=[e], holdout=0.0, penalties=[(n, 1e9) for n in names])
+    held = ident.identify(kr500, data, effects=[e], k_folds=0, penalties=[(n, 1e9) for n in names])
     (_, got0), = held.robot.effects
     assert np.max(np.abs(np.degrees(got0))) < 1e-6
     assert held.fit.rms_mm > 2 * NOISE
     with pytest.raises(ValueError, match="joint5.map_sin1"):
-        ident.identify(kr500, data, effects=[e], holdout=0.0, penalties=[("joint5.map_sin1", 1.0)])
+        ident.identify(kr500, data, effects=[e], k_folds=0, penalties=[("joint5.map_sin1", 1.0)])

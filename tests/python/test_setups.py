@@ -83,8 +83,8 @@ def test_two_setups_identified_jointly(kr500, truth):
     places = {"A": A, "B": B}
     data = simulate_setups(truth, places, 75, seed=11, targets=3)
     assert data["setup_names"] == ["A", "B"] and len(np.unique(data["pose"])) == 150
-    joint = ident.identify(kr500, data, holdout=0.0)
-    single = ident.identify(kr500, ident.simulate(truth, 150, seed=11, targets=3), holdout=0.0)
+    joint = ident.identify(kr500, data, k_folds=0)
+    single = ident.identify(kr500, ident.simulate(truth, 150, seed=11, targets=3), k_folds=0)
     names = [n for n, _, _ in joint.fit.setups]
     assert names == ["A", "B"]
     assert [p.name for p in joint.fit.layout.parameters if p.kind == "base"][6] == "base[B].x"
@@ -150,7 +150,7 @@ def test_validate_with_orientations_and_setups(kr500, truth):
     """6-D rows (0.005 deg orientation noise) from two placements B and C: one placement refitted
     per setup; rms_deg and mean_deg at the orientation noise, per-setup figures for both."""
     fit = ident.simulate(truth, 120, seed=31, targets=1, orientation_noise_deg=0.005)
-    cal = ident.identify(kr500, fit, holdout=0.0)
+    cal = ident.identify(kr500, fit, k_folds=0)
     new = simulate_setups(truth, {"B": B, "C": C}, 60, seed=32, targets=1, orientation_noise_deg=0.005)
     v = ident.validate(cal.robot, new)
     assert set(v["setups"]) == {"B", "C"} and v["setups"]["B"]["points"] == 60

@@ -121,7 +121,8 @@ def cmd_simulate(args) -> None:
                           effects=[ident.parse_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide],
                           orientation_noise_deg=args.orientation_noise, duration_h=args.duration)
     if args.select == "observability":
-        data = ident.select_observable(robot, data, args.poses)
+        from . import plan
+        data = plan.select_observable(robot, data, args.poses)
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 

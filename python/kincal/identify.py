@@ -1,10 +1,9 @@
 """Measurement campaigns and parameter identification (the Samak paper's calibration step 3).
 
-A measurement set is a dict of numpy arrays (``pose``, ``q_deg``, ``xyz``, ``target``,
-``payload_kg``, ``line``, ``source``), the rows of the contract's measurement CSV; with the optional
-columns also ``temperature_c``, ``dir``, ``abc``, ``time_s``, ``config`` (int64 codes) with
-``config_names`` and ``setup`` (int64 codes, one instrument placement each) with ``setup_names``.
-The heavy work (residuals, analytic Jacobian, Ceres) runs in the C++ core.
+A measurement set is a dict of numpy arrays, the rows of the contract's measurement CSV (``pose``,
+``q_deg``, ``xyz``, ``target``, ``payload_kg``, ``line``, ``source``; optional ``temperature_c``, ``dir``,
+``abc``, ``time_s``, ``config``/``setup`` int64 codes with ``config_names``/``setup_names``). The
+heavy work (residuals, analytic Jacobian, Ceres) runs in the C++ core.
 """
 
 from __future__ import annotations
@@ -19,6 +18,7 @@ import numpy as np
 from . import _core, grouping
 from ._core import Robot
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
+from .setups import _refit_placements, validate  # noqa: F401  (kincal.identify.validate, as before)
 
 #: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
 DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
@@ -206,43 +206,6 @@ def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float
     return o
 
 
-def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
-    """Choose ``poses`` of the candidate campaign's poses that maximise observability: greedy
-    D-optimal design on the nominal model's identification Jacobian (unit-scaled columns of the
-    parameters a generic campaign identifies), each step adding the pose that most increases
-    log det of the information matrix. Returns the chosen rows."""
-    n_targets = int(np.max(candidates["target"])) + 1
-    res = _core.identify(robot, candidates, _core.IdentifyOptions(compliance=compliance, loss="none", max_iterations=0,
-                                                                  covariance=False))
-    free = ~np.asarray(res.fixed)
-    pm = _core.PointModel(robot, n_targets)
-    _, J = pm.residuals(list(res.x), candidates, True)
-    J = np.asarray(J)[:, free]
-    J = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
-    ids = np.unique(candidates["pose"])
-    if poses >= len(ids):
-        return candidates
-    rows_of = {int(i): np.repeat(np.flatnonzero(candidates["pose"] == i) * 3, 3) + np.tile([0, 1, 2],
-               int(np.sum(candidates["pose"] == i))) for i in ids}
-    p = J.shape[1]
-    info = 1e-6 * np.eye(p)
-    chosen: list[int] = []
-    left = [int(i) for i in ids]
-    for _ in range(poses):
-        inv = np.linalg.inv(info)
-        best, gain = left[0], -np.inf
-        for i in left:
-            Ji = J[rows_of[i]]
-            # log det(I + Ji inv Ji^T): the information this pose adds
-            g = np.linalg.slogdet(np.eye(len(Ji)) + Ji @ inv @ Ji.T)[1]
-            if g > gain:
-                best, gain = i, g
-        chosen.append(best)
-        left.remove(best)
-        info += J[rows_of[best]].T @ J[rows_of[best]]
-    return subset(candidates, np.isin(candidates["pose"], chosen))
-
-
 def read_measurements(path: str, robot: Robot) -> dict:
     """The measurement CSV of the contract (errors name file:line and cause)."""
     return _core.read_measurements(str(path), robot.dof)
@@ -258,14 +221,12 @@ def subset(data: dict, mask: np.ndarray) -> dict:
 
 
 def split_poses(data: dict, holdout: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Boolean row masks (fit, held out): a random share ``holdout`` of the configurations is held
-    out whole (grouping.split: repeats of one configuration never sit on both sides)."""
+    """Row masks (fit, held out): a share of the configurations held out whole (grouping.split)."""
     return grouping.split(data, holdout, seed)
 
 
 def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
-    """k boolean masks of held-out rows, whole configurations dealt at random into k folds
-    (grouping.folds)."""
+    """k masks of held-out rows, whole configurations per fold (grouping.folds)."""
     return grouping.folds(data, k, seed)
 
 
@@ -413,12 +374,26 @@ def _cross_validated_errors(robot: Robot, data: dict, opts, held_masks,
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
+def _setup_errors(robot: Robot, data: dict, opts, held_masks, loss: str, loss_scale_mm: float,
+                  progress: Optional[Callable[[int, int], None]]) -> dict:
+    """Errors of every setup held out whole: the model fitted on the other setups, the held one's
+    placement and targets refitted on its rows (validate()'s refit)."""
+    parts = []
+    for i, held in enumerate(held_masks):
+        if progress:
+            progress(i, len(held_masks))
+        r = _fit(robot, subset(data, ~held), opts)
+        ea, eb, oa, ob, _ = _refit_placements(r.robot, subset(data, held), loss, loss_scale_mm)
+        parts.append(dict(ea=ea, eb=eb, **({"oa": oa, "ob": ob} if oa is not None else {})))
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
 def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: str = "huber",
              loss_scale_mm: float = 0.1, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
              fold_progress: Optional[Callable[[int, int], None]] = None,
-             penalties: Sequence = ()) -> Identification:
+             penalties: Sequence = (), hold_out_setups: bool = False) -> Identification:
     """Identify the robot's parameters from measurements.
 
     ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
@@ -429,7 +404,10 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     cross-validation (whole configurations per fold; 0: no validation). With ``holdout`` (a share in
     (0, 1)) a random share of the configurations is held out instead, and the model then excludes
     those rows (the validation says so). ``fold_progress(fold, folds)`` reports each validation fit.
-    ``penalties``: ridge penalties (parameter name, weight in mm per unit of the parameter)."""
+    ``penalties``: ridge penalties (parameter name, weight in mm per unit of the parameter).
+    ``hold_out_setups``: the validation holds out each setup (instrument placement) whole instead:
+    the model fitted on the other setups, the held setup's placement and targets refitted on it as
+    validate() does."""
     effects = check_effects(effects, robot, harmonics)
     check_data_for(effects, data, robot)
     if loss not in ("none", "huber", "cauchy"):
@@ -444,7 +422,15 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     cv_opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
                       covariance=False, penalties=penalties)
     every_row = np.ones(len(data["pose"]), dtype=bool)
-    if holdout is not None:
+    if hold_out_setups:
+        codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
+        if len(np.unique(codes)) < 2:
+            raise ValueError("holding out whole setups needs a setup column with at least two setups")
+        fit_mask, masks = every_row, [codes == c for c in np.unique(codes)]
+        val = {"scheme": f"each of the {len(masks)} setups held out whole (its placement and targets refitted)",
+               "grouping": "setup column", "configurations": int(grouping.configurations(data).count),
+               "held_rows": int(len(codes)), "model_rows": "every row (validated by holding out setups)"}
+    elif holdout is not None:
         fit_mask, held = split_poses(data, holdout, seed)
         val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()),
                    model_rows="the fitted rows only: the model excludes the held-out rows")
@@ -457,7 +443,10 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
         fit_mask, masks = every_row, []
         val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
     # folds: each predicted by a model fitted without it; a split: by the delivered model itself
-    e = _cross_validated_errors(robot, data, cv_opts, masks, fold_progress) if masks and holdout is None else {}
+    if hold_out_setups:
+        e = _setup_errors(robot, data, cv_opts, masks, loss, loss_scale_mm, fold_progress)
+    else:
+        e = _cross_validated_errors(robot, data, cv_opts, masks, fold_progress) if masks and holdout is None else {}
     r = _fit(robot, subset(data, fit_mask), opts, progress)
     if holdout is not None and val["held_rows"]:
         e = _errors(r, subset(data, ~fit_mask))
@@ -468,40 +457,6 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     val["fit_rows"] = int(fit_mask.sum())
     return Identification(robot=r.robot, targets=np.asarray(r.targets), fit=r, effects=list(effects),
                           validation=val)
-
-
-def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
-    """Accuracy of an identified robot on another measurement campaign, where the instrument stands
-    elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
-    differently: only the placements and the target offsets are refitted, on the calibrated
-    geometry (every effect it carries acting, its drift left out: that was the other campaign's)
-    and, for the "before", on the nominal one. Returns the contract's figures (``points``,
-    ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm``; with measured orientations ``rms_deg``,
-    ``mean_deg``), ``before_mean_mm``, ``before_max_mm``, per setup the same under ``setups`` and
-    the refitted ``placements``; ``rows``, ``after_rms_mm``, ``after_max_mm`` repeat them under the
-    names of earlier versions."""
-    if loss not in ("none", "huber", "cauchy"):
-        raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
-    def frames_only(calibrated: bool) -> "_core.IdentifyResult":
-        # the calibrated geometry may load a joint the nominal one does not: each its own names
-        layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, calibrated, []).layout
-        held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
-        opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
-                                     covariance=False)
-        return _core.identify(robot, data, opts, None, calibrated)
-
-    cal, nom = frames_only(True), frames_only(False)
-    ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data))
-    eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data))
-    oa = ob = None
-    if "abc" in data:
-        oa, ob = orientation_errors_deg(cal.robot, data), orientation_errors_deg(nom.robot, data)
-
-    v = validation_figures(ea, eb, oa, ob, data)
-    v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
-             refitted="the instrument placement of every setup and the target offsets; the model's geometry and "
-                      "effects held (its drift left out)", placements=setup_frames(cal.setups))
-    return v
 
 
 def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:

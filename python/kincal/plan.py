@@ -285,3 +285,40 @@ def plan(robot: Robot, k: int, *, targets: np.ndarray, effects: Sequence = ("joi
                 units=[p.unit for p in free_params], left_out=left, tcp_uncertainty_mm=tcp, o1=o1,
                 condition_number=float(s[0] / s[-1]) if m and s[-1] > 0 else math.inf,
                 min_singular_value=float(s[-1]) if m else 0.0, candidates=int(len(q)), rejected=rejected)
+
+
+def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
+    """Choose ``poses`` of the candidate campaign's poses that maximise observability: greedy
+    D-optimal design on the nominal model's identification Jacobian (unit-scaled columns of the
+    parameters a generic campaign identifies), each step adding the pose that most increases
+    log det of the information matrix. Returns the chosen rows."""
+    n_targets = int(np.max(candidates["target"])) + 1
+    res = _core.identify(robot, candidates, _core.IdentifyOptions(compliance=compliance, loss="none", max_iterations=0,
+                                                                  covariance=False))
+    free = ~np.asarray(res.fixed)
+    pm = _core.PointModel(robot, n_targets)
+    _, J = pm.residuals(list(res.x), candidates, True)
+    J = np.asarray(J)[:, free]
+    J = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
+    ids = np.unique(candidates["pose"])
+    if poses >= len(ids):
+        return candidates
+    rows_of = {int(i): np.repeat(np.flatnonzero(candidates["pose"] == i) * 3, 3) + np.tile([0, 1, 2],
+               int(np.sum(candidates["pose"] == i))) for i in ids}
+    p = J.shape[1]
+    info = 1e-6 * np.eye(p)
+    chosen: list[int] = []
+    left = [int(i) for i in ids]
+    for _ in range(poses):
+        inv = np.linalg.inv(info)
+        best, gain = left[0], -np.inf
+        for i in left:
+            Ji = J[rows_of[i]]
+            # log det(I + Ji inv Ji^T): the information this pose adds
+            g = np.linalg.slogdet(np.eye(len(Ji)) + Ji @ inv @ Ji.T)[1]
+            if g > gain:
+                best, gain = i, g
+        chosen.append(best)
+        left.remove(best)
+        info += J[rows_of[best]].T @ J[rows_of[best]]
+    return ident.subset(candidates, np.isin(candidates["pose"], chosen))

@@ -139,3 +139,46 @@ def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[
         codes = np.asarray(data["setup"])
         v["setups"] = {name: figures(codes == k) for k, name in enumerate(data["setup_names"]) if np.any(codes == k)}
     return v
+
+
+def _refit_placements(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1):
+    """validate()'s errors: every row's position error after refitting only the placements and
+    targets, on the calibrated model (after) and the nominal one (before); orientation errors (or
+    None); and the calibrated refit."""
+    from .identify import orientation_errors_deg
+
+    def frames_only(calibrated: bool) -> "_core.IdentifyResult":
+        # the calibrated geometry may load a joint the nominal one does not: each its own names
+        layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, calibrated, []).layout
+        held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
+        opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
+                                     covariance=False)
+        return _core.identify(robot, data, opts, None, calibrated)
+
+    cal, nom = frames_only(True), frames_only(False)
+    ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data))
+    eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data))
+    oa = ob = None
+    if "abc" in data:
+        oa, ob = orientation_errors_deg(cal.robot, data), orientation_errors_deg(nom.robot, data)
+    return ea, eb, oa, ob, cal
+
+
+def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
+    """Accuracy of an identified robot on another measurement campaign, where the instrument stands
+    elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
+    differently: only the placements and the target offsets are refitted, on the calibrated
+    geometry (every effect it carries acting, its drift left out: that was the other campaign's)
+    and, for the "before", on the nominal one. Returns the contract's figures (``points``,
+    ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm``; with measured orientations ``rms_deg``,
+    ``mean_deg``), ``before_mean_mm``, ``before_max_mm``, per setup the same under ``setups`` and
+    the refitted ``placements``; ``rows``, ``after_rms_mm``, ``after_max_mm`` repeat them under the
+    names of earlier versions."""
+    if loss not in ("none", "huber", "cauchy"):
+        raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
+    ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm)
+    v = validation_figures(ea, eb, oa, ob, data)
+    v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
+             refitted="the instrument placement of every setup and the target offsets; the model's geometry and "
+                      "effects held (its drift left out)", placements=setup_frames(cal.setups))
+    return v

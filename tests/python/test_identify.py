@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import _core
+from kincal import _core, plan
 from kincal import identify as ident
 from kincal.urdf import spec_urdf
 
@@ -166,7 +166,7 @@ def test_observability_selection_beats_random_poses():
     truth = ident.default_truth(robot, seed=3)
     held = ident.simulate(truth, 200, seed=99, targets=3)
     rand = ident.simulate(truth, 30, seed=5, targets=3)
-    chosen = ident.select_observable(robot, ident.simulate(truth, 300, seed=5, targets=3), 30)
+    chosen = plan.select_observable(robot, ident.simulate(truth, 300, seed=5, targets=3), 30)
     assert len(np.unique(chosen["pose"])) == 30
     out = {}
     for name, d in (("random", rand), ("chosen", chosen)):

@@ -137,7 +137,7 @@ def cmd_identify(args) -> None:
     res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
                          holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
                          progress=_progress("identify"), orientation_weight=args.orientation_weight,
-                         fold_progress=_fold_progress())
+                         fold_progress=_fold_progress(), hold_out_setups=args.hold_out_setups)
     if sys.stderr.isatty():
         print(file=sys.stderr)
     if args.tool_targets:
@@ -433,6 +433,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--folds", type=int, default=None,
                     help="k-fold cross-validation of the figures, whole configurations per fold (default 5; 0: "
                          "none); the model is fitted on every row")
+    sp.add_argument("--hold-out-setups", action="store_true", help="validate by holding out each setup (instrument "
+                    "placement) whole, its placement and targets refitted, instead of folds")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
     model_opts(sp)

@@ -94,8 +94,8 @@ def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
     """k boolean masks of held-out rows: whole configurations dealt at random into k folds."""
     cfg = configurations(data)
     if k > cfg.count:
-        raise ValueError(f"{k} folds need at least {k} configurations; the data have {cfg.count} "
-                         f"({cfg.rule})")
+        raise ValueError(f"{data.get('source', '<data>')}: {k} folds need at least {k} configurations; the data "
+                         f"have {cfg.count} ({cfg.rule})")
     perm = np.random.default_rng(seed).permutation(cfg.count)
     fold_of = np.empty(cfg.count, dtype=np.int64)
     fold_of[perm] = np.arange(cfg.count) % k

@@ -227,7 +227,8 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             s["_cand"] = c
             scored.append(s)
         scored.sort(key=lambda s: -s["cv_gain"])
-        history[-1]["candidates"] = [{k: v for k, v in s.items() if k != "_cand"} for s in scored[:LISTED]]
+        history[-1]["candidates"] = [{k: v for k, v in s.items() if k != "_cand" and not k.startswith("variant")}
+                                     for s in scored[:LISTED]]
         sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
         if not sig:
             break

@@ -183,20 +183,18 @@ class SerialProblem:
 
     def variants(self, cand, R: np.ndarray) -> Optional[list]:
         """joint_map's orders 1..K (its columns R: sine and cosine of each order, in order), each with
-        each smoothness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights);
-        transmission_error (a periodic error too) with each penalty on its orders."""
-        if cand.name not in ("joint_map", "transmission_error"):
+        each smoothness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights).
+        The library's transmission_error is fitted as it always was, without a penalty."""
+        if cand.name != "joint_map":
             return None
         s = float(np.mean(np.sum(R[:, :2] ** 2, axis=0)))
         kw = np.repeat(np.asarray(cand.harmonics, dtype=float), 2)
-        if cand.name == "transmission_error":
-            return [(cand, R.shape[1], np.sqrt(lam * s) * kw) for lam in MAP_SMOOTHING]
         return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * kw[:2 * k])
                 for k in range(1, cand.order + 1) for lam in MAP_SMOOTHING]
 
     def variant_folds(self, cand) -> list:
-        """joint_map's order and smoothing (transmission_error's smoothing) are chosen holding out, in
-        turn, each of VARIANT_BLOCKS contiguous ranges of the joint's angle (equal numbers of points):
+        """joint_map's order and smoothing are chosen holding out, in turn, each of VARIANT_BLOCKS
+        contiguous ranges of the joint's angle (equal numbers of points):
         a map must predict angles it has not seen, as it will on the next campaign."""
         q = np.asarray(self.data["q_deg"], dtype=float)[:, cand.joint - 1]
         edges = np.quantile(q, np.linspace(0.0, 1.0, VARIANT_BLOCKS + 1))
@@ -204,12 +202,13 @@ class SerialProblem:
         return [block == b for b in range(VARIANT_BLOCKS)]
 
     def variant_evidence(self, cand, i: int, gains: Sequence[float]) -> dict:
-        """A periodic step's evidence: the smoothing chosen; for joint_map its order and the best gain of
-        each order 1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
+        """A joint_map step's evidence: the order and smoothing chosen, and the best gain of each order
+        1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
         g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
-        out = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
+        out: dict = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
         if cand.name == "joint_map":
-            out.update(order=cand.order, order_range_cv_gain=[round(float(x), 6) for x in g.max(axis=1)])
+            out["order"] = cand.order
+            out["order_range_cv_gain"] = [round(float(x), 6) for x in g.max(axis=1)]
         return out
 
     def chosen(self, cand, ridge: np.ndarray) -> None:

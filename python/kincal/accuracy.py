@@ -326,9 +326,8 @@ def axis_statistics(data: dict, unit: str = "mm") -> dict:
                 raise ValueError(f"{src}:{data['line'][j[0]]}: target {tgt:g} direction {d:+d} has one run only: "
                                  "repeatability needs at least 2 runs (ISO 230-2 asks for 5)")
             side[d] = (float(dev[j].mean()), float(np.std(dev[j], ddof=1)), len(j))
-        (mu, su, nu), (md, sd, nd) = side[1], side[-1]
-        per.append({"target": float(tgt), "n_up": nu, "n_down": nd, "mean_up": mu, "mean_down": md, "s_up": su,
-                    "s_down": sd})
+        per.append({"target": float(tgt), "n_up": side[1][2], "n_down": side[-1][2], "mean_up": side[1][0],
+                    "mean_down": side[-1][0], "s_up": side[1][1], "s_down": side[-1][1]})
     mu, md = np.array([p["mean_up"] for p in per]), np.array([p["mean_down"] for p in per])
     su, sd = np.array([p["s_up"] for p in per]), np.array([p["s_down"] for p in per])
     b_i = mu - md
@@ -350,12 +349,13 @@ def axis_statistics(data: dict, unit: str = "mm") -> dict:
     ps_j = 6.0 * (su + sd) / 2.0
     half = (u_j + ps_j) / 2.0
     travel = float(data["target"].max() - data["target"].min())
-    vdi = {"P": float((mean_i + half).max() - (mean_i - half).min()), "Pa": float(mean_i.max() - mean_i.min()),
+    p_unc = float((mean_i + half).max() - (mean_i - half).min())
+    vdi: dict = {"P": p_unc, "Pa": float(mean_i.max() - mean_i.min()),
            "Ps": float(ps_j.max()), "U": float(u_j.max()), "Ps_mean": float(ps_j.mean()), "U_mean": float(u_j.mean()),
            "travel": travel,
            "targets": [{"target": p["target"], "mean": float(mean_i[k]), "U_j": float(u_j[k]), "Ps_j": float(ps_j[k]),
                         "s_j": float((su[k] + sd[k]) / 2.0)} for k, p in enumerate(per)]}
     if unit == "mm" and travel > 0:
-        vdi["P_per_m"] = vdi["P"] / (travel / 1000.0)
-        vdi["Ps_per_m"] = vdi["Ps"] / (travel / 1000.0)
+        vdi["P_per_m"] = p_unc / (travel / 1000.0)
+        vdi["Ps_per_m"] = float(ps_j.max()) / (travel / 1000.0)
     return {"unit": unit, "targets": len(per), "iso230_2": iso, "vdi3441": vdi}

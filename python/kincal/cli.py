@@ -262,14 +262,8 @@ def cmd_accuracy_iso9283(args) -> None:
 def cmd_accuracy_plan(args) -> None:
     from . import iso9283_plan as iso
 
-    res = iso.plan(_robot(args), cube=args.cube, orientation=args.orientation, z_min=args.z_min, cycles=args.cycles)
-    _core.write_file_atomic(args.out, format_rows(["x", "y", "z", "a", "b", "c", "point", "cycle"], res["rows"]))
-    c, a = res["centre_mm"], res["abc_deg"]
-    print(f"cube: edge {res['edge_mm']:.1f} mm (largest that fits: {res['largest_edge_mm']:.1f} mm), centre "
-          f"{c[0]:.1f}, {c[1]:.1f}, {c[2]:.1f} mm, orientation a,b,c {a[0]:g}, {a[1]:g}, {a[2]:g} deg")
-    for name, p in res["poses"].items():
-        print(f"{name}: " + ", ".join(f"{v:.3f}" for v in p))
-    print(f"{args.out}: {len(res['rows'])} poses, {args.cycles} cycles P1 -> P5 -> P4 -> P3 -> P2 -> P1")
+    print(iso.write_plan(_robot(args), args.out, cube=args.cube, orientation=args.orientation, z_min=args.z_min,
+                         cycles=args.cycles))
 
 
 def cmd_accuracy_axis(args) -> None:

@@ -19,11 +19,12 @@ position."""
 from __future__ import annotations
 
 import itertools
-from typing import Optional, Sequence
+from typing import Optional, Sequence, Union
 
 import numpy as np
 
 from . import _core, fk
+from .csv_text import format_rows
 
 VOXELS = 48          # voxels along the largest extent of the robot's reach
 SEARCH_LATTICE = 7   # lattice points per edge while searching
@@ -35,7 +36,7 @@ CORNERS = {"P2": (1, 1, 1), "P3": (-1, 1, 1), "P4": (-1, -1, -1), "P5": (1, -1, 
 class Reach:
     """Reachability of tool positions at one orientation within the joint limits (closed-form IK)."""
 
-    def __init__(self, robot: _core.Robot, abc: Sequence[float], z_min: Optional[float] = None):
+    def __init__(self, robot: _core.Robot, abc: Union[np.ndarray, Sequence[float]], z_min: Optional[float] = None):
         if not robot.closed_form_ik:
             raise ValueError(f"{robot.name}: plan-iso9283 needs the closed-form IK, which this robot has not "
                              f"({robot.ik_reason})")
@@ -89,9 +90,9 @@ def _voxel_cube(reach: Reach, seed: int) -> tuple:
                          f"a,b,c = {', '.join(f'{v:g}' for v in reach.abc)}")
 
     def corners(s: int) -> np.ndarray:  # low corners of fully reachable s x s x s blocks
-        m = occ
+        m: np.ndarray = occ
         for ax in range(3):
-            m = np.lib.stride_tricks.sliding_window_view(m, s, axis=ax).all(axis=-1)
+            m = np.asarray(np.lib.stride_tricks.sliding_window_view(m, s, axis=ax).all(axis=-1))
         return m
 
     best, top = 1, min(occ.shape)
@@ -154,12 +155,12 @@ def largest_cube(reach: Reach, seed: int = 0) -> tuple:
     top = max(e for _, e in found)
     # the workspace of a robot is nearly symmetric about its first axis: of the cubes within 1% of
     # the largest, the one nearest the tool's home position (in front of the robot)
-    home = fk(reach.robot, [reach.ref])[0, :3]
+    home = fk(reach.robot, reach.ref[None, :])[0, :3]
     c, e = min((f for f in found if f[1] >= 0.99 * top), key=lambda f: float(np.linalg.norm(f[0] - home)))
     return c, _largest_edge(reach, c, e, FINAL_LATTICE)
 
 
-def iso_poses(centre: np.ndarray, edge: float, abc: Sequence[float]) -> dict:
+def iso_poses(centre: np.ndarray, edge: float, abc: np.ndarray) -> dict:
     """P1..P5 (x,y,z,a,b,c) of the cube of ``edge`` centred at ``centre``."""
     out = {"P1": np.r_[centre, abc]}
     for name, s in CORNERS.items():
@@ -210,3 +211,17 @@ def plan(robot: _core.Robot, cube: Optional[float] = None, orientation: Optional
     poses = iso_poses(centre, edge, abc)
     return {"centre_mm": centre, "edge_mm": edge, "largest_edge_mm": largest, "abc_deg": abc, "poses": poses,
             "rows": program_rows(poses, cycles)}
+
+
+def write_plan(robot: _core.Robot, out: str, **options) -> str:
+    """`kincal accuracy plan-iso9283`: the program written to ``out`` (x,y,z,a,b,c, point, cycle);
+    returns the summary (the cube and P1..P5)."""
+    res = plan(robot, **options)
+    _core.write_file_atomic(out, format_rows(["x", "y", "z", "a", "b", "c", "point", "cycle"], res["rows"]))
+    c, a = res["centre_mm"], res["abc_deg"]
+    lines = [f"cube: edge {res['edge_mm']:.1f} mm (largest that fits: {res['largest_edge_mm']:.1f} mm), centre "
+             f"{c[0]:.1f}, {c[1]:.1f}, {c[2]:.1f} mm, orientation a,b,c {a[0]:g}, {a[1]:g}, {a[2]:g} deg"]
+    lines += [f"{name}: " + ", ".join(f"{v:.3f}" for v in p) for name, p in res["poses"].items()]
+    cycles = options.get("cycles", 30)
+    lines.append(f"{out}: {len(res['rows'])} poses, {cycles} cycles P1 -> P5 -> P4 -> P3 -> P2 -> P1")
+    return "\n".join(lines)

@@ -93,13 +93,15 @@ def _deviation_figure(runs: dict, res: dict) -> bytes:
             ax.set_title(f"{p['point']}: x-{plane}", fontsize=9)
             if k % ncol == 0:
                 ax.set_ylabel(f"d{plane} (mm)", fontsize=8)
-            if row == 1:
+            if row == 1:  # every x-z panel shows its dx scale (the last block may be short)
                 ax.set_xlabel("dx (mm)", fontsize=8)
+                ax.tick_params(labelbottom=True)
     for k in range(len(pts), nblock * ncol):
         for row in range(2):
             axes[2 * (k // ncol) + row, k % ncol].set_visible(False)
     handles, names = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="outside lower center", ncol=min(len(names), 4), fontsize=8, frameon=False,
+    fig.legend(handles, names, loc="outside lower center", ncol=min(len(names), {1: 1, 2: 2}.get(ncol, 4)), fontsize=8,
+               frameon=False,
                markerscale=1.5)
     return _png(fig)
 
@@ -109,7 +111,7 @@ def _summary_figure(res: dict) -> bytes:
     plt = _plt()
     pts = res["points"]
     x = np.arange(len(pts))
-    fig, ax = plt.subplots(figsize=(1.2 + 0.9 * len(pts), 3.2), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(max(4.5, 1.2 + 0.9 * len(pts)), 3.2), constrained_layout=True)
     ap = [p["AP_P_mm"] for p in pts]
     rp = [p["RP_l_mm"] for p in pts]
     ax.bar(x - 0.2, ap, 0.4, label="AP_P", color="tab:blue")
@@ -130,7 +132,7 @@ def iso9283_html(runs: dict, res: dict, title: str) -> str:
     rows = [[p["point"], p["n"], _f(p["AP_P_mm"]), _f(p["AP_x_mm"]), _f(p["AP_y_mm"]), _f(p["AP_z_mm"]),
              _f(p["RP_l_mm"])] + ([_f(p.get("vAP_P_mm"))] if has_v else []) for p in pts]
     body = [f"<h1>{esc(title)}</h1>",
-            f"<p>{len(runs['point'])} measured poses of {len(pts)} points, frame: {esc(res['frame'])}. "
+            f"<p>{len(runs['point'])} measured poses of {len(pts)} point{'s' if len(pts) > 1 else ''}, frame: {esc(res['frame'])}. "
             "Formulas of ISO 9283:1998 (7.2 pose accuracy and repeatability, 7.3 multi-directional variation, "
             "7.4 distance accuracy and repeatability); standard deviations with n - 1.</p>",
             "<h2>Position (mm)</h2>", report.table(head, rows, numeric=True)]
@@ -211,6 +213,8 @@ def _axis_figure(data: dict, res: dict) -> bytes:
         s = np.array([p[sk] for p in iso["targets"]])
         a1.plot(tg, m, "-o", color=col, ms=3, lw=1.2, label=f"mean {name}")
         a1.fill_between(tg, m - 2 * s, m + 2 * s, color=col, alpha=0.2, lw=0, label=f"mean +- 2 s, {name}")
+        if len(tg) == 1:  # one target: the band as a bar
+            a1.vlines(tg, m - 2 * s, m + 2 * s, color=col, alpha=0.3, lw=8)
     a1.set_ylabel(f"deviation ({unit})")
     a1.set_title(f"ISO 230-2: A = {iso['A']:.4g}, E = {iso['E']:.4g}, R = {iso['R']:.4g}, B = {iso['B']:.4g} {unit}",
                  fontsize=10)
@@ -218,6 +222,8 @@ def _axis_figure(data: dict, res: dict) -> bytes:
     mean = np.array([p["mean"] for p in vdi["targets"]])
     half = np.array([(p["U_j"] + p["Ps_j"]) / 2 for p in vdi["targets"]])
     a2.fill_between(tg, mean - half, mean + half, color="tab:green", alpha=0.25, lw=0, label="mean +- (U_j + Ps_j) / 2")
+    if len(tg) == 1:
+        a2.vlines(tg, mean - half, mean + half, color="tab:green", alpha=0.3, lw=8)
     a2.plot(tg, mean, "-o", color="tab:green", ms=3, lw=1.2, label="mean position deviation")
     top, bottom = float((mean + half).max()), float((mean - half).min())
     a2.axhline(top, color="k", ls=":", lw=0.8)

@@ -173,3 +173,23 @@ def test_bad_plan(tmp_path, args, message):
     assert r.returncode == 1
     assert re.search(message, r.stderr), r.stderr
     assert not (tmp_path / "p.csv").exists()
+
+
+def test_orientation_floor_and_cycles(tmp_path):
+    """The URDF arm with its tool pointing down (--orientation 0,180,0), the cube kept above z = 300 mm
+    (--z-min) and 2 cycles: every pose has that orientation, the cube's bottom face is at or above
+    300 mm and within 5% of the edge of it (the floor is what limits it), its lattice is reachable,
+    and the program has 1 + 2 x 5 rows."""
+    (tmp_path / "arm6.urdf").write_text(ARM6)
+    robot = kincal.load_robot(str(tmp_path / "arm6.urdf"))
+    r = run("kincal", "accuracy", "plan-iso9283", "--robot", str(tmp_path / "arm6.urdf"), "--orientation", "0,180,0",
+            "--z-min", "300", "--cycles", "2", "--out", str(tmp_path / "p.csv"))
+    assert r.returncode == 0, r.stderr
+    poses, points, cycles = _read_program(tmp_path / "p.csv")
+    assert len(poses) == 11 and cycles == [0] + [1] * 5 + [2] * 5 and points[1:6] == ["P5", "P4", "P3", "P2", "P1"]
+    assert np.allclose(poses[:, 3:], [0, 180, 0])
+    centre = poses[0, :3]
+    edge = (poses[points.index("P2"), 0] - poses[points.index("P3"), 0]) / 0.8
+    bottom = centre[2] - edge / 2
+    assert 300.0 - 1e-9 <= bottom < 300.0 + 0.05 * edge
+    assert _fits(robot, centre, edge, poses[0, 3:], 11, check=_reachable)

@@ -320,6 +320,26 @@ def cmd_demo(args) -> None:
     print(f"report: {out / 'report.html'}", file=sys.stderr)
 
 
+def cmd_accuracy_iso9283(args) -> None:
+    from . import accuracy_report as rep
+
+    res = rep.run_iso9283(args.data, args.out, distance=args.distance, model=args.model, frame=args.frame)
+    print(rep.iso9283_summary(res, args.out))
+
+
+def cmd_accuracy_plan(args) -> None:
+    from . import iso9283_plan as iso
+
+    print(iso.write_plan(_robot(args), args.out, cube=args.cube, orientation=args.orientation, z_min=args.z_min,
+                         cycles=args.cycles))
+
+
+def cmd_accuracy_axis(args) -> None:
+    from . import accuracy_report as rep
+
+    print(rep.axis_summary(rep.run_axis(args.data, args.out, args.unit), args.out))
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="kincal", description="Calibration and compensation of industrial robots")
     sub = p.add_subparsers(dest="command", required=True)
@@ -536,6 +556,34 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--identify-poses", type=int, default=1000, help="poses of the identification benchmark")
     sp.add_argument("--no-identify", action="store_true", help="skip the identification benchmark")
     sp.set_defaults(func=cmd_bench)
+
+    acc = sub.add_parser("accuracy", help="standard accuracy reports: ISO 9283, ISO 230-2, VDI/DGQ 3441")
+    asub = acc.add_subparsers(dest="accuracy_command", required=True)
+    sp = asub.add_parser("iso9283", help="ISO 9283 pose accuracy and repeatability from measured runs")
+    sp.add_argument("--data", required=True, help="RUNS.csv: point,cycle,xc,yc,zc[,ac,bc,cc],x,y,z[,a,b,c][,direction] "
+                                                  "(mm, deg)")
+    sp.add_argument("--out", required=True, help="folder for iso9283.json, report.html and the figures")
+    sp.add_argument("--distance", metavar="P2,P4", help="distance accuracy AD and repeatability RD between two points")
+    sp.add_argument("--model", help="identified model JSON whose instrument placement maps the attained points "
+                                    "(with --frame instrument)")
+    sp.add_argument("--frame", choices=["base", "instrument"], default="base",
+                    help="frame of the attained x,y,z[,a,b,c]: the commanded poses' (base, default) or the "
+                         "instrument's (mapped to the base with --model)")
+    sp.set_defaults(func=cmd_accuracy_iso9283)
+    sp = asub.add_parser("plan-iso9283", help="the ISO 9283 test poses P1..P5 and their 30-cycle pose program")
+    robot_opts(sp)
+    sp.add_argument("--cube", type=float, metavar="MM", help="the cube's edge (default: the largest that fits)")
+    sp.add_argument("--orientation", metavar="A,B,C", help="the tool's orientation at every pose (deg; default: "
+                                                           "its orientation at the robot's home pose)")
+    sp.add_argument("--z-min", type=float, metavar="MM", help="keep the cube above this height (e.g. the floor)")
+    sp.add_argument("--cycles", type=int, default=30, help="cycles of the program (default 30, as ISO 9283)")
+    sp.add_argument("--out", required=True, help="pose program CSV x,y,z,a,b,c (with point and cycle columns)")
+    sp.set_defaults(func=cmd_accuracy_plan)
+    sp = asub.add_parser("axis", help="ISO 230-2 and VDI/DGQ 3441 positioning statistics of one axis")
+    sp.add_argument("--data", required=True, help="AXIS.csv: target,direction,run,measured (one unit throughout)")
+    sp.add_argument("--unit", choices=["mm", "deg"], default="mm", help="the file's unit (default mm)")
+    sp.add_argument("--out", required=True, help="folder for axis.json, report.html and the figure")
+    sp.set_defaults(func=cmd_accuracy_axis)
 
     sp = sub.add_parser("demo", help="the whole pipeline on the built-in example")
     sp.add_argument("--out", default="kincal-demo", help="output folder")

@@ -56,7 +56,7 @@ def robot_for_setup(robot: Robot, name: str, source: str = "the model") -> Robot
     known = [n for n, _, _ in robot.placements]
     for n, xyz, abc in robot.placements:
         if n == name:
-            return robot.with_placements([(n, xyz, abc)])
+            return robot.with_placements([(n, [float(v) for v in xyz], [float(v) for v in abc])])
     have = ", ".join(known) if known != [""] else "none: it was identified from one placement"
     raise ValueError(f"{source}: no setup '{name}' (setups: {have})")
 

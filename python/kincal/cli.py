@@ -84,16 +84,6 @@ def _progress(label: str):
     return report
 
 
-def _fold_progress():
-    """A one-line report of the cross-validation's fits on stderr (quiet when not a terminal)."""
-    if not sys.stderr.isatty():
-        return None
-
-    def report(fold: int, folds: int) -> None:
-        print(f"\rcross-validation: fold {fold + 1} of {folds}   ", end="", file=sys.stderr, flush=True)
-    return report
-
-
 def _harmonics(text: str) -> list:
     """--harmonics 1,2,3: transmission_error's harmonic orders."""
     try:
@@ -137,7 +127,7 @@ def cmd_identify(args) -> None:
     res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
                          holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
                          progress=_progress("identify"), orientation_weight=args.orientation_weight,
-                         fold_progress=_fold_progress(), hold_out_setups=args.hold_out_setups)
+                         fold_progress=campaign._step_progress("cross-validation, fold"), hold_out_setups=args.hold_out_setups)
     if sys.stderr.isatty():
         print(file=sys.stderr)
     if args.tool_targets:

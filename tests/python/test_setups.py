@@ -113,7 +113,6 @@ def test_validate_command_on_a_moved_instrument(tmp_path, kr500, truth):
     its placement unknown): the calibration's RMS within 15% of the truth's own (the truth model
     validated the same way, which is the noise), far below the nominal model's (before_rms_mm);
     V.json has the contract's keys; the table is printed; bad input leaves no V.json."""
-    ident.simulate  # noqa: B018 (the campaigns below use the CLI's own simulation path)
     fit = ident.simulate(truth, 150, seed=21, targets=3)
     (tmp_path / "fit.csv").write_text(ident.measurements_csv(fit, 6))
     r = run("kincal", "identify", "--robot", "kr500", "--data", str(tmp_path / "fit.csv"), "--out",

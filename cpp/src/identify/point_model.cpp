@@ -242,6 +242,35 @@ const PointModel::Flange* PointModel::cached_flange(const Measurement& m) const 
   return i < flange_.size() ? &flange_[i] : nullptr;
 }
 
+const PointModel::Placement& PointModel::placement(const Measurement& m) const {
+  if (m.setup < 0 || m.setup >= layout_.n_setups)
+    throw InputError("a row of setup code " + std::to_string(m.setup) + " but the layout has " +
+                     std::to_string(layout_.n_setups) + " setup(s)");
+  return place_[static_cast<size_t>(m.setup)];
+}
+
+void PointModel::drifted(const Measurement& m, const Placement& pl, Mat3& rb, Vec3& tb, double& tau, Vec3& dw) const {
+  if (std::isnan(m.time_s)) throw InputError("drift needs the time_s column");
+  tau = (m.time_s - layout_.t_mean) / 3600.0;
+  const double* d = &x_[layout_.drift];
+  dw = tau * Vec3(d[3], d[4], d[5]);
+  rb = so3::exp(dw) * pl.r;
+  tb = pl.t + tau * Vec3(d[0], d[1], d[2]);
+}
+
+void PointModel::drift_columns(double tau, const Vec3& dw, const Vec3& rx, double* jac, double* jac_rot) const {
+  // y = Exp(tau w) R x + t + tau v: Exp(a + d) = Exp(Jl(a) d) Exp(a), Jl(a) = Jr(-a)
+  const int P = layout_.size;
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  const Mat3 jl = so3::right_jacobian(-dw);
+  J.block<3, 3>(0, layout_.drift) = tau * Mat3::Identity();
+  J.block<3, 3>(0, layout_.drift + 3) = -tau * so3::skew(rx) * jl;
+  if (jac_rot) {
+    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot, 3, P);
+    W.block<3, 3>(0, layout_.drift + 3) = tau * jl;
+  }
+}
+
 Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
   const Model& model = model_for(m.payload_kg);
   const int n = layout_.dof;
@@ -263,27 +292,16 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   const Mat3& rn = gr[n];
   const Vec3 xr = rn * x0 + gt[n];  // the point of the unscaled robot
   const Vec3 x = scale * xr;
-  // the row's placement: its setup's frame, moved by the drift at the row's time
-  if (m.setup < 0 || m.setup >= layout_.n_setups)
-    throw InputError("a row of setup code " + std::to_string(m.setup) + " but the layout has " +
-                     std::to_string(layout_.n_setups) + " setup(s)");
-  const Placement& pl = place_[static_cast<size_t>(m.setup)];
+  // the row's placement: its setup's frame, moved by the drift at the row's time (local copies: the
+  // compiler then knows that no Jacobian store changes them)
+  const Placement& pl = placement(m);
+  Mat3 rb = pl.r;
+  Vec3 tb = pl.t;
+  const Mat3 jrb = pl.jr;
   const bool drift = layout_.drift >= 0;
   double tau = 0;
   Vec3 dw = Vec3::Zero();  // the drift's rotation vector at the row's time
-  Mat3 rb_drift;
-  Vec3 tb_drift;
-  if (drift) {
-    if (std::isnan(m.time_s)) throw InputError("drift needs the time_s column");
-    tau = (m.time_s - layout_.t_mean) / 3600.0;
-    const double* d = &x_[layout_.drift];
-    dw = tau * Vec3(d[3], d[4], d[5]);
-    rb_drift = so3::exp(dw) * pl.r;
-    tb_drift = pl.t + tau * Vec3(d[0], d[1], d[2]);
-  }
-  const Mat3& rb = drift ? rb_drift : pl.r;
-  const Vec3& tb = drift ? tb_drift : pl.t;
-  const Mat3& jrb = pl.jr;
+  if (drift) drifted(m, pl, rb, tb, tau, dw);
   const int base = layout_.base + 6 * m.setup;
   const Vec3 y = rb * x + tb;
   if (rot) *rot = rb * rn * rm_;
@@ -302,13 +320,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   const Mat3 rbn = rb * rn;
   J.block<3, 3>(0, base) = Mat3::Identity();
   J.block<3, 3>(0, base + 3) = -rb * so3::skew(x) * jrb;
-  if (drift) {
-    // y = Exp(tau w) R x + t + tau v: Exp(a + d) = Exp(Jl(a) d) Exp(a), Jl(a) = Jr(-a)
-    const Mat3 jl = so3::right_jacobian(-dw);
-    J.block<3, 3>(0, layout_.drift) = tau * Mat3::Identity();
-    J.block<3, 3>(0, layout_.drift + 3) = -tau * so3::skew(rb * x) * jl;
-    if (ang) W.block<3, 3>(0, layout_.drift + 3) = tau * jl;
-  }
+  if (drift) drift_columns(tau, dw, rb * x, jac, ang ? jac_rot : nullptr);
   J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
   if (frames_only_) {
     J.block<3, 3>(0, layout_.tool + 3) = -scale * rbn * rm_ * so3::skew(tkv) * jrm_;

@@ -103,6 +103,14 @@ class PointModel {
     Vec3 t0, t;
   };
   std::vector<Placement> place_;
+  /// The row's placement (InputError for a setup code out of the layout); kept out of line with the
+  /// drift's parts, so that predict()'s common path stays as compact as with one placement.
+  [[gnu::noinline]] const Placement& placement(const Measurement& m) const;
+  /// The placement at the row's time (rb, tb), tau in hours and the drift's rotation vector dw.
+  [[gnu::noinline]] void drifted(const Measurement& m, const Placement& pl, Mat3& rb, Vec3& tb, double& tau,
+                                 Vec3& dw) const;
+  /// The drift's Jacobian columns at a row (rx: the rotated point R x).
+  [[gnu::noinline]] void drift_columns(double tau, const Vec3& dw, const Vec3& rx, double* jac, double* jac_rot) const;
   Mat3 rm_, jrm_;
   Vec3 tm_;
   std::vector<Vec3> w_, p_;

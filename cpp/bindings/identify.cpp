@@ -257,13 +257,16 @@ void define_identify(py::module_& m) {
                        const std::vector<std::string>& fix, const std::vector<int>& compliance_joints,
                        const std::vector<Effect>& effects, bool covariance, double orientation_weight,
                        double rank_tolerance, double weak_tolerance, double min_torque_share,
-                       double correlation_threshold) {
+                       double correlation_threshold, double prior_scale,
+                       const std::optional<std::vector<std::pair<std::string, double>>>& prior_sd) {
              IdentifyOptions o;
              o.compliance = compliance, o.compliance_joints = joints_from_one(compliance_joints), o.effects = effects;
              o.loss = loss, o.loss_scale_mm = loss_scale_mm, o.max_iterations = max_iterations;
              o.fix = fix, o.covariance = covariance, o.orientation_weight = orientation_weight;
              o.rank_tolerance = rank_tolerance, o.weak_tolerance = weak_tolerance;
              o.min_torque_share = min_torque_share, o.correlation_threshold = correlation_threshold;
+             o.prior_scale = prior_scale;
+             if (prior_sd) o.prior_sd = *prior_sd;
              return o;
            }),
            py::arg("compliance") = def.compliance, py::arg("loss") = def.loss,
@@ -272,10 +275,16 @@ void define_identify(py::module_& m) {
            py::arg("effects") = std::vector<Effect>{}, py::arg("covariance") = def.covariance,
            py::arg("orientation_weight") = def.orientation_weight, py::arg("rank_tolerance") = def.rank_tolerance,
            py::arg("weak_tolerance") = def.weak_tolerance, py::arg("min_torque_share") = def.min_torque_share,
-           py::arg("correlation_threshold") = def.correlation_threshold)
+           py::arg("correlation_threshold") = def.correlation_threshold, py::arg("prior_scale") = def.prior_scale,
+           py::arg("prior_sd") = py::none())
       .def_readwrite("compliance", &IdentifyOptions::compliance, "identify the joint compliances")
       .def_readwrite("loss", &IdentifyOptions::loss, "'none', 'huber' or 'cauchy'")
-      .def_readwrite("loss_scale_mm", &IdentifyOptions::loss_scale_mm, "where the robust loss bends (mm)")
+      .def_readwrite("loss_scale_mm", &IdentifyOptions::loss_scale_mm,
+                     "where the robust loss bends on a row's residual norm (mm); 0: from the data")
+      .def_readwrite("prior_sd", &IdentifyOptions::prior_sd,
+                     "prior standard deviations by kind, core units (joint_mm, joint_rad, compliance, tool_mm,\n"
+                     "tool_rad, base_mm, base_rad, target_mm, an effect's name); assign a whole list")
+      .def_readwrite("prior_scale", &IdentifyOptions::prior_scale, "times every prior standard deviation; 0: no priors")
       .def_readwrite("max_iterations", &IdentifyOptions::max_iterations, "Levenberg-Marquardt iterations at most")
       .def_readwrite("rank_tolerance", &IdentifyOptions::rank_tolerance,
                      "a unit Jacobian column closer than this to the others' span is redundant (held)")
@@ -320,6 +329,20 @@ void define_identify(py::module_& m) {
                                return a;
                              })
       .def_property_readonly("fixed_reason", [](const PyIdentifyResult& r) { return r.r.fixed_reason; })
+      .def_property_readonly("at_prior",
+                             [](const PyIdentifyResult& r) {
+                               py::array_t<bool> a(r.r.layout.size);
+                               for (int i = 0; i < r.r.layout.size; ++i)
+                                 a.mutable_at(i) = i < static_cast<int>(r.r.at_prior.size()) && r.r.at_prior[i];
+                               return a;
+                             },
+                             "free but determined by its prior, not by the data")
+      .def_property_readonly("prior_sd", [](const PyIdentifyResult& r) { return vec(r.r.prior_sd); },
+                             "each parameter's prior standard deviation (scaled; inf: no prior)")
+      .def_property_readonly("noise_mm", [](const PyIdentifyResult& r) { return r.r.noise_mm; },
+                             "the residuals' robust spread per coordinate (mm; 0: not estimated)")
+      .def_property_readonly("loss_scale_mm", [](const PyIdentifyResult& r) { return r.r.loss_scale_mm; },
+                             "the robust loss's scale in the final fit (mm; 0: none)")
       .def_property_readonly("targets", [](const PyIdentifyResult& r) { return targets_to(r.r.targets); })
       .def_property_readonly("nominal_targets", [](const PyIdentifyResult& r) { return targets_to(r.r.nominal_targets); })
       .def_property_readonly("effects", [](const PyIdentifyResult& r) { return effect_values_to(r.r.effects); },

@@ -218,11 +218,14 @@ class IdentifyOptions:
     effects: list[Effect]
     orientation_weight: float
     penalties: list[tuple[str, float]]
+    prior_sd: list[tuple[str, float]]
+    prior_scale: float
     def __init__(self, compliance: bool = ..., loss: str = ..., loss_scale_mm: float = ..., max_iterations: int = ...,
                  fix: Sequence[str] = ..., compliance_joints: Sequence[int] = ..., effects: Sequence[Effect] = ...,
                  covariance: bool = ..., orientation_weight: float = ..., rank_tolerance: float = ...,
                  weak_tolerance: float = ..., min_torque_share: float = ...,
-                 correlation_threshold: float = ...) -> None: ...
+                 correlation_threshold: float = ..., prior_scale: float = ...,
+                 prior_sd: Optional[Sequence[tuple[str, float]]] = ...) -> None: ...
 
 class IdentifyResult:
     @property
@@ -245,6 +248,14 @@ class IdentifyResult:
     def fixed(self) -> np.ndarray: ...
     @property
     def fixed_reason(self) -> list[str]: ...
+    @property
+    def at_prior(self) -> np.ndarray: ...
+    @property
+    def prior_sd(self) -> np.ndarray: ...
+    @property
+    def noise_mm(self) -> float: ...
+    @property
+    def loss_scale_mm(self) -> float: ...
     @property
     def targets(self) -> np.ndarray: ...
     @property

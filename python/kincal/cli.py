@@ -16,7 +16,7 @@ from . import _core, load_robot
 from . import cli_campaign as campaign
 from . import diagnose as diagnosis
 from . import feed as feedmod
-from . import fivebar
+from . import fivebar, priors
 from . import identify as ident
 from .csv_text import format_rows
 from .kinematics_files import fk_file, ik_file
@@ -124,7 +124,10 @@ def cmd_identify(args) -> None:
     ident.check_data_for(effects, dict(data, source=args.data), robot)
     if args.holdout is not None and args.folds is not None:
         raise ValueError("--holdout and --folds: give one (a split, or cross-validation)")
+    prior_model = load_robot(args.prior_model) if args.prior_model else None
     res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
+                         prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
+                         prior_scale=priors.parse_prior_scale(args.prior_scale),
                          holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
                          progress=_progress("identify"), orientation_weight=args.orientation_weight,
                          fold_progress=campaign._step_progress("cross-validation, fold"), hold_out_setups=args.hold_out_setups)
@@ -277,9 +280,10 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                         help="harmonic orders of transmission_error (default 1,2)")
 
-    def loss_opts(sp):
+    def loss_opts(sp, scale=0.1):
         sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
-        sp.add_argument("--loss-scale", type=float, default=0.1, help="where the robust loss bends (mm)")
+        sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
+                        + (f"{scale})" if scale else "from the residuals' robust spread)"))
 
     def model_opts(sp):
         sp.add_argument("--tool-targets", metavar="CSV",
@@ -365,7 +369,13 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "time_s, config, setup]; a setup column: one placement each)")
     sp.add_argument("--out", required=True, help="model JSON")
     effect_opts(sp, "joint_compliance", "non-geometric effects to identify")
-    loss_opts(sp)
+    loss_opts(sp, None)
+    sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated geometry "
+                    "(e.g. last year's calibration; default: the starting model)")
+    sp.add_argument("--prior-sd", metavar="KIND=SD,..", help="prior standard deviations over the defaults "
+                    f"({', '.join(f'{k}={v:g}' for k, v in priors.DEFAULT_PRIOR_SD.items())}; also base_mm, base_deg, "
+                    "target_mm, an effect's name); 'none': no priors")
+    sp.add_argument("--prior-scale", default="1", help="times every prior sd, or 'auto' (grouped cross-validation)")
     sp.add_argument("--holdout", type=float, default=None,
                     help="validate on a held-out share of the configurations instead of cross-validation (the "
                          "model then excludes those rows)")

@@ -15,7 +15,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core, grouping
+from . import _core, grouping, priors
 from ._core import Robot
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, validate  # noqa: F401  (kincal.identify.validate, as before)
@@ -193,16 +193,20 @@ def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
 
 def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
             orientation_weight: float = 100.0, max_iterations: int = 100,
-            fix: Sequence[str] = (), penalties: Sequence = ()) -> "_core.IdentifyOptions":
+            fix: Sequence[str] = (), penalties: Sequence = (), prior_sd: Optional[dict] = None,
+            prior_scale: float = 0.0) -> "_core.IdentifyOptions":
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
-    joint_map smoothness penalty."""
+    joint_map smoothness penalty. ``prior_sd`` (kinds in file units, priors.DEFAULT_PRIOR_SD) times
+    ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals."""
     effects = list(effects)
     o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
                               loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
                               effects=effects, covariance=covariance, orientation_weight=orientation_weight)
     o.penalties = [(str(n), float(w)) for n, w in penalties]
+    o.prior_sd = priors.core_prior_sd(priors.DEFAULT_PRIOR_SD if prior_sd is None else prior_sd)
+    o.prior_scale = float(prior_scale) if prior_sd is None or prior_sd else 0.0
     return o
 
 
@@ -248,12 +252,16 @@ class Identification:
     fit: "_core.IdentifyResult"
     effects: list
     validation: dict = field(default_factory=dict)
+    fit_info: dict = field(default_factory=dict)  #: priors.report(): the priors and the loss
+    worst: list = field(default_factory=list)  #: priors.down_weighted(): the most down-weighted rows
 
     def parameters(self) -> list:
         f = self.fit
         return [{"name": p.name, "kind": p.kind, "joint": p.joint or None, "unit": p.unit, "value": float(v),
-                 "stddev": (None if math.isnan(s) else float(s)), "fixed": bool(fx), "reason": r}
-                for p, v, s, fx, r in zip(f.layout.parameters, f.x, f.stddev, f.fixed, f.fixed_reason)]
+                 "stddev": (None if math.isnan(s) else float(s)), "fixed": bool(fx), "reason": r,
+                 "at_prior": bool(ap), "prior_sd": (float(ps) if math.isfinite(ps) else None)}
+                for p, v, s, fx, r, ap, ps in zip(f.layout.parameters, f.x, f.stddev, f.fixed, f.fixed_reason,
+                                                  f.at_prior, f.prior_sd)]
 
     def effect_labels(self) -> list:
         return [e.label for e in self.effects]
@@ -272,6 +280,7 @@ class Identification:
             "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f.rms_mm, "max_mm": f.max_mm,
                     "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
+            **self.fit_info,
         }
         if f.layout.n_setups > 1:
             d["identification"]["setups"] = setup_frames(f.setups)
@@ -310,7 +319,10 @@ class Identification:
             rates = ", ".join("{} {:+.4g} {}".format(x["name"], x["value"], x["unit"]) for x in drift["parameters"])
             lines.append(f"instrument drift about t = {drift['t_mean_s']:.0f} s (removed from the fit, never "
                          f"compensated): {rates}")
-        lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}")
+        lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}"
+                     " (what the data determine)")
+        if self.fit_info:
+            lines += priors.summary_lines(f, self.fit_info, self.worst)
         fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
         if fixed:
             lines.append("held at their start value:")
@@ -326,11 +338,6 @@ class Identification:
                 sd = "" if p["stddev"] is None else f" +- {p['stddev']:.3g}"
                 lines.append(f"  {p['name']:<22} {p['value']:+.6g}{sd} {p['unit']}")
         return "\n".join(lines)
-
-
-def _fit(robot: Robot, data: dict, opts: "_core.IdentifyOptions",
-         progress: Optional[Callable[[int, float], None]] = None) -> "_core.IdentifyResult":
-    return _core.identify(robot, data, opts, progress)
 
 
 def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
@@ -363,18 +370,18 @@ def _errors(r: "_core.IdentifyResult", h: dict) -> dict:
     return out
 
 
-def _cross_validated_errors(robot: Robot, data: dict, opts, held_masks,
+def _cross_validated_errors(fit: priors.Fitter, data: dict, opts, held_masks,
                             progress: Optional[Callable[[int, int], None]]) -> dict:
     """_errors of every held-out row, each fold predicted by the model fitted on the other folds."""
     parts = []
     for i, held in enumerate(held_masks):
         if progress:
             progress(i, len(held_masks))
-        parts.append(_errors(_fit(robot, subset(data, ~held), opts), subset(data, held)))
+        parts.append(_errors(fit(subset(data, ~held), opts), subset(data, held)))
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
-def _setup_errors(robot: Robot, data: dict, opts, held_masks, loss: str, loss_scale_mm: float,
+def _setup_errors(fit: priors.Fitter, data: dict, opts, held_masks, loss: str, loss_scale_mm: float,
                   progress: Optional[Callable[[int, int], None]]) -> dict:
     """Errors of every setup held out whole: the model fitted on the other setups, the held one's
     placement and targets refitted on its rows (validate()'s refit)."""
@@ -382,19 +389,26 @@ def _setup_errors(robot: Robot, data: dict, opts, held_masks, loss: str, loss_sc
     for i, held in enumerate(held_masks):
         if progress:
             progress(i, len(held_masks))
-        r = _fit(robot, subset(data, ~held), opts)
+        r = fit(subset(data, ~held), opts)
         ea, eb, oa, ob, _ = _refit_placements(r.robot, subset(data, held), loss, loss_scale_mm)
         parts.append(dict(ea=ea, eb=eb, **({"oa": oa, "ob": ob} if oa is not None else {})))
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
 def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: str = "huber",
-             loss_scale_mm: float = 0.1, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
+             loss_scale_mm: Optional[float] = None, prior_sd: Optional[dict] = None, prior_scale=1.0,
+             prior_model: Optional[Robot] = None, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
              fold_progress: Optional[Callable[[int, int], None]] = None,
              penalties: Sequence = (), hold_out_setups: bool = False) -> Identification:
     """Identify the robot's parameters from measurements.
+
+    ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread).
+    ``prior_sd``: prior standard deviations by kind in file units (None: priors.DEFAULT_PRIOR_SD; {}:
+    no priors), times ``prior_scale`` ("auto" or None: chosen by grouped cross-validation inside
+    each training set), centred on ``prior_model``'s calibrated geometry when given (e.g. last
+    year's calibration), else on the nominal model.
 
     ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
     ``--effects`` (``"joint_compliance"``, ``"transmission_error:3"``, ``"backlash:2"``,
@@ -417,10 +431,11 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     if holdout is not None and not 0.0 <= holdout < 1.0:
         raise ValueError(f"--holdout must be a share in (0, 1), not {holdout}")
     holdout = holdout or None  # a share of 0 holds nothing out
-    opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
-                   penalties=penalties)
-    cv_opts = options(effects, loss=loss, loss_scale_mm=loss_scale_mm, orientation_weight=orientation_weight,
-                      covariance=False, penalties=penalties)
+    auto = prior_scale is None or prior_scale == "auto"
+    opts, cv_opts = (options(effects, loss=loss, loss_scale_mm=loss_scale_mm or 0.0, covariance=cov,
+                             orientation_weight=orientation_weight, penalties=penalties, prior_sd=prior_sd,
+                             prior_scale=1.0 if auto else float(prior_scale)) for cov in (True, False))
+    fit = priors.Fitter(robot, prior_model, auto_scale=auto, seed=seed)
     every_row = np.ones(len(data["pose"]), dtype=bool)
     if hold_out_setups:
         codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
@@ -444,10 +459,11 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
         val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
     # folds: each predicted by a model fitted without it; a split: by the delivered model itself
     if hold_out_setups:
-        e = _setup_errors(robot, data, cv_opts, masks, loss, loss_scale_mm, fold_progress)
+        e = _setup_errors(fit, data, cv_opts, masks, loss, loss_scale_mm or 0.0, fold_progress)
     else:
-        e = _cross_validated_errors(robot, data, cv_opts, masks, fold_progress) if masks and holdout is None else {}
-    r = _fit(robot, subset(data, fit_mask), opts, progress)
+        e = _cross_validated_errors(fit, data, cv_opts, masks, fold_progress) if masks and holdout is None else {}
+    fit.scales.clear()
+    r = fit(subset(data, fit_mask), opts, progress)
     if holdout is not None and val["held_rows"]:
         e = _errors(r, subset(data, ~fit_mask))
     if e:
@@ -455,46 +471,14 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
         if "oa" in e:
             val.update(_figures(e["ob"], "before", "deg"), **_figures(e["oa"], "after", "deg"))
     val["fit_rows"] = int(fit_mask.sum())
+    choice = (f"{fit.scales[0]:g} (chosen by grouped cross-validation)" if fit.scales else f"{opts.prior_scale:g}")
+    info = priors.report(r, loss, loss_scale_mm, choice)
+    info["priors"]["centred_on"] = "the prior model's calibrated geometry" if prior_model else "the starting model"
     return Identification(robot=r.robot, targets=np.asarray(r.targets), fit=r, effects=list(effects),
-                          validation=val)
+                          validation=val, fit_info=info, worst=priors.down_weighted(r, subset(data, fit_mask)))
 
 
 def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:
-    """Reflectors alone cannot tell where the TCP is: the tool frame is redundant with the target
-    offsets and stays nominal in the fit. Given the targets' offsets in the tool frame as designed
-    or measured on a CMM (``known``, one row per target, mm), the tool frame is moved so that the
-    identified targets sit where they should: a rigid fit (Horn) for three or more targets, a
-    translation for one or two. Returns the identification with the moved tool and the known
-    offsets as its targets (the predicted reflector points do not change)."""
-    known = np.asarray(known, dtype=float).reshape(-1, 3)
-    ident_t = np.asarray(result.targets, dtype=float)
-    if len(known) != len(ident_t):
-        raise ValueError(f"{len(known)} known target offsets for {len(ident_t)} identified targets")
-    # identified t_k (tool frame M) = T known_k: then M' = M T puts known_k at the same points
-    if len(known) >= 3 and np.linalg.matrix_rank(known - known.mean(axis=0), tol=1e-6) >= 2:
-        ca, cb = known.mean(axis=0), ident_t.mean(axis=0)
-        h = (known - ca).T @ (ident_t - cb)
-        u, _, vt = np.linalg.svd(h)
-        d = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
-        r = vt.T @ d @ u.T
-        t = cb - r @ ca
-    else:
-        r, t = np.eye(3), (ident_t - known).mean(axis=0)
-    doc = json.loads(result.robot.to_json())
-    tool = doc["calibrated"]["tool"]
-    m_r = _core.abc_to_rotation(np.asarray(tool["abc_deg"], dtype=float))
-    m_t = np.asarray(tool["xyz_mm"], dtype=float)
-    new_r, new_t = m_r @ r, m_t + m_r @ t
-    tool["xyz_mm"] = new_t.tolist()
-    tool["abc_deg"] = _abc_of(new_r)
-    robot = Robot.from_json(json.dumps(doc), "<identified>")
-    return Identification(robot=robot, targets=known.copy(), fit=result.fit, effects=result.effects,
-                          validation=result.validation)
-
-
-def _abc_of(r: np.ndarray) -> list:
-    """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c)."""
-    b = math.degrees(math.atan2(-r[2, 0], math.hypot(r[0, 0], r[1, 0])))
-    a = math.degrees(math.atan2(r[1, 0], r[0, 0]))
-    c = math.degrees(math.atan2(r[2, 1], r[2, 2]))
-    return [a, b, c]
+    """The tool frame placed from known target offsets (tool_frame.tool_from_targets)."""
+    from .tool_frame import tool_from_targets as place
+    return place(result, known)

@@ -172,6 +172,29 @@ Linearization linearize(PointModel& pm, const MeasurementSet& data, const std::v
   return lin;
 }
 
+/// With priors: what a generic campaign leaves redundant is held as without them; of the rest,
+/// what these data leave redundant or barely seen (the greedy selection on the data, parameters
+/// without a prior kept first so that the ones the prior determines are those left) stays free,
+/// determined by its prior (res.at_prior), or is held when it has no prior.
+void at_prior(const Linearization& lin, const IdentifyResult& generic, const std::vector<int>& order,
+              const IdentifyOptions& opt, const std::vector<double>& prior_sd, IdentifyResult& res) {
+  for (int i = 0; i < res.layout.size; ++i)
+    if (generic.fixed[i] && !res.fixed[i]) res.fix(i, generic.fixed_reason[i]);
+  std::vector<int> data_order;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int i : order)
+      if (std::isfinite(prior_sd[i]) == (pass == 1)) data_order.push_back(i);
+  IdentifyResult on_data = res;
+  select_independent(lin.jacobian, data_order, opt, on_data);
+  for (int i = 0; i < res.layout.size; ++i) {
+    if (res.fixed[i] || !on_data.fixed[i]) continue;
+    if (std::isfinite(prior_sd[i]))
+      res.at_prior[i] = true;
+    else
+      res.fix(i, "not determined by these poses (" + on_data.fixed_reason[i] + "), and no prior");
+  }
+}
+
 }  // namespace
 
 void fix_unobservable(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
@@ -204,7 +227,8 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
 }
 
 Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
-                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res) {
+                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
+                                 const std::vector<double>& prior_sd) {
   const ParamLayout& L = res.layout;
   // penalised parameters (a ridge determines them where the data do not) are left out of the
   // analysis: always free, they never make another parameter look redundant
@@ -219,6 +243,11 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
   select_independent(linearize(pm, generic_campaign(nominal, data), x, opt.orientation_weight).jacobian, order, opt,
                      generic);
   Linearization lin = linearize(pm, data, x, opt.orientation_weight);
+  res.at_prior.assign(L.size, false);
+  if (std::any_of(prior_sd.begin(), prior_sd.end(), [](double s) { return std::isfinite(s); })) {
+    at_prior(lin, generic, order, opt, prior_sd, res);
+    return lin;
+  }
   select_independent(lin.jacobian, order, opt, res);
   std::string missing;
   int n_missing = 0;
@@ -236,8 +265,8 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
 void observability(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
   const Eigen::MatrixXd J = linearize(pm, data, res.x, opt.orientation_weight).jacobian;
   std::vector<int> free_idx;
-  for (int i = 0; i < res.layout.size; ++i)
-    if (!res.fixed[i]) free_idx.push_back(i);
+  for (int i = 0; i < res.layout.size; ++i)  // what the data determine (not the priors)
+    if (!res.fixed[i] && !(i < static_cast<int>(res.at_prior.size()) && res.at_prior[i])) free_idx.push_back(i);
   Eigen::MatrixXd Jf(J.rows(), free_idx.size());
   for (size_t k = 0; k < free_idx.size(); ++k) {
     const double nrm = J.col(free_idx[k]).norm();

@@ -3,6 +3,7 @@
 #include "kincal/identify/identify.hpp"
 
 #include "kincal/identify/identifiability.hpp"
+#include "kincal/identify/priors.hpp"
 #include "kincal/identify/simulate.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
@@ -50,6 +51,8 @@ class AllRows : public ceres::EvaluationCallback {
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
     pm_.set_params(x_);
   }
+  /// The residuals at the current point (Ceres's last evaluation may have been a rejected step).
+  void refresh() { PrepareForEvaluation(false, true); }
   double* z() { return z_.data(); }
   const double* residual(size_t i) const { return &r_[RS_ * i]; }
   const double* jacobian(size_t i) const { return &j_[RS_ * i * F_]; }
@@ -85,42 +88,43 @@ class RowCost : public ceres::CostFunction {
   size_t i_;
 };
 
-/// Ridge penalties: residual w_k z_k for the free parameters that carry a weight.
+/// Ridge penalties and Gaussian priors: residual w_k (z_k - m_k) for the free parameters that carry one.
 class PenaltyCost : public ceres::CostFunction {
  public:
-  PenaltyCost(std::vector<std::pair<int, double>> terms, int size) : terms_(std::move(terms)), size_(size) {
+  PenaltyCost(std::vector<PenaltyTerm> terms, int size) : terms_(std::move(terms)), size_(size) {
     set_num_residuals(static_cast<int>(terms_.size()));
     mutable_parameter_block_sizes()->push_back(size);
   }
   bool Evaluate(double const* const* z, double* residuals, double** jacobians) const override {
-    for (size_t i = 0; i < terms_.size(); ++i) residuals[i] = terms_[i].second * z[0][terms_[i].first];
+    for (size_t i = 0; i < terms_.size(); ++i) residuals[i] = terms_[i].weight * (z[0][terms_[i].index] - terms_[i].mean);
     if (jacobians && jacobians[0]) {
       std::fill_n(jacobians[0], terms_.size() * size_, 0.0);
-      for (size_t i = 0; i < terms_.size(); ++i) jacobians[0][i * size_ + terms_[i].first] = terms_[i].second;
+      for (size_t i = 0; i < terms_.size(); ++i) jacobians[0][i * size_ + terms_[i].index] = terms_[i].weight;
     }
     return true;
   }
 
  private:
-  std::vector<std::pair<int, double>> terms_;  // (index among the free parameters, weight)
+  std::vector<PenaltyTerm> terms_;
   int size_;
 };
 
-/// The penalty terms of the free parameters (index among them, weight); InputError for a name the
-/// layout does not have or a weight that is negative or not finite.
-std::vector<std::pair<int, double>> penalty_terms(const ParamLayout& L, const std::vector<int>& free_idx,
-                                                  const IdentifyOptions& opt) {
-  std::vector<std::pair<int, double>> out;
+/// The penalty terms of the free parameters (towards zero); InputError for a name the layout does
+/// not have or a weight that is negative or not finite.
+std::vector<PenaltyTerm> penalty_terms(const ParamLayout& L, const std::vector<int>& free_idx,
+                                       const IdentifyOptions& opt) {
+  std::vector<PenaltyTerm> out;
   for (const auto& [name, w] : opt.penalties) {
     const auto it = std::find(L.names.begin(), L.names.end(), name);
     if (it == L.names.end()) throw InputError("identify: a penalty on '" + name + "', which is no parameter of the model");
     if (!(w >= 0) || !std::isfinite(w)) throw InputError("identify: the penalty on '" + name + "' must be finite and >= 0");
     const int i = static_cast<int>(it - L.names.begin());
     const auto f = std::find(free_idx.begin(), free_idx.end(), i);
-    if (f != free_idx.end() && w > 0) out.emplace_back(static_cast<int>(f - free_idx.begin()), w);
+    if (f != free_idx.end() && w > 0) out.push_back({static_cast<int>(f - free_idx.begin()), w, 0.0});
   }
   return out;
 }
+
 
 class Progress : public ceres::IterationCallback {
  public:
@@ -134,11 +138,13 @@ class Progress : public ceres::IterationCallback {
   const std::function<void(int, double)>& f_;
 };
 
-std::unique_ptr<ceres::LossFunction> make_loss(const IdentifyOptions& opt) {
-  if (opt.loss == "huber") return std::make_unique<ceres::HuberLoss>(opt.loss_scale_mm);
-  if (opt.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(opt.loss_scale_mm);
-  if (opt.loss != "none" && !opt.loss.empty())
+/// The robust loss of the options at a scale (mm); none when the scale is not positive.
+std::unique_ptr<ceres::LossFunction> make_loss(const IdentifyOptions& opt, double scale_mm) {
+  if (opt.loss != "none" && opt.loss != "huber" && opt.loss != "cauchy" && !opt.loss.empty())
     throw InputError("identify: unknown loss '" + opt.loss + "' (none, huber, cauchy)");
+  if (!(scale_mm > 0)) return nullptr;
+  if (opt.loss == "huber") return std::make_unique<ceres::HuberLoss>(scale_mm);
+  if (opt.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale_mm);
   return nullptr;
 }
 
@@ -155,7 +161,7 @@ enum class Report { silent, progress };
 
 /// Levenberg-Marquardt on the free parameters of all (written back into its x by finish()).
 void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, const IdentifyOptions& opt,
-           ceres::Solver::Summary& summary, Report report, const std::vector<std::pair<int, double>>& penalties = {}) {
+           ceres::Solver::Summary& summary, Report report, const std::vector<PenaltyTerm>& penalties = {}) {
   for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, all.z());
   if (!penalties.empty()) problem.AddResidualBlock(new PenaltyCost(penalties, all.size()), nullptr, all.z());
   ceres::Solver::Options so;
@@ -279,7 +285,8 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   ceres::Solver::Summary summary;
   AllRows all(pm, data, x, frames, opt.orientation_weight);
   ceres::Problem problem(problem_options(all));
-  std::unique_ptr<ceres::LossFunction> loss = make_loss(opt);
+  // a scale from the data is not known yet: the frames are a start, fitted by least squares then
+  std::unique_ptr<ceres::LossFunction> loss = make_loss(opt, opt.loss_scale_mm);
   pm.set_params(x);
   pm.set_frames_only(true, &data);  // only the base and target columns are needed here
   solve(problem, all, loss.get(), opt, summary, Report::silent);
@@ -302,16 +309,22 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   res.nominal_rms_mm = std::sqrt(ss / data.rows.size());
 }
 
-/// The free parameters; InputError when the data give no more equations than them.
-std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResult& res) {
+/// The free parameters; InputError when the data give no more equations than them or, with priors,
+/// fewer measured points than there are free parameters without a prior (the frames: what only the
+/// data can determine).
+std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResult& res, const std::vector<double>& sd) {
   std::vector<int> free_idx;
+  size_t unconstrained = 0;
   for (int i = 0; i < res.layout.size; ++i)
-    if (!res.fixed[i]) free_idx.push_back(i);
+    if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
   const size_t nres = residual_size(residual_kind(data)) * data.rows.size();
-  if (nres <= free_idx.size())
-    throw InputError(data.source + ": " + std::to_string(data.rows.size()) + " measured points give " +
-                     std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
+  const std::string points = data.source + ": " + std::to_string(data.rows.size()) + " measured points";
+  if (unconstrained == free_idx.size() && nres <= free_idx.size())
+    throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
                      " free parameters: too few to identify the model");
+  if (unconstrained < free_idx.size() && data.rows.size() < unconstrained)
+    throw InputError(points + " for " + std::to_string(unconstrained) +
+                     " free parameters without a prior (frames and targets): too few to identify the model");
   return free_idx;
 }
 
@@ -358,7 +371,8 @@ void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summ
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(F, F);
   cov.GetCovarianceBlock(all.z(), all.z(), C.data());
   const double dofres = std::max(1, nres - F);
-  const double s2 = 2.0 * summary.final_cost / dofres;
+  // with priors the cost weighs them by the estimated noise: the posterior covariance is noise^2 (J^T J)^-1
+  const double s2 = res.noise_mm > 0 ? res.noise_mm * res.noise_mm : 2.0 * summary.final_cost / dofres;
   C *= s2;
   for (int a = 0; a < F; ++a) res.stddev[free_idx[a]] = std::sqrt(std::max(0.0, C(a, a)));
   for (int a = 0; a < F; ++a)
@@ -368,6 +382,61 @@ void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summ
         res.correlations.push_back({res.layout.names[free_idx[a]], res.layout.names[free_idx[b]], r});
     }
 }
+
+/// The stage-2 solves: each a Levenberg-Marquardt run on a set of free parameters from the current
+/// x, at a loss scale (0: least squares), with the options' penalties and the priors given. The
+/// last problem stays for the covariance.
+class Stage2 {
+ public:
+  Stage2(PointModel& pm, const MeasurementSet& data, std::vector<double>& x, const IdentifyOptions& opt,
+         const IdentifyResult& res)
+      : pm_(pm), data_(data), x_(x), opt_(opt), res_(res) {}
+  /// start: the linearization at x when x is the start (its first evaluation reused).
+  void solve(const std::vector<int>& free_idx, const Linearization* start, double scale_mm,
+             std::vector<PenaltyTerm> priors) {
+    problem_.reset();  // before the rows and the loss it refers to
+    all_ = std::make_unique<AllRows>(pm_, data_, x_, free_idx, opt_.orientation_weight);
+    if (start) all_->seed(*start);
+    loss_ = make_loss(opt_, scale_mm);
+    scale_ = loss_ ? scale_mm : 0.0;
+    problem_ = std::make_unique<ceres::Problem>(problem_options(*all_));
+    std::vector<PenaltyTerm> terms = penalty_terms(res_.layout, free_idx, opt_);
+    terms.insert(terms.end(), priors.begin(), priors.end());
+    free_ = free_idx;
+    kincal::solve(*problem_, *all_, loss_.get(), opt_, summary, Report::progress, terms);
+    if (first_) initial_cost = summary.initial_cost, first_ = false;
+    iterations += static_cast<int>(summary.iterations.size()) - 1;
+  }
+  /// The robust noise of the residuals at the solution, p parameters determined by the data.
+  double noise(size_t p) {
+    all_->refresh();
+    std::vector<double> position;
+    position.reserve(3 * all_->rows());
+    for (size_t i = 0; i < all_->rows(); ++i) position.insert(position.end(), all_->residual(i), all_->residual(i) + 3);
+    return robust_noise(position, p);
+  }
+  int row_size() const { return residual_size(residual_kind(data_)); }
+  double scale() const { return scale_; }
+  const std::vector<int>& free() const { return free_; }
+  ceres::Problem& problem() { return *problem_; }
+  AllRows& rows() { return *all_; }
+  ceres::Solver::Summary summary;
+  int iterations = 0;
+  double initial_cost = 0;
+
+ private:
+  PointModel& pm_;
+  const MeasurementSet& data_;
+  std::vector<double>& x_;
+  const IdentifyOptions& opt_;
+  const IdentifyResult& res_;
+  std::unique_ptr<AllRows> all_;
+  std::unique_ptr<ceres::LossFunction> loss_;
+  std::unique_ptr<ceres::Problem> problem_;
+  std::vector<int> free_;
+  double scale_ = 0;
+  bool first_ = true;
+};
 
 }  // namespace
 
@@ -386,25 +455,43 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   start_carried_effects(nominal, opt, res);
   std::vector<double> x = res.start;
   fix_unobservable(nominal, data, opt, res);
-  // stage 1: the frames on the nominal geometry; then what the data cannot determine is held
+  // stage 1: the frames on the nominal geometry; then what the data cannot determine is held (or,
+  // with priors, left to them)
   fit_frames(pm, nominal, data, opt, x, res);
-  const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res);
-  const std::vector<int> free_idx = free_parameters(data, res);
-
+  res.prior_sd = prior_sds(res.layout, opt);
+  const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd);
+  const std::vector<int> free_idx = free_parameters(data, res, res.prior_sd);
   // stage 2: everything identifiable, its first evaluation the linearization at the start
-  ceres::Solver::Summary summary;
-  std::unique_ptr<ceres::LossFunction> loss = make_loss(opt);
-  AllRows all(pm, data, x, free_idx, opt.orientation_weight);
-  all.seed(at_start);
-  ceres::Problem problem(problem_options(all));
-  solve(problem, all, loss.get(), opt, summary, Report::progress, penalty_terms(res.layout, free_idx, opt));
-  res.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  res.initial_cost = summary.initial_cost;
-  res.final_cost = summary.final_cost;
-  res.termination = summary.BriefReport();
+  Stage2 s2(pm, data, x, opt, res);
+  const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double v) { return std::isfinite(v); });
+  if (!priors && (opt.loss_scale_mm > 0 || opt.loss == "none")) {
+    s2.solve(free_idx, &at_start, opt.loss_scale_mm, {});
+  } else {
+    // a least-squares start on what the data determine gives the noise; then the robust (maximum a
+    // posteriori) fit at the data's scale; the noise re-estimated once from it
+    std::vector<int> determined;
+    for (int i : free_idx)
+      if (!res.at_prior[i]) determined.push_back(i);
+    s2.solve(determined, &at_start, 0.0, {});
+    res.noise_mm = s2.noise(determined.size());
+    for (int pass = 0; pass < 2; ++pass) {
+      const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
+      s2.solve(free_idx, nullptr, opt.loss == "none" ? 0.0 : scale, prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
+      const double again = s2.noise(determined.size());
+      const bool settled = std::abs(again / res.noise_mm - 1) < 0.02;
+      res.noise_mm = again;
+      if (settled) break;
+    }
+  }
+  res.loss_scale_mm = s2.scale();
+  res.iterations = s2.iterations;
+  res.initial_cost = s2.initial_cost;
+  res.final_cost = s2.summary.final_cost;
+  res.termination = s2.summary.BriefReport();
   store_solution(pm, nominal, data, x, res);
   observability(pm, data, opt, res);
-  covariance(problem, all, summary, free_idx, opt, res);
+  if (s2.free() == free_idx) covariance(s2.problem(), s2.rows(), s2.summary, free_idx, opt, res);
+  else res.stddev.assign(res.layout.size, std::nan(""));
   return res;
 }
 

@@ -32,9 +32,12 @@ struct Linearization {
 /// data and on a generic campaign (100 random poses in the limits of the nominal model, the targets
 /// measured, the same kind of rows). Throws InputError when the data leave redundant what the
 /// generic campaign determines (too few or too similar poses). Returns the data's linearization at
-/// x (pm's parameters are then x).
+/// x (pm's parameters are then x). With priors (prior_sd: one per parameter, finite where it has
+/// one) what only the data leave undetermined is no error: it stays free, determined by its prior
+/// (res.at_prior), or is held when it has none.
 Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
-                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res);
+                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
+                                 const std::vector<double>& prior_sd = {});
 
 /// The condition number and the observability index of the free parameters (the unit-scaled
 /// Jacobian at res.x), into res.

@@ -18,10 +18,24 @@
 
 namespace kincal {
 
+/// The default prior standard deviations: what a robot maker's tolerances justify for the joint
+/// geometry (1 mm, 0.1 deg), the tool (5 mm, 1 deg) and the compliances (0.01 deg/kNm, several times
+/// a large robot's); none (wide) for the base frames, the targets and the extra effects.
+std::vector<std::pair<std::string, double>> default_prior_sd();
+
 struct IdentifyOptions {
   bool compliance = true;          ///< identify the joint compliances
   std::string loss = "huber";      ///< "none", "huber", "cauchy"
-  double loss_scale_mm = 0.1;      ///< where the robust loss bends
+  /// where the robust loss bends on a row's residual norm (mm); 0: from the data (after a
+  /// least-squares start, from the residuals' robust spread, re-estimated once after the robust fit)
+  double loss_scale_mm = 0.1;
+  /// Priors (maximum a posteriori) by kind: every parameter of a kind named here gets a Gaussian
+  /// prior centred on its start value with this standard deviation (core units) times prior_scale.
+  /// Kinds: joint_mm and joint_rad (the joint lines' moves and tilts), compliance (deg/kNm),
+  /// tool_mm, tool_rad, base_mm, base_rad, target_mm, and an effect's name (each of its
+  /// parameters). Kinds not named have no prior. prior_scale 0: no priors.
+  std::vector<std::pair<std::string, double>> prior_sd = default_prior_sd();
+  double prior_scale = 0;
   int max_iterations = 100;
   double rank_tolerance = 1e-4;    ///< a unit column closer than this to the others' span: redundant
   double min_torque_share = 0.05;  ///< compliance of a joint with less gravity torque than this share is held
@@ -49,6 +63,12 @@ struct IdentifyResult {
   ModelSpec nominal_fitted;               ///< nominal geometry, fitted base frame
   std::vector<Vec3> nominal_targets;      ///< targets fitted with the nominal geometry
   std::vector<bool> fixed;                ///< held at its start value
+  /// free, but determined by its prior rather than by the data (these poses leave it redundant or
+  /// barely seen where a generic campaign would determine it)
+  std::vector<bool> at_prior;
+  std::vector<double> prior_sd;           ///< the prior's standard deviation (scaled; inf: none)
+  double noise_mm = 0;                    ///< the residuals' robust spread per coordinate (0: not estimated)
+  double loss_scale_mm = 0;               ///< the robust loss's scale used in the final fit (0: no robust loss)
   std::vector<std::string> fixed_reason;  ///< why it is held ("" when free)
   ModelSpec calibrated;
   std::vector<Vec3> targets;

@@ -1,0 +1,40 @@
+// kincal: the priors of identification (maximum a posteriori) and the data's own noise scale: the
+// prior standard deviation of every parameter from the options' kinds, the prior terms of a solve,
+// the residuals' robust spread and the robust loss's scale from it.
+#pragma once
+
+#include "kincal/identify/identify.hpp"
+
+#include <cstddef>
+#include <vector>
+
+namespace kincal {
+
+/// A penalty on one free parameter: the residual weight * (z[index] - mean).
+struct PenaltyTerm {
+  int index;  ///< among the free parameters
+  double weight, mean;
+};
+
+/// The prior standard deviation of every parameter of the layout (opt.prior_sd by kind times
+/// opt.prior_scale; infinity for the kinds not named, or for all with prior_scale 0). InputError for
+/// an unknown kind or a standard deviation or scale that is not a positive finite number.
+std::vector<double> prior_sds(const ParamLayout& L, const IdentifyOptions& opt);
+
+/// The prior terms of the free parameters that have one, centred on the start: weight noise / sd
+/// (the data's residuals weigh 1 / noise, so the cost is the negative log posterior times noise^2).
+std::vector<PenaltyTerm> prior_terms(const std::vector<double>& sd, const std::vector<double>& start,
+                                     const std::vector<int>& free_idx, double noise_mm);
+
+/// The residuals' robust spread per coordinate (mm): 1.4826 x the median absolute deviation of the
+/// position components given, corrected for the p parameters the data determine (sqrt(n / (n - p))),
+/// at least 0.1 um (no instrument measures better; noise-free data keep the priors and the loss finite).
+double robust_noise(std::vector<double> position, std::size_t p);
+
+/// Where the robust loss bends on a row's residual norm for a noise per coordinate: the 95% point of
+/// the norm of Gaussian noise (the square root of the chi-square quantile: 3 components 2.80, 6
+/// components 3.55), so that a clean row is rarely down-weighted (the scalar Huber constant 1.345
+/// would down-weight most clean rows, whose norms add three coordinates).
+double loss_threshold(double noise_mm, int row_size);
+
+}  // namespace kincal

@@ -135,6 +135,8 @@ int main(int argc, char** argv) {
   std::string format, targets = "joints", prog_name;
   std::optional<double> speed, zone;
   int max_per_file = 0;
+  std::vector<double> program_tool, program_base;
+  bool skip_unresolved = false;
   app.add_option("--model", model, "built-in robot name or model JSON");
   app.add_option("--fivebar", fivebar, "five-bar hidden robot: FIT.json of kincal hidden-robot fit");
   app.add_option("--matrix", matrix, "five-bar: MATRIX.json of kincal hidden-robot matrix");
@@ -150,6 +152,11 @@ int main(int argc, char** argv) {
   app.add_option("--speed", speed, "joint motions: percent of the axes' maximum speed (default 20); linear motions: "
                                    "mm/s (default 250)");
   app.add_option("--zone", zone, "approximation / blending in mm (FANUC: CNT 0..100); default 0: exact stop");
+  app.add_option("--program-tool", program_tool, "a KRL/RAPID program's TCP in the model's tool frame: X,Y,Z,A,B,C")
+      ->delimiter(',')->expected(6);
+  app.add_option("--program-base", program_base, "a KRL/RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
+      ->delimiter(',')->expected(6);
+  app.add_flag("--skip-unresolved", skip_unresolved, "pass targets computed at run time through with a warning");
   app.add_option("--max-targets-per-file", max_per_file, "split longer KRL / LS programs into parts (default: 2000)");
   app.add_option("--frame", frame, "frame of the program poses")->check(CLI::IsMember({"base", "instrument"}));
   app.add_flag("--stream", stream, "read pose lines on stdin, write joint lines on stdout, flushed");
@@ -206,7 +213,15 @@ int main(int argc, char** argv) {
     if (speed) w.speed = *speed;
     if (zone) w.zone = *zone;
     w.max_targets_per_file = max_per_file;
-    const auto res = kincal::compensate_to_controller(robot, program, out, opt, w).result;
+    kincal::NativeOptions n;
+    if (program_tool.size() == 6)
+      n.program_tool = {kincal::Vec3(program_tool[0], program_tool[1], program_tool[2]),
+                        kincal::Vec3(program_tool[3], program_tool[4], program_tool[5])};
+    if (program_base.size() == 6)
+      n.program_base = {kincal::Vec3(program_base[0], program_base[1], program_base[2]),
+                        kincal::Vec3(program_base[3], program_base[4], program_base[5])};
+    n.skip_unresolved = skip_unresolved;
+    const auto res = kincal::compensate_to_controller(robot, program, out, opt, w, n).result;
     for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());
     std::fprintf(stderr, "%s: %zu poses, at most %d iterations, largest residual %.3g\n", out.c_str(),
                  res.q_deg.size(), res.max_iterations, res.max_residual);

@@ -24,6 +24,23 @@ def add_options(sp) -> None:
                                                "default 0: exact stop")
     sp.add_argument("--max-targets-per-file", type=int, default=0,
                     help="split KRL and LS programs with more targets into parts a main program calls (default 2000)")
+    sp.add_argument("--program-tool", help="a KRL or RAPID program's TCP in the model's tool frame: X,Y,Z,A,B,C (mm, deg)")
+    sp.add_argument("--program-base", help="a KRL or RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
+    sp.add_argument("--skip-unresolved", action="store_true",
+                    help="pass targets computed at run time (RelTool, Offs, CRobT, geometric operators) through "
+                         "unchanged with a warning (default: an error listing them)")
+
+
+def _frame(text, option: str) -> list:
+    if text is None:
+        return []
+    try:
+        v = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise ValueError(f"{option} {text}: expected X,Y,Z,A,B,C") from None
+    if len(v) != 6:
+        raise ValueError(f"{option} {text}: expected 6 numbers X,Y,Z,A,B,C")
+    return v
 
 
 def compensate(robot, args, comp_kwargs: dict) -> dict:
@@ -32,4 +49,7 @@ def compensate(robot, args, comp_kwargs: dict) -> dict:
     return _core.compensate_to_controller(robot, str(args.program), str(args.out), **comp_kwargs,
                                           format=args.format, targets=args.targets, name=args.name,
                                           speed=args.speed, zone=args.zone,
-                                          max_targets_per_file=args.max_targets_per_file)
+                                          max_targets_per_file=args.max_targets_per_file,
+                                          program_tool=_frame(args.program_tool, "--program-tool"),
+                                          program_base=_frame(args.program_base, "--program-base"),
+                                          skip_unresolved=args.skip_unresolved)

@@ -17,7 +17,14 @@ namespace kincal {
 std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::vector<Vec6>& q_deg, TargetKind kind,
                                                  ControllerFormat format, const std::vector<std::string>& where);
 
-/// Reads a pose program (CSV or G-code), compensates it and writes it in w.format (every file, or
+/// A native program's frames and what to do with targets computed at run time.
+struct NativeOptions {
+  Pose6 program_tool;  ///< the program's TCP in the model's tool frame (--program-tool)
+  Pose6 program_base;  ///< the program's base in the robot's base frame (--program-base)
+  bool skip_unresolved = false;  ///< pass run-time targets through with a warning (else an error)
+};
+
+/// Reads a pose program (CSV or G-code; a KRL or RAPID program: see NativeOptions), compensates it and writes it in w.format (every file, or
 /// none when anything fails). A G-code program written as G-code joints keeps its other lines.
 /// Returns the result with the files written in `files`.
 struct ControllerProgramResult {
@@ -26,6 +33,6 @@ struct ControllerProgramResult {
 };
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
                                                  const std::string& out_path, const ProgramOptions& opt,
-                                                 const WriterOptions& w);
+                                                 const WriterOptions& w, const NativeOptions& native = {});
 
 }  // namespace kincal

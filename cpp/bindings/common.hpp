@@ -18,6 +18,7 @@ void define_model(py::module_& m);
 void define_kinematics(py::module_& m);
 void define_compensation(py::module_& m);
 void define_io(py::module_& m);
+void define_controllers(py::module_& m);
 void define_feed(py::module_& m);
 void define_measurements(py::module_& m);
 void define_identify(py::module_& m);

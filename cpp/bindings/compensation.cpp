@@ -1,6 +1,7 @@
 // _core bindings of program compensation: compensate_poses, compensate_program, stream_lines.
 #include "common.hpp"
 
+#include "kincal/compensation/controller_program.hpp"
 #include "kincal/compensation/program.hpp"
 #include "kincal/compensation/stream.hpp"
 
@@ -92,6 +93,47 @@ void define_compensation(py::module_& m) {
       },
       py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS,
       "Compensates a pose program file (CSV or G-code) into a joint program file, atomically");
+  m.def(
+      "compensate_to_controller",
+      [](const Robot& r, const std::string& in, const std::string& out, KINCAL_COMP_PARAMS,
+         std::optional<std::string> format, const std::string& targets, const std::string& name,
+         std::optional<double> speed, std::optional<double> zone, int max_per_file,
+         const std::vector<double>& program_tool, const std::vector<double>& program_base, bool skip_unresolved) {
+        NativeOptions n;
+        for (const auto* v : {&program_tool, &program_base})
+          if (!v->empty() && v->size() != 6) throw InputError("--program-tool / --program-base: X,Y,Z,A,B,C (6 numbers)");
+        if (!program_tool.empty())
+          n.program_tool = Pose6{Vec3(program_tool[0], program_tool[1], program_tool[2]),
+                                 Vec3(program_tool[3], program_tool[4], program_tool[5])};
+        if (!program_base.empty())
+          n.program_base = Pose6{Vec3(program_base[0], program_base[1], program_base[2]),
+                                 Vec3(program_base[3], program_base[4], program_base[5])};
+        n.skip_unresolved = skip_unresolved;
+        WriterOptions w;
+        w.format = format ? controller_format_named(*format) : controller_format_of_path(out);
+        if (targets != "joints" && targets != "filtered")
+          throw InputError("--targets " + targets + ": joints or filtered");
+        w.targets = targets == "filtered" ? TargetKind::Filtered : TargetKind::Joints;
+        w.name = name;
+        if (speed) w.speed = *speed;
+        if (zone) w.zone = *zone;
+        w.max_targets_per_file = max_per_file;
+        const ProgramOptions o = KINCAL_COMP_OPTIONS;
+        ControllerProgramResult res;
+        {
+          py::gil_scoped_release release;
+          res = compensate_to_controller(r, in, out, o, w, n);
+        }
+        py::dict d = result_dict(res.result);
+        d["files"] = res.files;
+        return d;
+      },
+      py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS, py::arg("format") = py::none(),
+      py::arg("targets") = "joints", py::arg("name") = "", py::arg("speed") = py::none(), py::arg("zone") = py::none(),
+      py::arg("max_targets_per_file") = 0, py::arg("program_tool") = std::vector<double>{},
+      py::arg("program_base") = std::vector<double>{}, py::arg("skip_unresolved") = false,
+      "Compensates a pose program file into a program in a controller's language (format: krl, rapid, fanuc-ls, "
+      "urscript, gcode, csv; None: by the output's extension), every file written or none");
   m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,

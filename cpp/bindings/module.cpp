@@ -10,6 +10,7 @@ PYBIND11_MODULE(_core, m) {
   define_kinematics(m);
   define_compensation(m);
   define_io(m);
+  define_controllers(m);
   define_feed(m);
   define_measurements(m);
   define_identify(m);

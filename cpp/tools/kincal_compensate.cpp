@@ -9,6 +9,7 @@
 // `kincal compensate` (both run this library). Errors: one line "file:line: cause", exit 1, and no
 // output file.
 #include "kincal/fivebar/fivebar.hpp"
+#include "kincal/compensation/controller_program.hpp"
 #include "kincal/compensation/program.hpp"
 #include "kincal/compensation/stream.hpp"
 #include "kincal/io/csv.hpp"
@@ -131,11 +132,32 @@ int main(int argc, char** argv) {
   std::string initial_direction, residual = "rotation_vector";
   int max_iter = 20;
   std::string fivebar, matrix;
+  std::string format, targets = "joints", prog_name;
+  std::optional<double> speed, zone;
+  int max_per_file = 0;
+  std::vector<double> program_tool, program_base;
+  bool skip_unresolved = false;
   app.add_option("--model", model, "built-in robot name or model JSON");
   app.add_option("--fivebar", fivebar, "five-bar hidden robot: FIT.json of kincal hidden-robot fit");
   app.add_option("--matrix", matrix, "five-bar: MATRIX.json of kincal hidden-robot matrix");
   app.add_option("--program", program, "pose program: CSV (x,y,z,a,b,c) or G-code (X Y Z A B C)");
-  app.add_option("--out", out, "joint program: .csv (q1..q6) or G-code (A1=..)");
+  app.add_option("--out", out,
+                 "the program written: .csv (q1..q6), G-code (A1=..), KRL .src (+ .dat), RAPID .mod, FANUC .ls, "
+                 "URScript .script");
+  app.add_option("--format", format, "krl, rapid, fanuc-ls, urscript, gcode or csv (default: by --out's extension)")
+      ->check(CLI::IsMember({"krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"}));
+  app.add_option("--targets", targets, "joints (default) or filtered (Cartesian, with the controller's branch data)")
+      ->check(CLI::IsMember({"joints", "filtered"}));
+  app.add_option("--name", prog_name, "program name (default: the output file's name)");
+  app.add_option("--speed", speed, "joint motions: percent of the axes' maximum speed (default 20); linear motions: "
+                                   "mm/s (default 250)");
+  app.add_option("--zone", zone, "approximation / blending in mm (FANUC: CNT 0..100); default 0: exact stop");
+  app.add_option("--program-tool", program_tool, "a KRL/RAPID program's TCP in the model's tool frame: X,Y,Z,A,B,C")
+      ->delimiter(',')->expected(6);
+  app.add_option("--program-base", program_base, "a KRL/RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
+      ->delimiter(',')->expected(6);
+  app.add_flag("--skip-unresolved", skip_unresolved, "pass targets computed at run time through with a warning");
+  app.add_option("--max-targets-per-file", max_per_file, "split longer KRL / LS programs into parts (default: 2000)");
   app.add_option("--frame", frame, "frame of the program poses")->check(CLI::IsMember({"base", "instrument"}));
   app.add_flag("--stream", stream, "read pose lines on stdin, write joint lines on stdout, flushed");
   app.add_flag("--finite-difference", fd, "the paper's finite-difference Jacobian (eq. 7)");
@@ -184,7 +206,22 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (program.empty() || out.empty()) throw kincal::InputError("--program and --out are needed (or --stream)");
-    const auto res = kincal::compensate_program_file(robot, program, out, opt);
+    kincal::WriterOptions w;
+    w.format = format.empty() ? kincal::controller_format_of_path(out) : kincal::controller_format_named(format);
+    w.targets = targets == "filtered" ? kincal::TargetKind::Filtered : kincal::TargetKind::Joints;
+    w.name = prog_name;
+    if (speed) w.speed = *speed;
+    if (zone) w.zone = *zone;
+    w.max_targets_per_file = max_per_file;
+    kincal::NativeOptions n;
+    if (program_tool.size() == 6)
+      n.program_tool = {kincal::Vec3(program_tool[0], program_tool[1], program_tool[2]),
+                        kincal::Vec3(program_tool[3], program_tool[4], program_tool[5])};
+    if (program_base.size() == 6)
+      n.program_base = {kincal::Vec3(program_base[0], program_base[1], program_base[2]),
+                        kincal::Vec3(program_base[3], program_base[4], program_base[5])};
+    n.skip_unresolved = skip_unresolved;
+    const auto res = kincal::compensate_to_controller(robot, program, out, opt, w, n).result;
     for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());
     std::fprintf(stderr, "%s: %zu poses, at most %d iterations, largest residual %.3g\n", out.c_str(),
                  res.q_deg.size(), res.max_iterations, res.max_residual);

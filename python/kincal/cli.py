@@ -14,6 +14,7 @@ import numpy as np
 
 from . import _core, load_robot
 from . import cli_campaign as campaign
+from . import cli_programs as programs
 from . import diagnose as diagnosis
 from . import feed as feedmod
 from . import fivebar, priors
@@ -66,7 +67,7 @@ def cmd_compensate(args) -> None:
     robot = load_robot(args.model)
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
-    res = _core.compensate_program(robot, args.program, args.out, **_comp_kwargs(args))
+    res = programs.compensate(robot, args, _comp_kwargs(args))
     for w in res["warnings"]:
         print(f"kincal compensate: warning: {w}", file=sys.stderr)
     it = np.asarray(res["iterations"])
@@ -316,8 +317,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp = sub.add_parser("compensate", help="Newton compensation of a pose program into a joint program")
     sp.add_argument("--model", required=True, help="built-in name, URDF file or model JSON")
     sp.add_argument("--program", required=True, help="pose program: CSV x,y,z,a,b,c or G-code X Y Z A B C")
-    sp.add_argument("--out", required=True, help="joint program: .csv (q1..q6) or G-code (A1=..)")
+    sp.add_argument("--out", required=True, help="the program: .csv (q1..q6), G-code (A1=..), .src (KRL), .mod "
+                                                 "(RAPID), .ls (FANUC LS), .script (URScript)")
     sp.add_argument("--frame", choices=["base", "instrument"], default="base")
+    programs.add_options(sp)
     sp.add_argument("--finite-difference", action="store_true", help="the paper's finite-difference Jacobian")
     sp.add_argument("--paper-start", action="store_true", help="start Newton from the nominal IK (no correction)")
     sp.add_argument("--nominal", action="store_true", help="nominal IK only: the uncompensated program")

@@ -1,0 +1,38 @@
+// kincal: a pose program compensated into a program in a controller's language (KRL, RAPID, FANUC
+// LS, URScript, G-code, CSV), with joint targets or filtered Cartesian targets (the nominal FK of the
+// compensated joints with the branch data that makes the controller take them).
+#pragma once
+
+#include "kincal/compensation/program.hpp"
+#include "kincal/io/controllers.hpp"
+
+#include <string>
+#include <vector>
+
+namespace kincal {
+
+/// The targets of compensated joints: with Filtered, the nominal FK pose and the branch data of each,
+/// checked: the controller's selection (select_branch, KRL / RAPID / FANUC LS) must bring back the
+/// compensated joints to 1e-6 deg, else InputError "where[i]: cause".
+std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::vector<Vec6>& q_deg, TargetKind kind,
+                                                 ControllerFormat format, const std::vector<std::string>& where);
+
+/// A native program's frames and what to do with targets computed at run time.
+struct NativeOptions {
+  Pose6 program_tool;  ///< the program's TCP in the model's tool frame (--program-tool)
+  Pose6 program_base;  ///< the program's base in the robot's base frame (--program-base)
+  bool skip_unresolved = false;  ///< pass run-time targets through with a warning (else an error)
+};
+
+/// Reads a pose program (CSV or G-code; a KRL or RAPID program: see NativeOptions), compensates it and writes it in w.format (every file, or
+/// none when anything fails). A G-code program written as G-code joints keeps its other lines.
+/// Returns the result with the files written in `files`.
+struct ControllerProgramResult {
+  ProgramResult result;
+  std::vector<std::string> files;
+};
+ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
+                                                 const std::string& out_path, const ProgramOptions& opt,
+                                                 const WriterOptions& w, const NativeOptions& native = {});
+
+}  // namespace kincal

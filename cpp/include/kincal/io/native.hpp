@@ -1,0 +1,54 @@
+// kincal: programs the controllers run, read in (KUKA KRL .src with its .dat, ABB RAPID modules) so
+// that their Cartesian targets can be compensated and written back with every other line unchanged,
+// byte for byte. Targets computed at run time (KRL: a target assigned in the program, a geometric
+// operator, a _REL motion; RAPID: Offs, RelTool, CRobT, ...) are listed as unresolved. Every error is
+// an InputError "file:line: cause".
+#pragma once
+
+#include "kincal/core/types.hpp"
+#include "kincal/io/controllers.hpp"
+
+#include <string>
+#include <vector>
+
+namespace kincal {
+
+/// One Cartesian target of a native program: where its value stands (a span of one line), its
+/// pose in the program's frame, and that frame (RAPID: the work object of its first motion).
+struct NativeTarget {
+  int file = 0;                        ///< index into NativeProgram::paths
+  int line = 0;                        ///< 1-based line of the value
+  size_t begin = 0, end = 0;           ///< the value's span in that line ("{...}" / "[[...],...]")
+  Pose6 pose;                          ///< in the program's frame (mm, KUKA ABC deg)
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();  ///< the program's frame in the robot base
+  std::string name;                    ///< declared name, or "" when inline
+};
+
+/// A target the program computes at run time: not compensated.
+struct UnresolvedTarget {
+  std::string where;  ///< "file:line"
+  std::string text;   ///< the motion statement
+};
+
+struct NativeProgram {
+  ControllerFormat format = ControllerFormat::Krl;
+  std::vector<std::string> paths;               ///< KRL: .src, .dat; RAPID: the module
+  std::vector<std::vector<std::string>> lines;  ///< every file's lines (without the '\n')
+  std::vector<bool> final_newline;              ///< whether each file ends in '\n'
+  std::vector<NativeTarget> targets;            ///< in the order the motions first use them
+  std::vector<UnresolvedTarget> unresolved;
+};
+
+/// Reads a KRL program (path: the .src; its .dat beside it when present) or a RAPID module.
+NativeProgram read_native_program(const std::string& path, ControllerFormat format);
+
+/// The program with target k's value replaced by pose[k] (in the program's frame) and the branch data
+/// of t[k] (KRL S and T, RAPID confdata); every other byte unchanged. Files go to out_path (KRL: its
+/// .src and .dat).
+std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
+                                             const std::vector<ControllerTarget>& t, const std::string& out_path);
+
+/// Splits s at top-level commas (outside brackets, braces, parentheses and strings); trims blanks.
+std::vector<std::string> split_top(const std::string& s);
+
+}  // namespace kincal

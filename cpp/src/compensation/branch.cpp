@@ -1,0 +1,116 @@
+#include "kincal/compensation/branch.hpp"
+
+#include "kincal/ik/ik.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <cmath>
+
+namespace kincal {
+
+namespace {
+
+double wrap180(double q) {  // to [-180, 180)
+  return q - 360.0 * std::floor((q + 180.0) / 360.0);
+}
+
+// point x moved by joint j of model m turned by q (deg)
+Vec3 turn(const Model& m, int j, double q_deg, const Vec3& x) {
+  return axis_rotation(m.axis(j), q_deg * kDeg) * (x - m.point(j)) + m.point(j);
+}
+
+int quadrant(double q) { return static_cast<int>(std::floor(q / 90.0)); }
+int fanuc_turn(double q) { return static_cast<int>(std::floor((q + 180.0) / 360.0)); }
+
+// the value of a joint with the wanted 360-degree multiple in format f (joint j, branch data of t)
+double unwrap(ControllerFormat f, int j, double q, const ControllerTarget& t) {
+  const double w = wrap180(q);
+  if (f == ControllerFormat::Krl) {
+    const bool neg = (t.kuka_t >> j) & 1;
+    if (neg) return w < 0 ? w : w - 360.0;
+    return w >= 0 ? w : w + 360.0;
+  }
+  const int idx = j == 0 ? 0 : j == 3 ? 1 : j == 5 ? 2 : -1;
+  if (idx < 0) return w;
+  if (f == ControllerFormat::Rapid) {
+    const int cf = t.abb_conf[static_cast<size_t>(idx)];
+    for (int k = -3; k <= 3; ++k)
+      if (quadrant(w + 360.0 * k) == cf) return w + 360.0 * k;
+    return std::nan("");
+  }
+  // FANUC: the turn number written after the three letters
+  int turns[3] = {0, 0, 0};
+  const size_t c = t.fanuc_config.find(',');
+  if (c == std::string::npos || std::sscanf(t.fanuc_config.c_str() + c + 1, "%d , %d , %d", &turns[0], &turns[1], &turns[2]) != 3)
+    return std::nan("");
+  return w + 360.0 * turns[idx];
+}
+
+}  // namespace
+
+ArmClass arm_class(const Robot& robot, const Vec6& q) {
+  const Model& m = *robot.nominal;
+  const IkStructure& st = robot.ik().structure();
+  if (!st.spherical_wrist_parallel_23)
+    throw InputError("filtered targets with branch data need a robot whose axes 2 and 3 are parallel and whose wrist "
+                     "axes meet (" + st.reason + ")");
+  const Vec3 wc0 = st.wrist_center;
+  const Vec3 w1 = m.axis(0), p1 = m.point(0);
+  Vec3 u = (wc0 - p1) - (wc0 - p1).dot(w1) * w1;  // x of the A1 system
+  if (u.norm() < 1e-9) u = Vec3::UnitX();
+  u.normalize();
+  const Vec3 y = Vec3::UnitZ().cross(u);
+  // in the A1 system (axis 1 undone): shoulder, elbow, wrist centre
+  const Vec3 s = m.point(1);
+  const Vec3 e = turn(m, 1, q[1], m.point(2));
+  const Vec3 wc = turn(m, 1, q[1], turn(m, 2, q[2], wc0));
+  ArmClass a;
+  a.x_a1 = (wc - p1).dot(u);
+  a.behind = a.x_a1 < 0;
+  const Vec3 ua = e - s, fa = wc - e;
+  a.elbow_sin = ua.cross(fa).dot(y) / (ua.norm() * fa.norm());
+  a.elbow_up = a.elbow_sin > 0;
+  a.wrist_negative = wrap180(q[4]) < 0;
+  return a;
+}
+
+void set_branch_data(const Robot& robot, ControllerTarget& t) {
+  const Vec6& q = t.q_deg;
+  const ArmClass a = arm_class(robot, q);
+  t.kuka_s = (a.behind ? 1 : 0) | (a.elbow_up ? 2 : 0) | (a.wrist_negative ? 4 : 0);
+  t.kuka_t = 0;
+  for (int j = 0; j < 6; ++j)
+    if (q[j] < 0) t.kuka_t |= 1 << j;
+  t.abb_conf = {{quadrant(q[0]), quadrant(q[3]), quadrant(q[5]),
+                 (a.behind ? 4 : 0) | (a.elbow_up ? 0 : 2) | (a.wrist_negative ? 1 : 0)}};
+  t.fanuc_config = std::string(wrap180(q[4]) > 0 ? "F" : "N") + " " + (a.elbow_up ? "U" : "D") + " " +
+                   (a.behind ? "B" : "T") + ", " + std::to_string(fanuc_turn(q[0])) + ", " +
+                   std::to_string(fanuc_turn(q[3])) + ", " + std::to_string(fanuc_turn(q[5]));
+}
+
+std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const ControllerTarget& t, std::string* why) {
+  const IkSolutions s = robot.ik().solve(pose_to_iso(t.pose), IkOptions());
+  if (s.status != IkStatus::Ok) {
+    if (why) *why = "the nominal inverse kinematics has no solution";
+    return std::nullopt;
+  }
+  std::optional<Vec6> found;
+  for (int i = 0; i < s.count; ++i) {
+    ControllerTarget c = t;
+    for (int j = 0; j < 6; ++j) c.q_deg[j] = unwrap(f, j, s.sol[static_cast<size_t>(i)].q_deg[j], t);
+    if (!c.q_deg.allFinite()) continue;
+    set_branch_data(robot, c);
+    const bool same = f == ControllerFormat::Krl     ? (c.kuka_s == t.kuka_s && c.kuka_t == t.kuka_t)
+                      : f == ControllerFormat::Rapid ? c.abb_conf == t.abb_conf
+                                                     : c.fanuc_config == t.fanuc_config;
+    if (!same) continue;
+    if (found && (*found - c.q_deg).cwiseAbs().maxCoeff() > 1e-6) {
+      if (why) *why = "two solutions have the same branch data";
+      return std::nullopt;
+    }
+    found = c.q_deg;
+  }
+  if (!found && why) *why = "no solution has the target's branch data";
+  return found;
+}
+
+}  // namespace kincal

@@ -1,0 +1,112 @@
+#include "kincal/compensation/controller_program.hpp"
+
+#include "kincal/compensation/branch.hpp"
+#include "kincal/io/file.hpp"
+#include "kincal/io/native.hpp"
+#include "kincal/io/programs.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <cstdio>
+
+namespace kincal {
+
+std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::vector<Vec6>& q, TargetKind kind,
+                                                 ControllerFormat format, const std::vector<std::string>& where) {
+  std::vector<ControllerTarget> out(q.size());
+  const bool branches = format == ControllerFormat::Krl || format == ControllerFormat::Rapid ||
+                        format == ControllerFormat::FanucLs;
+  for (size_t i = 0; i < q.size(); ++i) {
+    ControllerTarget& t = out[i];
+    t.q_deg = q[i];
+    if (kind != TargetKind::Filtered) continue;
+    t.pose = iso_to_pose(fk(*robot.nominal, VecQ(q[i] * kDeg)));
+    if (!branches) continue;
+    set_branch_data(robot, t);
+    std::string why;
+    const auto back = select_branch(robot, format, t, &why);
+    const std::string at = i < where.size() ? where[i] : "target " + std::to_string(i + 1);
+    if (!back) throw InputError(at + ": the filtered target's branch data does not fix the joints (" + why + ")");
+    const double d = (*back - q[i]).cwiseAbs().maxCoeff();
+    if (d > 1e-6) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, ": the controller's nominal model would reach the filtered target %.3g deg away "
+                    "from the compensated joints (near a singularity?)", d);
+      throw InputError(at + buf);
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// a KRL or RAPID program with its Cartesian targets filtered, every other byte unchanged
+ControllerProgramResult compensate_native(const Robot& robot, const std::string& in_path, ControllerFormat in_format,
+                                          const std::string& out_path, const ProgramOptions& opt,
+                                          const WriterOptions& w, const NativeOptions& n) {
+  if (w.format != in_format)
+    throw InputError(out_path + ": a " + format_name(in_format) + " program is written back as " +
+                     format_name(in_format) + " (not " + format_name(w.format) + ")");
+  if (w.targets != TargetKind::Filtered)
+    throw InputError(in_path + ": a " + std::string(format_name(in_format)) +
+                     " program is rewritten with filtered targets: give --targets filtered (joint targets in a native "
+                     "program are not done yet)");
+  const NativeProgram p = read_native_program(in_path, in_format);
+  ControllerProgramResult r;
+  if (!p.unresolved.empty()) {
+    std::string list;
+    for (const auto& u : p.unresolved) list += "\n  " + u.where + ": target computed at run time: " + u.text;
+    if (!n.skip_unresolved)
+      throw InputError(in_path + ": " + std::to_string(p.unresolved.size()) +
+                       " target(s) computed at run time (--skip-unresolved passes them through):" + list);
+    for (const auto& u : p.unresolved)
+      r.result.warnings.push_back(u.where + ": target computed at run time, passed through unchanged: " + u.text);
+  }
+  if (p.targets.empty()) throw InputError(in_path + ": the program has no Cartesian targets to compensate");
+  const Eigen::Isometry3d base = pose_to_iso(n.program_base), tool = pose_to_iso(n.program_tool);
+  std::vector<Pose6> poses;
+  std::vector<std::string> where_of;
+  for (const NativeTarget& t : p.targets) {
+    poses.push_back(iso_to_pose(base * t.frame * pose_to_iso(t.pose) * tool.inverse()));
+    where_of.push_back(where(p.paths[static_cast<size_t>(t.file)], t.line));
+  }
+  const auto warnings = std::move(r.result.warnings);
+  r.result = compensate_poses(robot, poses, where_of, opt);
+  r.result.warnings.insert(r.result.warnings.begin(), warnings.begin(), warnings.end());
+  const auto targets = controller_targets(robot, r.result.q_deg, TargetKind::Filtered, in_format, where_of);
+  std::vector<Pose6> back;
+  for (size_t k = 0; k < targets.size(); ++k)
+    back.push_back(iso_to_pose((base * p.targets[k].frame).inverse() * pose_to_iso(targets[k].pose) * tool));
+  const auto files = write_native_program(p, back, targets, out_path);
+  write_files_atomic(files);
+  for (const auto& f : files) r.files.push_back(f.path);
+  return r;
+}
+
+}  // namespace
+
+ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
+                                                 const std::string& out_path, const ProgramOptions& opt,
+                                                 const WriterOptions& w, const NativeOptions& native) {
+  const ControllerFormat in_format = controller_format_of_path(in_path);
+  if (in_format != ControllerFormat::Csv && in_format != ControllerFormat::Gcode)
+    return compensate_native(robot, in_path, in_format, out_path, opt, w, native);
+  const PoseProgram prog = read_pose_program(in_path);
+  std::vector<std::string> where_of;
+  where_of.reserve(prog.poses.size());
+  for (int l : prog.pose_line) where_of.push_back(where(in_path, l));
+  ControllerProgramResult r;
+  r.result = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
+  std::vector<OutputFile> files;
+  if (w.targets == TargetKind::Joints && (w.format == ControllerFormat::Csv || w.format == ControllerFormat::Gcode)) {
+    files.push_back({out_path, format_joint_program(prog, r.result.q_deg,
+                                                    w.format == ControllerFormat::Csv ? ProgramFormat::Csv
+                                                                                      : ProgramFormat::Gcode)});
+  } else {
+    files = write_controller_program(out_path, controller_targets(robot, r.result.q_deg, w.targets, w.format, where_of), w);
+  }
+  write_files_atomic(files);
+  for (const auto& f : files) r.files.push_back(f.path);
+  return r;
+}
+
+}  // namespace kincal

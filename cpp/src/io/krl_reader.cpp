@@ -1,0 +1,262 @@
+// kincal: KRL programs read in (.src with its .dat): DEF/END and DEFDAT/ENDDAT checked, the POS,
+// E6POS and FRAME declarations, and the motions PTP, LIN, CIRC (and SPTP, SLIN, SCIRC) to declared
+// names or inline aggregates. A target assigned in the program, a geometric operator (A:B), a _REL
+// motion are unresolved; E6AXIS / AXIS targets are joints and stay as they are.
+#include "controller_writers.hpp"
+#include "kincal/io/file.hpp"
+#include "kincal/io/native.hpp"
+
+#include <cctype>
+#include <cstdlib>
+#include <map>
+#include <regex>
+
+namespace kincal {
+
+namespace {
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// the line without its comment (';' outside strings)
+std::string code_of(const std::string& l) {
+  bool str = false;
+  for (size_t i = 0; i < l.size(); ++i) {
+    if (l[i] == '"') str = !str;
+    if (l[i] == ';' && !str) return l.substr(0, i);
+  }
+  return l;
+}
+
+}  // namespace
+
+std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl) {
+  std::vector<std::string> out;
+  size_t b = 0;
+  while (b < text.size()) {
+    const size_t e = text.find('\n', b);
+    if (e == std::string::npos) {
+      out.push_back(text.substr(b));
+      final_nl = false;
+      return out;
+    }
+    out.push_back(text.substr(b, e - b));
+    b = e + 1;
+  }
+  final_nl = true;
+  return out;
+}
+
+namespace {
+
+struct Decl {
+  std::string type;
+  int file = 0, line = 0;
+  size_t begin = 0, end = 0;
+  bool has_value = false, assigned = false;
+};
+
+// the numbers X Y Z A B C of a KRL aggregate "{X 1,Y 2,...}"
+Pose6 parse_aggregate(const std::string& agg, const std::string& at) {
+  Pose6 p;
+  bool seen[6] = {false, false, false, false, false, false};
+  for (const std::string& item : split_top(agg.substr(1, agg.size() - 2))) {
+    size_t k = 0;
+    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
+    const std::string key = upper(item.substr(0, k));
+    std::string val = item.substr(k);
+    val.erase(0, val.find_first_not_of(" \t"));
+    static const char* keys[6] = {"X", "Y", "Z", "A", "B", "C"};
+    for (int f = 0; f < 6; ++f) {
+      if (key != keys[f]) continue;
+      char* end = nullptr;
+      const double v = std::strtod(val.c_str(), &end);
+      if (val.empty() || end == val.c_str() || *end != '\0' || !std::isfinite(v))
+        throw InputError(at + ": " + key + " '" + val + "' is not a number");
+      (f < 3 ? p.xyz : p.abc)[f % 3] = v;
+      seen[f] = true;
+    }
+  }
+  for (int f = 0; f < 6; ++f)
+    if (!seen[f]) throw InputError(at + ": the target has no " + std::string(1, "XYZABC"[f]) + " value");
+  return p;
+}
+
+}  // namespace
+
+std::vector<std::string> split_top(const std::string& s) {
+  std::vector<std::string> out;
+  int depth = 0;
+  bool str = false;
+  std::string cur;
+  for (char c : s) {
+    if (c == '"') str = !str;
+    if (!str && (c == '{' || c == '[' || c == '(')) ++depth;
+    if (!str && (c == '}' || c == ']' || c == ')')) --depth;
+    if (!str && depth == 0 && c == ',') {
+      out.push_back(cur);
+      cur.clear();
+      continue;
+    }
+    cur += c;
+  }
+  out.push_back(cur);
+  for (auto& x : out) {
+    const size_t a = x.find_first_not_of(" \t\r"), b = x.find_last_not_of(" \t\r");
+    x = a == std::string::npos ? std::string() : x.substr(a, b - a + 1);
+  }
+  return out;
+}
+
+NativeProgram read_krl_program(const std::string& src_path) {
+  NativeProgram p;
+  p.format = ControllerFormat::Krl;
+  p.paths.push_back(src_path);
+  const std::string dat_path = ctl::with_ext(src_path, ".dat");
+  {
+    bool nl = true;
+    p.lines.push_back(krl_lines_of(read_text_file(src_path), nl));
+    p.final_newline.push_back(nl);
+  }
+  if (FILE* f = std::fopen(dat_path.c_str(), "rb")) {
+    std::fclose(f);
+    bool nl = true;
+    p.paths.push_back(dat_path);
+    p.lines.push_back(krl_lines_of(read_text_file(dat_path), nl));
+    p.final_newline.push_back(nl);
+  }
+  static const std::regex decl_re(
+      R"(^\s*(?:DECL\s+)?(?:GLOBAL\s+)?(E6POS|POS|FRAME|E6AXIS|AXIS)\s+(\w+)\s*(=\s*(\{.*\}))?\s*$)", std::regex::icase);
+  static const std::regex assign_re(R"(^\s*(\w+)(\.\w+)?\s*=)");
+  static const std::regex motion_re(R"(^\s*(PTP|LIN|CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL)\s+(.*)$)",
+                                    std::regex::icase);
+  std::map<std::string, Decl> decls;
+  // declarations and block structure, in both files
+  for (size_t f = 0; f < p.lines.size(); ++f) {
+    const char* open = f == 0 ? "DEF" : "DEFDAT";
+    const char* close = f == 0 ? "END" : "ENDDAT";
+    int open_line = 0;
+    bool closed = false;
+    for (size_t i = 0; i < p.lines[f].size(); ++i) {
+      const std::string code = code_of(p.lines[f][i]);
+      const std::string at = where(p.paths[f], static_cast<int>(i + 1));
+      std::string first = upper(code.substr(code.find_first_not_of(" \t") == std::string::npos ? code.size() : code.find_first_not_of(" \t")));
+      first = first.substr(0, first.find_first_of(" \t(\r"));
+      if (first == "GLOBAL" && std::regex_search(upper(code), std::regex(R"(^\s*GLOBAL\s+DEF(FCT)?\b)")))
+        first = "DEF";
+      if (first == open || (f == 0 && first == "DEFFCT")) {
+        if (open_line && !closed && f == 1) throw InputError(at + ": DEFDAT inside DEFDAT");
+        open_line = static_cast<int>(i + 1);
+        closed = false;
+      } else if (first == close || (f == 0 && first == "ENDFCT")) {
+        if (!open_line || closed) throw InputError(at + ": " + first + " without " + open);
+        closed = true;
+      }
+      std::smatch m;
+      if (std::regex_match(code, m, decl_re)) {
+        Decl d;
+        d.type = upper(m[1].str());
+        d.file = static_cast<int>(f);
+        d.line = static_cast<int>(i + 1);
+        d.has_value = m[4].matched;
+        if (d.has_value) {
+          d.begin = static_cast<size_t>(m.position(4));
+          d.end = d.begin + static_cast<size_t>(m.length(4));
+        }
+        decls[upper(m[2].str())] = d;
+      } else if (f == 0 && std::regex_search(code, m, assign_re)) {
+        const auto it = decls.find(upper(m[1].str()));
+        if (it != decls.end()) it->second.assigned = true;
+        else decls[upper(m[1].str())].assigned = true;  // declared later or elsewhere: computed at run time
+      }
+    }
+    if (!open_line) throw InputError(p.paths[f] + ": no " + open + " in the file");
+    if (!closed)
+      throw InputError(where(p.paths[f], open_line) + ": " + open + " is not closed by " + close + " (end of file)");
+  }
+  // the motions, in order
+  std::map<std::string, size_t> used;
+  for (size_t i = 0; i < p.lines[0].size(); ++i) {
+    const std::string code = code_of(p.lines[0][i]);
+    std::smatch m;
+    if (!std::regex_match(code, m, motion_re)) continue;
+    const std::string at = where(p.paths[0], static_cast<int>(i + 1));
+    const std::string kind = upper(m[1].str());
+    std::vector<std::string> args = split_top(m[2].str());
+    const size_t n_targets = kind.find("CIRC") != std::string::npos ? 2 : 1;
+    if (args.size() < n_targets) throw InputError(at + ": " + kind + " needs " + std::to_string(n_targets) + " target(s)");
+    const size_t base_pos = static_cast<size_t>(m.position(2));
+    for (size_t a = 0; a < n_targets; ++a) {
+      std::string arg = args[a];
+      arg = arg.substr(0, arg.find_first_of(" \t") == std::string::npos || arg[0] == '{' ? arg.size() : arg.find_first_of(" \t"));
+      if (kind.find("_REL") != std::string::npos || arg.find(':') != std::string::npos) {
+        p.unresolved.push_back({at, code});
+        continue;
+      }
+      if (!arg.empty() && arg[0] == '{') {
+        if (std::regex_search(arg, std::regex(R"(\{\s*A1\s)", std::regex::icase))) continue;  // joints
+        NativeTarget t;
+        t.file = 0;
+        t.line = static_cast<int>(i + 1);
+        t.begin = p.lines[0][i].find(arg, base_pos);
+        t.end = t.begin + arg.size();
+        t.pose = parse_aggregate(arg, at);
+        p.targets.push_back(t);
+        continue;
+      }
+      const std::string key = upper(arg);
+      if (key.empty() || key[0] == '$') {
+        p.unresolved.push_back({at, code});
+        continue;
+      }
+      const auto it = decls.find(key);
+      if (it == decls.end() || it->second.type.empty())
+        throw InputError(at + ": target '" + arg + "' is not declared (in the .src or its .dat)");
+      const Decl& d = it->second;
+      if (d.type == "E6AXIS" || d.type == "AXIS") continue;
+      if (d.assigned || !d.has_value) {
+        p.unresolved.push_back({at, code});
+        continue;
+      }
+      if (used.count(key)) continue;
+      used[key] = p.targets.size();
+      NativeTarget t;
+      t.file = d.file;
+      t.line = d.line;
+      t.begin = d.begin;
+      t.end = d.end;
+      t.name = arg;
+      t.pose = parse_aggregate(p.lines[static_cast<size_t>(d.file)][static_cast<size_t>(d.line - 1)].substr(d.begin, d.end - d.begin),
+                               where(p.paths[static_cast<size_t>(d.file)], d.line));
+      p.targets.push_back(t);
+    }
+  }
+  return p;
+}
+
+// a KRL aggregate with X..C, S and T replaced (every other field kept as written)
+std::string krl_aggregate(const std::string& old, const Pose6& pose, const ControllerTarget& t, bool is_frame) {
+  std::vector<std::string> items = split_top(old.substr(1, old.size() - 2));
+  const double v[6] = {pose.xyz[0], pose.xyz[1], pose.xyz[2], pose.abc[0], pose.abc[1], pose.abc[2]};
+  bool has_s = false, has_t = false;
+  for (std::string& item : items) {
+    size_t k = 0;
+    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
+    const std::string key = upper(item.substr(0, k));
+    const std::string sep = item.substr(k, item.find_first_not_of(" \t", k) - k);
+    const std::string name = item.substr(0, k);
+    for (int f = 0; f < 6; ++f)
+      if (key == std::string(1, "XYZABC"[f])) item = name + sep + ctl::fixed(v[f], f < 3 ? 4 : 6);
+    if (key == "S") item = name + sep + std::to_string(t.kuka_s), has_s = true;
+    if (key == "T") item = name + sep + std::to_string(t.kuka_t), has_t = true;
+  }
+  std::string out = "{";
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + items[i];
+  if (!is_frame && !has_s) out += ",S " + std::to_string(t.kuka_s);
+  if (!is_frame && !has_t) out += ",T " + std::to_string(t.kuka_t);
+  return out + "}";
+}
+
+}  // namespace kincal

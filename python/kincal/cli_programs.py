@@ -1,0 +1,55 @@
+"""`kincal compensate`'s program options: the controller languages (KUKA KRL, ABB RAPID, FANUC LS,
+URScript, G-code, CSV), joint or filtered targets, program name, speed, zone. Every format is written
+by the C++ core (the same code as kincal-compensate)."""
+
+from __future__ import annotations
+
+from . import _core
+
+FORMATS = ["krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"]
+
+
+def add_options(sp) -> None:
+    sp.add_argument("--format", choices=FORMATS,
+                    help="the output's language (default: by --out's extension: .src KRL (+ .dat), .mod RAPID, "
+                         ".ls FANUC LS, .script URScript, .csv CSV, other G-code)")
+    sp.add_argument("--targets", choices=["joints", "filtered"], default="joints",
+                    help="joints: joint targets (default); filtered: Cartesian targets with the controller's branch "
+                         "data (KUKA S/T, ABB confdata, FANUC configuration) that its nominal model turns into the "
+                         "compensated joints")
+    sp.add_argument("--name", default="", help="program name (default: the output file's name)")
+    sp.add_argument("--speed", type=float, help="joint motions: percent of the axes' maximum speed (default 20); "
+                                                "linear motions: mm/s (default 250)")
+    sp.add_argument("--zone", type=float, help="approximation / blending, mm (FANUC: the CNT value 0..100); "
+                                               "default 0: exact stop")
+    sp.add_argument("--max-targets-per-file", type=int, default=0,
+                    help="split KRL and LS programs with more targets into parts a main program calls (default 2000)")
+    sp.add_argument("--program-tool", help="a KRL or RAPID program's TCP in the model's tool frame: X,Y,Z,A,B,C (mm, deg)")
+    sp.add_argument("--program-base", help="a KRL or RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
+    sp.add_argument("--skip-unresolved", action="store_true",
+                    help="pass targets computed at run time (RelTool, Offs, CRobT, geometric operators) through "
+                         "unchanged with a warning (default: an error listing them)")
+
+
+def _frame(text, option: str) -> list:
+    if text is None:
+        return []
+    try:
+        v = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise ValueError(f"{option} {text}: expected X,Y,Z,A,B,C") from None
+    if len(v) != 6:
+        raise ValueError(f"{option} {text}: expected 6 numbers X,Y,Z,A,B,C")
+    return v
+
+
+def compensate(robot, args, comp_kwargs: dict) -> dict:
+    """Compensates args.program into args.out in the chosen language; returns the result dict (with
+    `files`, the files written)."""
+    return _core.compensate_to_controller(robot, str(args.program), str(args.out), **comp_kwargs,
+                                          format=args.format, targets=args.targets, name=args.name,
+                                          speed=args.speed, zone=args.zone,
+                                          max_targets_per_file=args.max_targets_per_file,
+                                          program_tool=_frame(args.program_tool, "--program-tool"),
+                                          program_base=_frame(args.program_base, "--program-base"),
+                                          skip_unresolved=args.skip_unresolved)

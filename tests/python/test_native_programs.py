@@ -1,0 +1,158 @@
+"""Native programs read and filtered (issue 19, readers): a hand-written KRL program (tests/data/programs/
+tape.src + tape.dat: folds, comments, I/O, a FOR loop, speeds, E6AXIS home, E6POS / POS / FRAME
+declarations, an inline LIN target, CIRC) and a RAPID module (tape.mod: tooldata, a declared work
+object, jointtarget + MoveAbsJ, CONST / PERS robtargets, an inline MoveL target, MoveC, I/O) are
+compensated on the calibrated kr500 (conftest: 1 mm / 0.05 deg errors and compliance, seed 9) with
+filtered targets. A line diff shows that only the target lines change; the changed targets, read by
+regular expressions here, are selected by the controller's branch choice (select_branch) as joints
+at which the calibrated model reaches the program's pose (within the printed precision). Targets
+computed at run time are an error unless --skip-unresolved; malformed programs give file:line
+errors, exit 1, and no output file."""
+
+from __future__ import annotations
+
+import difflib
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kincal
+from kincal import _core
+
+from conftest import run
+from test_filtered_targets import _abc_of_quaternion
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "programs"
+N = r"(-?\d+(?:\.\d+)?)"
+
+
+def _changed(a: str, b: str) -> list[int]:
+    """1-based numbers of the lines of a that differ in b (the files have the same line count)."""
+    la, lb = a.split("\n"), b.split("\n")
+    assert len(la) == len(lb)
+    ops = difflib.SequenceMatcher(a=la, b=lb, autojunk=False).get_opcodes()
+    assert all(op in ("equal", "replace") for op, *_ in ops)
+    return [i + 1 for i, (x, y) in enumerate(zip(la, lb)) if x != y]
+
+
+@pytest.fixture()
+def model(tmp_path, calibrated):
+    path = tmp_path / "m.json"
+    path.write_text(calibrated.to_json())
+    return path
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_krl_only_target_lines_change(tmp_path, model, calibrated, tool):
+    for f in ("tape.src", "tape.dat"):
+        shutil.copy(DATA / f, tmp_path / f)
+    (tmp_path / "out").mkdir()
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "tape.src"), "--out",
+            str(tmp_path / "out" / "tape.src"), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    src_in, src_out = (DATA / "tape.src").read_text(), (tmp_path / "out" / "tape.src").read_text()
+    dat_in, dat_out = (DATA / "tape.dat").read_text(), (tmp_path / "out" / "tape.dat").read_text()
+    # only the inline LIN target in the .src; in the .dat the five Cartesian declarations, not the
+    # E6AXIS home, the PDAT or the folds
+    assert [src_in.split("\n")[i - 1] for i in _changed(src_in, src_out)] == \
+        ["LIN {X 2000.0,Y -600.0,Z 520.0,A 0.0,B 90.0,C 0.0}"]
+    assert [dat_in.split("\n")[i - 1].split("=")[0] for i in _changed(dat_in, dat_out)] == \
+        ["DECL E6POS XP1", "DECL E6POS XP2", "DECL POS XAUX", "DECL E6POS XP3", "DECL FRAME XP4"]
+    # the new targets: nominal poses with S and T that the controller turns into joints at which
+    # the calibrated robot reaches the program's poses
+    desired = {m.group(1): [float(m.group(k)) for k in range(2, 8)] for m in re.finditer(
+        r"(\w+)=\{X " + N + ",Y " + N + ",Z " + N + ",A " + N + ",B " + N + ",C " + N, dat_in)}
+    desired["inline"] = [2000.0, -600.0, 520.0, 0.0, 90.0, 0.0]
+    new = {m.group(1): m for m in re.finditer(
+        r"(\w+)=\{X " + N + ",Y " + N + ",Z " + N + ",A " + N + ",B " + N + ",C " + N + r"(?:,S (\d+),T (\d+))?", dat_out)}
+    m = re.search(r"LIN \{X " + N + ",Y " + N + ",Z " + N + ",A " + N + ",B " + N + ",C " + N + r",S (\d+),T (\d+)\}",
+                  src_out)
+    assert m
+    checked = 0
+    for name, g, off in [(k, v, 1) for k, v in new.items() if v.group(8)] + [("inline", m, 0)]:
+        pose = [float(g.group(k + off)) for k in range(1, 7)]
+        t = {"pose": pose, "kuka_s": int(g.group(7 + off)), "kuka_t": int(g.group(8 + off))}
+        q = _core.select_branch(calibrated, "krl", t)
+        assert not isinstance(q, str), q
+        reached = kincal.fk(calibrated, q)[0]
+        assert np.linalg.norm(reached[:3] - desired[name][:3]) < 1e-3, name  # printed: 1e-4 mm, 1e-6 deg
+        assert np.linalg.norm(np.asarray(pose[:3]) - desired[name][:3]) > 0.1  # the target did move
+        checked += 1
+    assert checked == 5  # XP1, XP2, XAUX, XP3 and the inline target (the FRAME has no S and T)
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_rapid_only_target_lines_change(tmp_path, model, calibrated, tool):
+    args = ["compensate"] if tool == "kincal" else []
+    out = tmp_path / "tape.mod"
+    r = run(tool, *args, "--model", str(model), "--program", str(DATA / "tape.mod"), "--out", str(out),
+            "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    a, b = (DATA / "tape.mod").read_text(), out.read_text()
+    changed = [a.split("\n")[i - 1].strip() for i in _changed(a, b)]
+    assert [c.split("[[")[0] for c in changed] == ["CONST robtarget p1:=", "CONST robtarget p2:=",
+                                                   "PERS robtarget paux:=", "CONST robtarget p3:=", "MoveL "]
+    # the work object wtable (uframe x + 100, oframe y - 20) is applied: the robot's pose is the
+    # object pose moved by (100, -20, 0); the new robtargets stay in the work object
+    for line in b.split("\n"):
+        m = re.search(r"\[\[([^\]]*)\],\[([^\]]*)\],\[([^\]]*)\],\[9E9", line)
+        if not m:
+            continue
+        old = re.search(r"\[\[([^\]]*)\]", a.split("\n")[b.split("\n").index(line)]).group(1)
+        want = np.array([float(v) for v in old.split(",")]) + [100, -20, 0]
+        xyz = [float(v) for v in m.group(1).split(",")]
+        t = {"pose": list(np.array(xyz) + [100, -20, 0]) + _abc_of_quaternion(*[float(v) for v in m.group(2).split(",")]),
+             "abb_conf": [int(v) for v in m.group(3).split(",")]}
+        q = _core.select_branch(calibrated, "rapid", t)
+        assert not isinstance(q, str), q
+        assert np.linalg.norm(kincal.fk(calibrated, q)[0][:3] - want) < 1e-3
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_runtime_targets_are_listed(tmp_path, model, tool):
+    mod = (DATA / "tape.mod").read_text().replace(
+        "    WaitTime 0.5;\n", "    WaitTime 0.5;\n    MoveL Offs(p3,0,0,50),v100,fine,thead\\WObj:=wtable;\n"
+        "    MoveL RelTool(p3,0,0,-20),v100,fine,thead\\WObj:=wtable;\n")
+    (tmp_path / "rt.mod").write_text(mod)
+    args = ["compensate"] if tool == "kincal" else []
+    out = tmp_path / "out.mod"
+    r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "rt.mod"), "--out", str(out),
+            "--targets", "filtered")
+    assert r.returncode == 1 and "2 target(s) computed at run time" in r.stderr, r.stderr
+    assert "rt.mod:20:" in r.stderr and "Offs(p3" in r.stderr and "rt.mod:21:" in r.stderr and not out.exists()
+    r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "rt.mod"), "--out", str(out),
+            "--targets", "filtered", "--skip-unresolved")
+    assert r.returncode == 0 and "rt.mod:20: target computed at run time, passed through" in r.stderr, r.stderr
+    assert "MoveL Offs(p3,0,0,50)," in out.read_text()
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+@pytest.mark.parametrize("ext,edit,message", [
+    (".mod", ("ENDMODULE\n", ""), "tape.mod:1: MODULE is not closed by ENDMODULE"),
+    (".mod", ("MoveL p2,", "MoveL p9,"), "tape.mod:16: target 'p9' is not declared"),
+    (".mod", ("[0,-2,-2,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n  CONST robtarget p2", "[0,-2,-2,0]];\n  CONST robtarget p2"),
+     "tape.mod:6: a robtarget has 4 parts"),
+    (".mod", ("[[1900,-720,500]", "[[1900,-72O,500]"), "tape.mod:7: the robtarget's trans: '-72O' is not a number"),
+    (".src", ("PTP XHOME\nEND\n", "PTP XHOME\n"), "tape.src:4: DEF is not closed by END"),
+    (".src", ("LIN XP2 C_DIS", "LIN XP7 C_DIS"), "tape.src:26: target 'XP7' is not declared"),
+    (".dat", ("Z 500.0,A 0.0", "Z 5OO.0,A 0.0"), "tape.dat:10: Z '5OO.0' is not a number"),
+    (".dat", ("ENDDAT\n", ""), "tape.dat:3: DEFDAT is not closed by ENDDAT"),
+])
+def test_malformed_programs(tmp_path, model, tool, ext, edit, message):
+    for f in ("tape.src", "tape.dat", "tape.mod"):
+        text = (DATA / f).read_text()
+        if f.endswith(ext):
+            assert edit[0] in text
+            text = text.replace(edit[0], edit[1], 1)
+        (tmp_path / f).write_text(text)
+    (tmp_path / "out").mkdir()
+    prog = tmp_path / ("tape.mod" if ext == ".mod" else "tape.src")
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(prog), "--out", str(tmp_path / "out" / prog.name),
+            "--targets", "filtered")
+    assert r.returncode == 1 and message in r.stderr, r.stderr
+    assert not any((tmp_path / "out").iterdir())

@@ -477,10 +477,11 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
       s2.solve(free_idx, nullptr, opt.loss == "none" ? 0.0 : scale, prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
+      if (pass == 1) break;
+      // res.noise_mm stays the one the final solve weighed the priors and set the loss with
       const double again = s2.noise(determined.size());
-      const bool settled = std::abs(again / res.noise_mm - 1) < 0.02;
+      if (std::abs(again / res.noise_mm - 1) < 0.02) break;
       res.noise_mm = again;
-      if (settled) break;
     }
   }
   res.loss_scale_mm = s2.scale();

@@ -13,7 +13,7 @@ namespace kincal {
 
 std::vector<std::pair<std::string, double>> default_prior_sd() {
   const double deg = M_PI / 180.0;
-  return {{"joint_mm", 1.0}, {"joint_rad", 0.1 * deg}, {"tool_mm", 5.0}, {"tool_rad", 1.0 * deg}, {"compliance", 0.01}};
+  return {{"joint_mm", 1.0}, {"joint_rad", 0.1 * deg}, {"tool_mm", 5.0}, {"tool_rad", 1.0 * deg}};
 }
 
 std::vector<double> prior_sds(const ParamLayout& L, const IdentifyOptions& opt) {

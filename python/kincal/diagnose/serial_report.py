@@ -98,18 +98,23 @@ def _point_errors(res, data: dict) -> np.ndarray:
 
 
 def _variables_figure(plt, scores: list, path: Path) -> None:
-    """The held-out share of the residual each candidate variable explains, one bar each (a share at
-    or below zero: fitting the variable only adds noise; drawn as none, its value written)."""
+    """The held-out share of the residual each candidate variable explains, one bar each, signed (a
+    share below zero: fitting the variable only adds noise, the bar goes left of zero)."""
     fig, ax = plt.subplots(figsize=(8, 1.0 + 0.28 * len(scores)), constrained_layout=True)
     y = np.arange(len(scores))[::-1]
     vals = [100 * s["share"] for s in scores]
-    ax.barh(y, [max(v, 0.0) for v in vals],
-            color=["tab:red" if v >= 100 * residual_vars.CARRIES else "tab:gray" for v in vals])
-    for yy, v in zip(y, vals):
-        ax.text(max(v, 0.0), yy, f" {v:.1f}%" if v > 0 else f" {v:.1f}% (nothing)", va="center", fontsize=8)
+    carries = 100 * residual_vars.CARRIES
+    ax.barh(y, vals, color=["tab:red" if v >= carries else ("tab:gray" if v > 0 else "silver") for v in vals])
+    for yy, v in zip(y, vals):  # the value beside the bar's end, outside it
+        ax.text(v, yy, f" {v:.1f}%" if v > 0 else f"{v:.1f}% ", va="center", ha="left" if v > 0 else "right",
+                fontsize=8)
     ax.set_yticks(y, [s["variable"] for s in scores], fontsize=8)
-    ax.set_xlim(0, max(10.0, max(vals)) * 1.25)
-    ax.axvline(100 * residual_vars.CARRIES, color="k", ls=":", lw=0.8)
+    lo, hi = min(0.0, min(vals)), max(10.0, max(vals))
+    ax.set_xlim(lo - 0.25 * (hi - lo) if lo < 0 else 0.0, hi * 1.25)
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.axvline(carries, color="k", ls=":", lw=0.8)
+    ax.text(carries, len(scores) - 0.5, f" {carries:.0f}%: carries the rest", fontsize=8, va="bottom")
+    ax.set_ylim(-0.7, len(scores) + 0.1)
     ax.set_xlabel("share of the final residual's variance a smooth function of the variable explains, held out (%)")
     fig.savefig(path, dpi=100)
     plt.close(fig)

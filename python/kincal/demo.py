@@ -175,7 +175,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
                                      "RP_l_mm": {p["point"]: p["RP_l_mm"] for p in v["report"]["points"]},
                                      "AD_mm": v["report"]["AD_mm"], "RD_mm": v["report"]["RD_mm"]}
                                  for k, v in iso["programs"].items()}},
-        "fivebar_vdi3441_um": {f"{m} {a}": {k: r["vdi3441"][k] * 1000 for k in ("P", "P_per_m", "Pa", "Ps", "U")}
+        "fivebar_vdi3441_um": {f"{m} {a}": {k: r["vdi3441"][k] * 1000 for k in ("P", "P_per_m", "Pa", "Ps", "U", "Ps_mean", "U_mean")}
                                for (m, a), r in axes.items()},
         "diagnosed_model_effects": diagnosed.effect_labels(),
         "newton_iterations": {"max": int(np.max(com["iterations"]))},

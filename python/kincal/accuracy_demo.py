@@ -105,7 +105,7 @@ def fivebar_axes(sixbar, model, matrix, out: Path, seed: int) -> dict:
     xm = (x0 + x1) / 2.0
     lines = {"x": (np.c_[np.linspace(x0 + 1, x1 - 1, AXIS_TARGETS), np.zeros(AXIS_TARGETS)], 0),
              "y": (np.c_[np.full(AXIS_TARGETS, xm), np.linspace(y0 + 1, y1 - 1, AXIS_TARGETS)], 1)}
-    res = {}
+    res: dict = {}
     for mech, (m, mx) in (("corrected", (model, matrix)), ("nominal", (fb.FiveBar(), None))):
         for name, (line, coord) in lines.items():
             folder = out / "fivebar" / f"axis_{mech}_{name}"

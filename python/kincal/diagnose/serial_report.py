@@ -146,7 +146,7 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     ax.set_yticks(y, labels, fontsize=8)
     ax.set_xlabel("cross-validated RMS (um), each step adds one effect to the model above it")
     ax.set_xlim(0, max(vals) * 1.15)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower left", bbox_to_anchor=(1.01, 0.0), fontsize=8, frameon=False)  # beside the bars, never on them
     fig.savefig(out / "gap.png", dpi=100)
     plt.close(fig)
     files.append("gap.png")
@@ -197,7 +197,8 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
 residual of the current model (projected off what the model can already absorb), adds the best significant one,
 refits everything and checks that the cross-validated RMS falls ({diag['folds']} folds of whole configurations:
 the repeats of one of the {diag['validation']['configurations']} configurations never sit on both sides).</p>
-{report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True)}
+{report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True)
+ if rows else "<p>No effect was named: no candidate of the library passed the test.</p>"}
 <p><b>Result:</b> cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um against a noise estimate of
 {diag['noise_rms_mm'] * 1000:.1f} um: {report.esc(diag['verdict'])}.</p>
 <ul>{notes}</ul>

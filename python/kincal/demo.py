@@ -175,7 +175,8 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
                                      "RP_l_mm": {p["point"]: p["RP_l_mm"] for p in v["report"]["points"]},
                                      "AD_mm": v["report"]["AD_mm"], "RD_mm": v["report"]["RD_mm"]}
                                  for k, v in iso["programs"].items()}},
-        "fivebar_vdi3441_um": {f"{m} {a}": {k: r["vdi3441"][k] * 1000 for k in ("P", "P_per_m", "Pa", "Ps", "U", "Ps_mean", "U_mean")}
+        "fivebar_vdi3441_um": {f"{m} {a}": {k: r["vdi3441"][k] * 1000
+                                            for k in ("P", "P_per_m", "Pa", "Ps", "U", "Ps_mean", "U_mean")}
                                for (m, a), r in axes.items()},
         "diagnosed_model_effects": diagnosed.effect_labels(),
         "newton_iterations": {"max": int(np.max(com["iterations"]))},
@@ -229,7 +230,8 @@ def _report(out: Path, res, diag, summary, err_unc, err_com, err_dia, fres, tabl
                 f"{v['max_error_mm'] * 1000:.1f}"] for k, v in table_fits.items()]
     hb = summary["fivebar_max_error_mm"]
     t1_html = ("<p>Table I of the Kiper paper, ranked as the paper does for the polynomial and least-squares methods:</p>"
-               + report.table(["method", "points", "a", "b", "c", "d", "largest error (um)"], t1_rows, numeric=True, labelled=True)
+               + report.table(["method", "points", "a", "b", "c", "d", "largest error (um)"], t1_rows, numeric=True,
+                              labelled=True)
                if t1_rows else "<p>Table I of the Kiper paper (shared/data/fivebar-table1.csv) was not found above "
                "the package or the working folder: its fits are left out.</p>")
     feed_imgs = "".join(report.figure(f"feed/axis{a}.png", f"axis {a}") for a in (1, 2, 3))
@@ -273,7 +275,8 @@ the rotation between the commanded and the attained tool orientation):</p>
                 f"{summary[f'orientation_error_{k}_deg']['mean']:.4f}", f"{summary[f'orientation_error_{k}_deg']['max']:.4f}"]
                for label, k in (("uncompensated (nominal IK)", "uncompensated"),
                                 ("compensated on the identified model", "compensated"),
-                                ("compensated on the diagnosed model", "compensated_diagnosed"))], numeric=True, labelled=True)}
+                                ("compensated on the diagnosed model", "compensated_diagnosed"))],
+              numeric=True, labelled=True)}
 <p>The paper's own figures, on its real robot: 2.04 &rarr; 0.58 mm and 0.147 &rarr; 0.095 deg.</p>
 {report.figure("line_errors.png", "line errors")}
 

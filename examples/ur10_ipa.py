@@ -9,7 +9,9 @@ measured from its own tracker placement), in the calls a user makes:
    refitted (`kincal validate --model DIR/model.json --data A.csv --out VA.json`);
 3. with --joint, all four series identified jointly, one placement per series (a `setup` column),
    validated by grouped 5-fold cross-validation (whole configurations per fold) and by holding out
-   each series whole (`kincal identify --data ABCD.csv --hold-out-setups`)."""
+   each series whole (`kincal identify --data ABCD.csv --hold-out-setups`; per series: the other
+   three identified jointly, then `kincal validate` on it), and the diagnosis of all four jointly
+   (`kincal diagnose --data ABCD.csv --effects joint_compliance --out DIR-joint`: what remains)."""
 
 from __future__ import annotations
 
@@ -65,7 +67,17 @@ def main() -> None:
         print("\nall four series jointly (one tracker placement each):\n" + res.summary())
         held = ident.identify(robot, every, effects="joint_compliance", hold_out_setups=True)
         v = held.validation
-        print(f"\neach series held out whole: RMS {v['before_rms_mm']:.3f} -> {v['after_rms_mm']:.3f} mm")
+        print(f"\neach series held out whole: RMS {v['before_rms_mm']:.3f} -> {v['after_rms_mm']:.3f} mm, mean "
+              f"{v['before_mean_mm']:.3f} -> {v['after_mean_mm']:.3f} mm, max {v['before_max_mm']:.3f} -> "
+              f"{v['after_max_mm']:.3f} mm")
+        for k in SERIES:
+            others = with_setups({n: series[n] for n in SERIES if n != k})
+            fit = ident.identify(robot, others, effects="joint_compliance", k_folds=0)
+            print(f"\nseries {k}, the model of the other three series with only the placement and probe refitted:")
+            print(setups.validation_summary(ident.validate(fit.robot, series[k])))
+        jdiag, jmodel = diagnose.run(robot, every, args.out + "-joint", effects="joint_compliance",
+                                     title="kincal diagnose: UR10 series A-D jointly (one setup each)", progress=print)
+        print("\nthe diagnosis of all four series jointly:\n" + diagnose.summary(jdiag, jmodel, args.out + "-joint", 0.0))
 
 
 if __name__ == "__main__":

@@ -162,8 +162,9 @@ def iso9283_html(runs: dict, res: dict, title: str) -> str:
 
 
 def run_iso9283(data: str, out: str, distance: Optional[str] = None, model: Optional[str] = None,
-                frame: str = "base") -> dict:
-    """`kincal accuracy iso9283`: DIR/iso9283.json, DIR/report.html and the figures; returns the report."""
+                frame: str = "base", frame_label: Optional[str] = None) -> dict:
+    """`kincal accuracy iso9283`: DIR/iso9283.json, DIR/report.html and the figures; returns the report.
+    ``frame_label``: the frame the data are in, as the report says it (default "base (as given)")."""
     names = acc.parse_distance(distance) if distance is not None else None
     if frame == "instrument" and model is None:
         raise ValueError("--frame instrument needs --model M (an identified model: its instrument placement)")
@@ -173,6 +174,8 @@ def run_iso9283(data: str, out: str, distance: Optional[str] = None, model: Opti
     runs = acc.read_runs(data)
     if model is not None:
         runs = acc.to_base(runs, model)
+    elif frame_label is not None:
+        runs["frame"] = frame_label
     res = acc.iso9283(runs, names)
     files = {"deviations.png": _deviation_figure(runs, res), "summary.png": _summary_figure(res),
              "iso9283.json": json.dumps(res, indent=1) + "\n",

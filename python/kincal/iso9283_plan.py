@@ -46,7 +46,7 @@ class Reach:
     def one(self, p: np.ndarray) -> bool:
         if self.z_min is not None and p[2] < self.z_min:
             return False
-        return _core.ik_nearest(self.robot, np.r_[p, self.abc], self.ref) is not None
+        return _core.ik_nearest(self.robot, np.concatenate((p, self.abc)), self.ref) is not None
 
     def many(self, pts: np.ndarray) -> np.ndarray:
         return np.fromiter((self.one(p) for p in pts), dtype=bool, count=len(pts))

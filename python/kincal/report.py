@@ -14,6 +14,7 @@ from . import _core
 STYLE = """body{font-family:sans-serif;max-width:980px;margin:2em auto;color:#222;line-height:1.4}
 table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:3px 8px}
 table.num td,table.num th{text-align:right}
+table.lab td:first-child{text-align:left}
 img{max-width:100%}code{background:#f3f3f3}"""
 
 # counts the figures that loaded (checked by the demo test in a headless browser)
@@ -38,11 +39,12 @@ def page(title: str, body: str) -> str:
 """
 
 
-def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = False) -> str:
-    """A table of escaped cells; ``numeric``: the cells right-aligned (columns of numbers)."""
+def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = False, labelled: bool = False) -> str:
+    """A table of escaped cells; ``numeric``: the cells right-aligned (columns of numbers);
+    ``labelled``: with ``numeric``, the first column (the rows' names) left-aligned."""
     h = "".join(f"<th>{esc(x)}</th>" for x in header)
     b = "".join("<tr>" + "".join(f"<td>{esc(x)}</td>" for x in r) + "</tr>" for r in rows)
-    cls = ' class="num"' if numeric else ""
+    cls = (' class="num lab"' if labelled else ' class="num"') if numeric else ""
     return f"<table{cls}><tr>{h}</tr>{b}</table>"
 
 

@@ -62,24 +62,26 @@ def robot_for_setup(robot: Robot, name: str, source: str = "the model") -> Robot
 
 
 def validation_summary(v: dict) -> str:
-    """The table of identify's summary for a validation (validate()'s result): RMS and largest
-    position error before (the nominal model) and after (the calibrated one), the placements
-    refitted on both; per setup when there are several, and the orientation when measured."""
-    lines = [f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'max before':>12}{'max after':>12}"]
+    """The table of identify's summary for a validation (validate()'s result): RMS, mean (the Samak
+    paper's figure) and largest position error before (the nominal model) and after (the calibrated
+    one), the placements refitted on both; per setup when there are several, and the orientation
+    when measured."""
+    lines = [f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
+             f"{'mean after':>12}{'max before':>12}{'max after':>12}"]
 
-    def row(label: str, f: dict) -> None:
-        lines.append(f"{label:<28}{f['before_rms_mm']:>12.4f}{f['rms_mm']:>12.4f}"
-                     f"{f['before_max_mm']:>12.4f}{f['max_mm']:>12.4f}")
+    def row(label: str, f: dict, unit: str = "mm") -> None:
+        lines.append(f"{label:<28}" + "".join(f"{f[f'{w}{s}_{unit}']:>12.4f}" for s in ("rms", "mean", "max")
+                                              for w in ("before_", "")))
 
     row(f"new points ({v['points']})", v)
     for name, f in v.get("setups", {}).items():
         row(f"  setup {name} ({f['points']})", f)
     if "rms_deg" in v:
-        lines.append(f"{'orientation (deg)':<28}{v['before_rms_deg']:>12.4f}{v['rms_deg']:>12.4f}"
-                     f"{v['before_max_deg']:>12.4f}{v['max_deg']:>12.4f}")
+        row("orientation (deg)", v, "deg")
+        for name, f in v.get("setups", {}).items():
+            row(f"  setup {name}", f, "deg")
     lines.append("")
-    lines.append(f"refitted: {v['refitted']}; mean error {v['mean_mm']:.4f} mm"
-                 + (f", {v['mean_deg']:.4f} deg" if "mean_deg" in v else ""))
+    lines.append(f"refitted: {v['refitted']}")
     return "\n".join(lines)
 
 
@@ -119,7 +121,7 @@ def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[
     and before (the nominal one) and, with measured orientations, the orientation errors (deg):
     ``points``, ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm`` (``before_mean_mm``,
     ``before_max_mm``; ``rms_deg``, ``mean_deg``, ``max_deg``, ``before_rms_deg``,
-    ``before_max_deg``), the same per setup under ``setups`` when the data have several, and
+    ``before_mean_deg``, ``before_max_deg``), the same per setup under ``setups`` when the data have several, and
     ``rows``, ``after_rms_mm``, ``after_max_mm`` (the names of earlier versions)."""
     ea, eb = np.asarray(after), np.asarray(before)
 
@@ -130,7 +132,7 @@ def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[
         if o_after is not None and o_before is not None:
             oa, ob = np.asarray(o_after)[mask], np.asarray(o_before)[mask]
             out.update(rms_deg=_rms(oa), mean_deg=float(np.mean(oa)), max_deg=float(np.max(oa)),
-                       before_rms_deg=_rms(ob), before_max_deg=float(np.max(ob)))
+                       before_rms_deg=_rms(ob), before_mean_deg=float(np.mean(ob)), before_max_deg=float(np.max(ob)))
         return out
 
     v = figures(np.ones(len(ea), dtype=bool))

@@ -4,6 +4,7 @@ bench, and bad input (one message naming file, line and cause; non-zero exit; no
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 from pathlib import Path
 
@@ -136,8 +137,9 @@ def test_stream_stops_on_a_bad_line(calibrated, tmp_path):
 def test_demo(tmp_path):
     """kincal demo (truth: kr500 seed 7 with compliance and a hidden backlash on joint 2): the line
     compensated on the identified model lands far closer on the true robot than the uncompensated
-    one; the diagnosis names the backlash; the five-bar reaches 30 um; report.html opens in a real
-    headless browser (Debian's chromium) with every figure loaded."""
+    one; the diagnosis names the backlash; the five-bar reaches 30 um; the standard figures (issue 18)
+    are those of their statistics; report.html opens in a real headless browser (Debian's chromium)
+    with every figure loaded."""
     import re
     import shutil
 
@@ -158,6 +160,31 @@ def test_demo(tmp_path):
     assert s["fivebar_max_error_mm"]["fit_and_matrix"] < 0.030
     assert s["feed_violations"] == {"program": 0, "compare": 0}
     assert s["seconds"] < 180
+    # the Samak paper's figures of the line: orientation too, and compensation reduces both means
+    for what in ("position_error", "orientation_error"):
+        unit = "mm" if what == "position_error" else "deg"
+        assert s[f"{what}_compensated_{unit}"]["mean"] < s[f"{what}_uncompensated_{unit}"]["mean"]
+    # ISO 9283 on the truth (the truth deterministic; its repeatability a Gaussian scatter of sigma per
+    # axis): RP_l of isotropic 3-D scatter is sigma (2 sqrt(2/pi) + 3 sqrt(3 - 8/pi)) = 3.616 sigma, the
+    # mean over 3 programs x 5 points of 30 cycles within 10% (its standard error is about 2%)
+    iso = s["iso9283"]
+    sigma = iso["repeatability_sigma_mm"]
+    rp = [v for p in iso["programs"].values() for v in p["RP_l_mm"].values()]
+    theory = sigma * (2 * math.sqrt(2 / math.pi) + 3 * math.sqrt(3 - 8 / math.pi))
+    assert len(rp) == 15 and abs(np.mean(rp) / theory - 1) < 0.10, (np.mean(rp), theory)
+    # AP_P: the uncompensated program misses every pose by the truth's errors (mm); the diagnosed
+    # model (the backlash included) within 0.05 mm (30 cycles average the scatter to ~6 um)
+    assert min(iso["programs"]["uncompensated"]["AP_P_mm"].values()) > 1.0
+    assert max(iso["programs"]["diagnosed"]["AP_P_mm"].values()) < 0.05
+    assert abs(iso["programs"]["diagnosed"]["AD_mm"]) < 0.05
+    # VDI/DGQ 3441 of the five-bar: the corrected mechanism's P far below the nominal one's; the
+    # stated reversal (3 um each way) gives U_mean about 6 um; the scatter (1 um noise per axis and a
+    # uniform 2 um clearance disc: 1.41 um per axis) gives Ps_mean about 6 x 0.94 x 1.41 = 8.0 um
+    vdi = s["fivebar_vdi3441_um"]
+    for axis in ("x", "y"):
+        c = vdi[f"corrected {axis}"]
+        assert c["P"] < vdi[f"nominal {axis}"]["P"] / 10
+        assert 4.5 < c["U_mean"] < 7.5 and abs(c["Ps_mean"] / 7.98 - 1) < 0.25, c
     for f in ("uncompensated.gcode", "compensated.gcode", "compensated.csv", "model.json", "line.gcode",
               "report.html", "diagnosis/report.html", "feed/feed.json", "fivebar/fit.json"):
         assert (d / f).stat().st_size > 0

@@ -125,6 +125,9 @@ def test_validate_command_on_a_moved_instrument(tmp_path, kr500, truth):
             "--out", str(out))
     assert r.returncode == 0, r.stderr
     assert "RMS before" in r.stdout and "new points (360)" in r.stdout
+    # the table gives the mean errors (the Samak paper's figure) beside RMS and max, as identify's does
+    head = next(line for line in r.stdout.splitlines() if "RMS before" in line).split()
+    assert "mean" in head and head.count("before") == 3 and head.count("after") == 3
     v = json.loads(out.read_text())
     for k in ("points", "rms_mm", "mean_mm", "max_mm", "before_rms_mm"):
         assert k in v
@@ -156,6 +159,9 @@ def test_validate_with_orientations_and_setups(kr500, truth):
     assert [p["name"] for p in v["placements"]] == ["B", "C"]
     # 3 components of 0.005 deg: an angle of about 0.0087 deg RMS
     assert v["rms_deg"] < 1.5 * 0.005 * np.sqrt(3) and v["mean_deg"] <= v["rms_deg"]
+    assert v["before_mean_deg"] <= v["before_rms_deg"]
+    table = ident.validation_summary(v)
+    assert table.count("orientation (deg)") == 1 and table.count("  setup ") == 4  # position and angle per setup
     assert v["rms_mm"] < 1.3 * 0.02 * np.sqrt(3)
 
 

@@ -98,18 +98,23 @@ def _point_errors(res, data: dict) -> np.ndarray:
 
 
 def _variables_figure(plt, scores: list, path: Path) -> None:
-    """The held-out share of the residual each candidate variable explains, one bar each (a share at
-    or below zero: fitting the variable only adds noise; drawn as none, its value written)."""
+    """The held-out share of the residual each candidate variable explains, one bar each, signed (a
+    share below zero: fitting the variable only adds noise, the bar goes left of zero)."""
     fig, ax = plt.subplots(figsize=(8, 1.0 + 0.28 * len(scores)), constrained_layout=True)
     y = np.arange(len(scores))[::-1]
     vals = [100 * s["share"] for s in scores]
-    ax.barh(y, [max(v, 0.0) for v in vals],
-            color=["tab:red" if v >= 100 * residual_vars.CARRIES else "tab:gray" for v in vals])
-    for yy, v in zip(y, vals):
-        ax.text(max(v, 0.0), yy, f" {v:.1f}%" if v > 0 else f" {v:.1f}% (nothing)", va="center", fontsize=8)
+    carries = 100 * residual_vars.CARRIES
+    ax.barh(y, vals, color=["tab:red" if v >= carries else ("tab:gray" if v > 0 else "silver") for v in vals])
+    for yy, v in zip(y, vals):  # the value beside the bar's end, outside it
+        ax.text(v, yy, f" {v:.1f}%" if v > 0 else f"{v:.1f}% ", va="center", ha="left" if v > 0 else "right",
+                fontsize=8)
     ax.set_yticks(y, [s["variable"] for s in scores], fontsize=8)
-    ax.set_xlim(0, max(10.0, max(vals)) * 1.25)
-    ax.axvline(100 * residual_vars.CARRIES, color="k", ls=":", lw=0.8)
+    lo, hi = min(0.0, min(vals)), max(10.0, max(vals))
+    ax.set_xlim(lo - 0.25 * (hi - lo) if lo < 0 else 0.0, hi * 1.25)
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.axvline(carries, color="k", ls=":", lw=0.8)
+    ax.text(carries, len(scores) - 0.5, f" {carries:.0f}%: carries the rest", fontsize=8, va="bottom")
+    ax.set_ylim(-0.7, len(scores) + 0.1)
     ax.set_xlabel("share of the final residual's variance a smooth function of the variable explains, held out (%)")
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -141,7 +146,7 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     ax.set_yticks(y, labels, fontsize=8)
     ax.set_xlabel("cross-validated RMS (um), each step adds one effect to the model above it")
     ax.set_xlim(0, max(vals) * 1.15)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower left", bbox_to_anchor=(1.01, 0.0), fontsize=8, frameon=False)  # beside the bars, never on them
     fig.savefig(out / "gap.png", dpi=100)
     plt.close(fig)
     files.append("gap.png")
@@ -192,7 +197,8 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
 residual of the current model (projected off what the model can already absorb), adds the best significant one,
 refits everything and checks that the cross-validated RMS falls ({diag['folds']} folds of whole configurations:
 the repeats of one of the {diag['validation']['configurations']} configurations never sit on both sides).</p>
-{report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True)}
+{report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True)
+ if rows else "<p>No effect was named: no candidate of the library passed the test.</p>"}
 <p><b>Result:</b> cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um against a noise estimate of
 {diag['noise_rms_mm'] * 1000:.1f} um: {report.esc(diag['verdict'])}.</p>
 <ul>{notes}</ul>

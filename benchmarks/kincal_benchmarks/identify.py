@@ -6,6 +6,7 @@ import numpy as np
 
 from kincal import _core, load_robot
 from kincal import identify as ident
+from kincal import priors
 
 from .numpy_model import NumpyPointModel
 from .timing import median_ms
@@ -32,6 +33,13 @@ def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
     opts_cov = _core.IdentifyOptions(compliance=True, loss="none", covariance=True)
     ours, res = median_ms(lambda: _core.identify(robot, data, opts), repeats)
     ours_cov, _ = median_ms(lambda: _core.identify(robot, data, opts_cov), repeats)
+    # the defaults of `kincal identify`: priors and the robust loss scaled by the data, against the
+    # identification before them (Huber at a fixed 0.1 mm, no priors)
+    old = _core.IdentifyOptions(compliance=True, loss="huber", loss_scale_mm=0.1, covariance=False)
+    new = _core.IdentifyOptions(compliance=True, loss="huber", loss_scale_mm=0.0, covariance=False, prior_scale=1.0,
+                                prior_sd=priors.core_prior_sd(priors.DEFAULT_PRIOR_SD))
+    old_ms, _ = median_ms(lambda: _core.identify(robot, data, old), repeats)
+    map_ms, _ = median_ms(lambda: _core.identify(robot, data, new), repeats)
     pm = _core.PointModel(robot, 1)
     free = ~np.asarray(res.fixed)
     # scipy starts where our second stage starts (after our first stage fitted the base frame and
@@ -59,7 +67,8 @@ def bench_identify(poses: int, seed: int, repeats: int = 5) -> dict:
                                                  **tol), 3)
     return {"identify_poses": poses, "identify_parameters": res.layout.size,
             "identify_free_parameters": int(free.sum()), "identify_ms": ours,
-            "identify_with_covariance_ms": ours_cov, "scipy_numpy_identify_ms": np_ms,
+            "identify_with_covariance_ms": ours_cov, "identify_huber_fixed_ms": old_ms,
+            "identify_map_data_scaled_ms": map_ms, "identify_map_ratio": map_ms / old_ms, "scipy_numpy_identify_ms": np_ms,
             "identify_speedup_vs_scipy_numpy": np_ms / ours, "scipy_numpy_identify_cost": float(npr.cost),
             "scipy_identify_ms": fd_ms,
             "scipy_analytic_identify_ms": an_ms, "identify_speedup_vs_scipy": fd_ms / ours,

@@ -383,6 +383,21 @@ void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summ
     }
 }
 
+/// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
+/// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r).
+double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, int row_size) {
+  const Eigen::Index n = static_cast<Eigen::Index>(lin.residuals.size());
+  Eigen::MatrixXd J(n, static_cast<Eigen::Index>(determined.size()));
+  for (size_t k = 0; k < determined.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = lin.jacobian.col(determined[k]);
+  const Eigen::Map<const Eigen::VectorXd> r(lin.residuals.data(), n);
+  const Eigen::VectorXd step = (J.transpose() * J).ldlt().solve(J.transpose() * r);
+  const Eigen::VectorXd after = r - J * step;
+  std::vector<double> position;
+  for (Eigen::Index i = 0; i < n; i += row_size)
+    for (int c = 0; c < 3; ++c) position.push_back(after[i + c]);
+  return robust_noise(position, determined.size());
+}
+
 /// The stage-2 solves: each a Levenberg-Marquardt run on a set of free parameters from the current
 /// x, at a loss scale (0: least squares), with the options' penalties and the priors given. The
 /// last problem stays for the covariance.
@@ -467,16 +482,17 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   if (!priors && (opt.loss_scale_mm > 0 || opt.loss == "none")) {
     s2.solve(free_idx, &at_start, opt.loss_scale_mm, {});
   } else {
-    // a least-squares start on what the data determine gives the noise; then the robust (maximum a
-    // posteriori) fit at the data's scale; the noise re-estimated once from it
+    // the noise from a least-squares start on what the data determine (one Gauss-Newton step from the
+    // linearization at the start: the model is nearly linear over the errors of a real robot); then
+    // the robust (maximum a posteriori) fit at the data's scale; the noise re-estimated once from it
     std::vector<int> determined;
     for (int i : free_idx)
       if (!res.at_prior[i]) determined.push_back(i);
-    s2.solve(determined, &at_start, 0.0, {});
-    res.noise_mm = s2.noise(determined.size());
+    res.noise_mm = least_squares_noise(at_start, determined, s2.row_size());
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
-      s2.solve(free_idx, nullptr, opt.loss == "none" ? 0.0 : scale, prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
+      s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == "none" ? 0.0 : scale,
+               prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
       if (pass == 1) break;
       // res.noise_mm stays the one the final solve weighed the priors and set the loss with
       const double again = s2.noise(determined.size());

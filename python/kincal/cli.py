@@ -117,6 +117,7 @@ def cmd_simulate(args) -> None:
     if args.select == "observability":
         from . import plan
         data = plan.select_observable(robot, data, args.poses)
+    data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 

@@ -119,3 +119,19 @@ def test_ls_joint_program_and_fk_carry_the_controller_j3(tmp_path, fanuc):
     assert r.returncode == 0, r.stderr
     got = np.loadtxt(tmp_path / "fk.csv", delimiter=",", skiprows=1)
     assert np.abs(got[:, :3] - poses[:, :3]).max() < 1e-6
+
+
+def test_simulate_writes_the_controller_numbers(tmp_path):
+    # the same truth simulated with and without the convention: the same rows, J3 = q3 - q2
+    truth = kincal.load_robot(URDF).with_calibrated(13, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
+    (tmp_path / "truth.json").write_text(truth.to_json())
+    out = {}
+    for conv in ([], ["--joint-convention", "fanuc"]):
+        path = tmp_path / f"sim{len(conv)}.csv"
+        r = run("kincal", "simulate", "--robot", str(URDF), *conv, "--truth", str(tmp_path / "truth.json"), "--poses",
+                "5", "--noise", "0", "--out", str(path))
+        assert r.returncode == 0, r.stderr
+        out[len(conv)] = list(csv.DictReader(io.StringIO(path.read_text())))
+    for a, b in zip(out[0], out[2]):
+        assert float(b["q3"]) == pytest.approx(float(a["q3"]) - float(a["q2"]), abs=1e-9)
+        assert b["x"] == a["x"] and b["q2"] == a["q2"]

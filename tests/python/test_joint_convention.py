@@ -135,3 +135,22 @@ def test_simulate_writes_the_controller_numbers(tmp_path):
     for a, b in zip(out[0], out[2]):
         assert float(b["q3"]) == pytest.approx(float(a["q3"]) - float(a["q2"]), abs=1e-9)
         assert b["x"] == a["x"] and b["q2"] == a["q2"]
+
+
+def test_ik_writes_the_controller_numbers(tmp_path):
+    cal = kincal.load_robot(URDF)
+    model = json.loads(cal.to_json())
+    model["joint_convention"] = "fanuc"
+    (tmp_path / "m.json").write_text(json.dumps(model))
+    q_model = np.array([[5.0, 10.0, -20.0, 10.0, -40.0, 15.0], [12.0, 20.0, -10.0, 15.0, -50.0, 25.0]])
+    poses = kincal.fk(cal, q_model, calibrated=False)
+    (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n" + "".join(",".join(f"{v:.12f}" for v in p) + "\n" for p in poses))
+    r = run("kincal", "ik", "--robot", str(tmp_path / "m.json"), "--poses", str(tmp_path / "p.csv"), "--out",
+            str(tmp_path / "q.csv"), "--all")
+    assert r.returncode == 0, r.stderr
+    rows = np.loadtxt(tmp_path / "q.csv", delimiter=",", skiprows=1)
+    hand = q_model.copy()
+    hand[:, 2] = q_model[:, 2] - q_model[:, 1]  # J3 = q3 - q2
+    for i in range(2):
+        sols = rows[rows[:, 0] == i][:, 3:]
+        assert np.abs(sols - hand[i]).max(axis=1).min() < 1e-8

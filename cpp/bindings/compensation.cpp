@@ -98,8 +98,10 @@ void define_compensation(py::module_& m) {
       [](const Robot& r, const std::string& in, const std::string& out, KINCAL_COMP_PARAMS,
          std::optional<std::string> format, const std::string& targets, const std::string& name,
          std::optional<double> speed, std::optional<double> zone, int max_per_file,
-         const std::vector<double>& program_tool, const std::vector<double>& program_base, bool skip_unresolved) {
+         const std::vector<double>& program_tool, const std::vector<double>& program_base, bool skip_unresolved,
+         std::optional<double> tolerance) {
         NativeOptions n;
+        if (tolerance) n.tolerance_mm = *tolerance;
         for (const auto* v : {&program_tool, &program_base})
           if (!v->empty() && v->size() != 6) throw InputError("--program-tool / --program-base: X,Y,Z,A,B,C (6 numbers)");
         if (!program_tool.empty())
@@ -126,14 +128,20 @@ void define_compensation(py::module_& m) {
         }
         py::dict d = result_dict(res.result);
         d["files"] = res.files;
+        d["path_before_mm"] = res.path_before_mm;
+        d["path_after_mm"] = res.path_after_mm;
+        d["inserted"] = res.inserted;
         return d;
       },
       py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS, py::arg("format") = py::none(),
       py::arg("targets") = "joints", py::arg("name") = "", py::arg("speed") = py::none(), py::arg("zone") = py::none(),
       py::arg("max_targets_per_file") = 0, py::arg("program_tool") = std::vector<double>{},
       py::arg("program_base") = std::vector<double>{}, py::arg("skip_unresolved") = false,
+      py::arg("tolerance") = py::none(),
       "Compensates a pose program file into a program in a controller's language (format: krl, rapid, fanuc-ls, "
-      "urscript, gcode, csv; None: by the output's extension), every file written or none");
+      "urscript, gcode, csv; None: by the output's extension), every file written or none; tolerance (mm): targets "
+      "inserted where the path between two targets leaves the desired segment by more (path_before_mm, "
+      "path_after_mm, inserted)");
   m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,

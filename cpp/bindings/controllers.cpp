@@ -5,6 +5,7 @@
 #include "kincal/compensation/branch.hpp"
 #include "kincal/compensation/controller_program.hpp"
 #include "kincal/io/controllers.hpp"
+#include "kincal/model/joint_convention.hpp"
 
 using namespace kincal;
 
@@ -99,4 +100,25 @@ void define_controllers(py::module_& m) {
       py::arg("out"), py::arg("targets"), py::arg("format"), py::arg("targets_kind") = "joints", py::arg("name") = "",
       py::arg("speed") = py::none(), py::arg("zone") = py::none(), py::arg("max_targets_per_file") = 0,
       "The files (path, text) of a program in a controller's language; nothing is written");
+  m.def(
+      "joints_to_controller",
+      [](const Robot& r, Eigen::MatrixXd q) {
+        if (q.cols() != r.nominal->dof()) throw InputError("joints_to_controller: one column per joint");
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a = q;
+        for (Eigen::Index i = 0; i < a.rows(); ++i) joints_to_controller(r.nominal->spec(), a.row(i).data(), int(a.cols()));
+        return Eigen::MatrixXd(a);
+      },
+      py::arg("robot"), py::arg("q_deg"), "The model's joint angles (N x dof, deg) as the controller numbers them");
+  m.def(
+      "joints_from_controller",
+      [](const Robot& r, Eigen::MatrixXd q) {
+        if (q.cols() != r.nominal->dof()) throw InputError("joints_from_controller: one column per joint");
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a = q;
+        for (Eigen::Index i = 0; i < a.rows(); ++i) joints_from_controller(r.nominal->spec(), a.row(i).data(), int(a.cols()));
+        return Eigen::MatrixXd(a);
+      },
+      py::arg("robot"), py::arg("q_deg"), "The controller's joint numbers (N x dof, deg) as the model's angles");
+  m.def(
+      "joint_convention", [](const Robot& r) { return r.nominal->spec().joint_convention; }, py::arg("robot"),
+      "The robot's joint convention: '' (the model's own angles) or 'fanuc'");
 }

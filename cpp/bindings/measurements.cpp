@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "kincal/io/measurements.hpp"
+#include "kincal/model/model.hpp"
 
 using namespace kincal;
 
@@ -167,8 +168,12 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
 void define_measurements(py::module_& m) {
   m.def(
       "read_measurements",
-      [](const std::string& path, int dof) { return measurements_to_dict(read_measurements(path, dof), dof); },
-      py::arg("path"), py::arg("dof"));
+      [](const std::string& path, int dof, const Robot* robot) {
+        MeasurementSet ms = read_measurements(path, dof);
+        if (robot) measurements_from_controller(ms, robot->nominal->spec());  // the controller's numbers
+        return measurements_to_dict(ms, dof);
+      },
+      py::arg("path"), py::arg("dof"), py::arg("robot") = nullptr);
   m.def(
       "parse_measurements",
       [](const std::string& text, const std::string& src, int dof) {

@@ -137,6 +137,7 @@ int main(int argc, char** argv) {
   int max_per_file = 0;
   std::vector<double> program_tool, program_base;
   bool skip_unresolved = false;
+  std::optional<double> tolerance;
   app.add_option("--model", model, "built-in robot name or model JSON");
   app.add_option("--fivebar", fivebar, "five-bar hidden robot: FIT.json of kincal hidden-robot fit");
   app.add_option("--matrix", matrix, "five-bar: MATRIX.json of kincal hidden-robot matrix");
@@ -157,6 +158,8 @@ int main(int argc, char** argv) {
   app.add_option("--program-base", program_base, "a KRL/RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
       ->delimiter(',')->expected(6);
   app.add_flag("--skip-unresolved", skip_unresolved, "pass targets computed at run time through with a warning");
+  app.add_option("--tolerance", tolerance, "insert targets where the path between two targets leaves the desired "
+                                           "segment by more than this (mm)");
   app.add_option("--max-targets-per-file", max_per_file, "split longer KRL / LS programs into parts (default: 2000)");
   app.add_option("--frame", frame, "frame of the program poses")->check(CLI::IsMember({"base", "instrument"}));
   app.add_flag("--stream", stream, "read pose lines on stdin, write joint lines on stdout, flushed");
@@ -221,10 +224,16 @@ int main(int argc, char** argv) {
       n.program_base = {kincal::Vec3(program_base[0], program_base[1], program_base[2]),
                         kincal::Vec3(program_base[3], program_base[4], program_base[5])};
     n.skip_unresolved = skip_unresolved;
-    const auto res = kincal::compensate_to_controller(robot, program, out, opt, w, n).result;
+    if (tolerance) n.tolerance_mm = *tolerance;
+    const auto cr = kincal::compensate_to_controller(robot, program, out, opt, w, n);
+    const auto& res = cr.result;
     for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());
     std::fprintf(stderr, "%s: %zu poses, at most %d iterations, largest residual %.3g\n", out.c_str(),
                  res.q_deg.size(), res.max_iterations, res.max_residual);
+    if (tolerance)
+      std::fprintf(stderr, "%s: path between targets: largest deviation from the desired segments %.4f mm before, "
+                   "%.4f mm after %d inserted target(s)\n", out.c_str(), cr.path_before_mm, cr.path_after_mm,
+                   cr.inserted);
     return 0;
   } catch (const kincal::InputError& e) {
     std::fprintf(stderr, "kincal-compensate: error: %s\n", e.what());

@@ -10,6 +10,8 @@ The hot paths run in the C++ core (``kincal._core``); this package is the typed 
 
 from __future__ import annotations
 
+import json
+
 from pathlib import Path
 from typing import Optional, Sequence, Union
 
@@ -25,11 +27,22 @@ __version__ = "0.1.0"
 ArrayLike = Union[np.ndarray, Sequence[Sequence[float]]]
 
 
-def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: Optional[str] = None) -> Robot:
-    """A robot by built-in name (``kr500``), URDF file (chain ``base`` to ``tip``) or model JSON."""
+def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: Optional[str] = None,
+               joint_convention: Optional[str] = None) -> Robot:
+    """A robot by built-in name (``kr500``), URDF file (chain ``base`` to ``tip``) or model JSON;
+    ``joint_convention`` (``fanuc``) says how the controller numbers the joints (a URDF's or built-in
+    robot's; a model JSON carries its own)."""
     s = str(name_or_path)
-    if s.lower().endswith(".urdf"):
-        return Robot.from_json(urdf_model_json(s, base, tip), s)
+    text = urdf_model_json(s, base, tip) if s.lower().endswith(".urdf") else None
+    if joint_convention:
+        if text is None and s.lower().endswith(".json"):
+            raise ValueError(f"{s}: a model JSON carries its joint convention (\"joint_convention\"); "
+                             f"--joint-convention is for a URDF or a built-in robot")
+        o = json.loads(text if text is not None else Robot.load(s).to_json())
+        o["joint_convention"] = joint_convention
+        text = json.dumps(o)
+    if text is not None:
+        return Robot.from_json(text, s)
     return Robot.load(s)
 
 

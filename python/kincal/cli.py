@@ -26,7 +26,8 @@ from .urdf import spec_urdf, urdf_left_out
 
 
 def _robot(args) -> _core.Robot:
-    return load_robot(args.robot, getattr(args, "base", None), getattr(args, "tip", None))
+    return load_robot(args.robot, getattr(args, "base", None), getattr(args, "tip", None),
+                      getattr(args, "joint_convention", None))
 
 
 def cmd_fk(args) -> None:
@@ -64,7 +65,7 @@ def _comp_kwargs(args) -> dict:
 
 
 def cmd_compensate(args) -> None:
-    robot = load_robot(args.model)
+    robot = load_robot(args.model, joint_convention=args.joint_convention)
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
     res = programs.compensate(robot, args, _comp_kwargs(args))
@@ -73,6 +74,8 @@ def cmd_compensate(args) -> None:
     it = np.asarray(res["iterations"])
     print(f"{args.out}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
+    if line := programs.summary(res):
+        print(f"{args.out}: {line}", file=sys.stderr)
 
 
 def _progress(label: str):
@@ -114,6 +117,7 @@ def cmd_simulate(args) -> None:
     if args.select == "observability":
         from . import plan
         data = plan.select_observable(robot, data, args.poses)
+    data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
@@ -271,6 +275,7 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--robot", required=True, help="built-in name (kr500), URDF file or model JSON")
         sp.add_argument("--base", help="URDF: base link of the chain (default: the root link)")
         sp.add_argument("--tip", help="URDF: tip link of the chain (default: the only leaf)")
+        programs.joint_convention_option(sp)
 
     def effect_opts(sp, default: str, what: str):
         names = ", ".join(k.name for k in _core.effect_kinds() if k.domain == "serial")

@@ -10,6 +10,7 @@ FORMATS = ["krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"]
 
 
 def add_options(sp) -> None:
+    joint_convention_option(sp)
     sp.add_argument("--format", choices=FORMATS,
                     help="the output's language (default: by --out's extension: .src KRL (+ .dat), .mod RAPID, "
                          ".ls FANUC LS, .script URScript, .csv CSV, other G-code)")
@@ -29,6 +30,17 @@ def add_options(sp) -> None:
     sp.add_argument("--skip-unresolved", action="store_true",
                     help="pass targets computed at run time (RelTool, Offs, CRobT, geometric operators) through "
                          "unchanged with a warning (default: an error listing them)")
+    sp.add_argument("--tolerance", type=float, metavar="MM",
+                    help="insert targets where the real robot's path between two targets (joint interpolation; "
+                         "for filtered targets the controller's straight line) leaves the desired segment by more "
+                         "than MM; the summary gives the largest deviation before and after")
+
+
+def joint_convention_option(sp) -> None:
+    sp.add_argument("--joint-convention", choices=["fanuc"],
+                    help="how the controller numbers the joints of a URDF or built-in robot (a model JSON carries "
+                         "its own): fanuc, J3 is the forearm's angle to the horizontal; every joint angle in the "
+                         "files is then the controller's")
 
 
 def _frame(text, option: str) -> list:
@@ -52,4 +64,12 @@ def compensate(robot, args, comp_kwargs: dict) -> dict:
                                           max_targets_per_file=args.max_targets_per_file,
                                           program_tool=_frame(args.program_tool, "--program-tool"),
                                           program_base=_frame(args.program_base, "--program-base"),
-                                          skip_unresolved=args.skip_unresolved)
+                                          skip_unresolved=args.skip_unresolved, tolerance=args.tolerance)
+
+
+def summary(res: dict) -> str:
+    """The --tolerance line of the summary ('' without --tolerance)."""
+    if res.get("inserted") is None or res["path_before_mm"] != res["path_before_mm"]:  # NaN: no --tolerance
+        return ""
+    return (f"path between targets: largest deviation from the desired segments {res['path_before_mm']:.4f} mm "
+            f"before, {res['path_after_mm']:.4f} mm after {res['inserted']} inserted target(s)")

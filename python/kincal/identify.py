@@ -212,7 +212,7 @@ def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float
 
 def read_measurements(path: str, robot: Robot) -> dict:
     """The measurement CSV of the contract (errors name file:line and cause)."""
-    return _core.read_measurements(str(path), robot.dof)
+    return _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
 
 
 def measurements_csv(data: dict, dof: int) -> str:

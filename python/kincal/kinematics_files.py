@@ -63,6 +63,7 @@ def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: st
     if frame == "instrument" and not robot.identified:
         raise ValueError(f"{robot_arg}: --frame instrument needs an identified model (kincal identify)")
     q, _ = _core.read_joint_program(joints, robot.dof)
+    q = _core.joints_from_controller(robot, np.asarray(q, dtype=float).reshape(-1, robot.dof))  # controller's numbers
     ctx = effect_columns(joints, robot, len(q), temperature)
     poses = fk(robot, q, frame=frame, dir=ctx.get("dir"), temperature_c=ctx.get("temperature_c"))
     extra = text_columns(joints, ["pose", "target"]) if joints.lower().endswith(".csv") else {}
@@ -86,6 +87,11 @@ def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: st
     _core.write_file_atomic(out, format_rows(head, rows))
 
 
+def _controller(robot: _core.Robot, q) -> list:
+    """One configuration as the controller numbers its joints (the robot's joint convention)."""
+    return list(_core.joints_to_controller(robot, np.asarray(q, dtype=float).reshape(1, -1))[0])
+
+
 def ik_file(robot: _core.Robot, robot_arg: str, poses_path: str, out: str, every: bool = False) -> None:
     """`kincal ik`: nominal closed-form IK of the pose program ``poses_path`` written to ``out``, each
     pose's solution nearest the previous one (the first nearest the robot's home); ``every``: all
@@ -100,13 +106,13 @@ def ik_file(robot: _core.Robot, robot_arg: str, poses_path: str, out: str, every
         if not sols:
             raise ValueError(f"{poses_path}:{line}: pose out of reach of the robot (no IK solution)")
         if every:
-            rows += [[i, k, int(s["within_limits"])] + list(s["q_deg"]) for k, s in enumerate(sols)]
+            rows += [[i, k, int(s["within_limits"])] + _controller(robot, s["q_deg"]) for k, s in enumerate(sols)]
         best = _core.ik_nearest(robot, np.asarray(pose, dtype=float), np.asarray(ref, dtype=float))
         if best is None:
             raise ValueError(f"{poses_path}:{line}: no IK solution within the joint limits")
         ref = list(sols[best]["q_deg"])
         if not every:
-            rows.append(ref)
+            rows.append(_controller(robot, ref))
     qn = [f"q{j + 1}" for j in range(robot.dof)]
     head = ["row", "solution", "within_limits"] + qn if every else qn
     _core.write_file_atomic(out, format_rows(head, rows))

@@ -1,11 +1,14 @@
 #include "kincal/compensation/controller_program.hpp"
 
 #include "kincal/compensation/branch.hpp"
+#include "kincal/compensation/tolerance.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/native.hpp"
 #include "kincal/io/programs.hpp"
+#include "kincal/model/joint_convention.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace kincal {
@@ -18,7 +21,7 @@ std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::
   for (size_t i = 0; i < q.size(); ++i) {
     ControllerTarget& t = out[i];
     t.q_deg = q[i];
-    if (kind != TargetKind::Filtered) continue;
+    if (kind != TargetKind::Filtered) continue;  // (the model's angles until the end)
     t.pose = iso_to_pose(fk(*robot.nominal, VecQ(q[i] * kDeg)));
     if (!branches) continue;
     set_branch_data(robot, t);
@@ -34,6 +37,7 @@ std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::
       throw InputError(at + buf);
     }
   }
+  for (ControllerTarget& t : out) joints_to_controller(robot.nominal->spec(), t.q_deg.data(), 6);  // as written
   return out;
 }
 
@@ -50,6 +54,9 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
     throw InputError(in_path + ": a " + std::string(format_name(in_format)) +
                      " program is rewritten with filtered targets: give --targets filtered (joint targets in a native "
                      "program are not done yet)");
+  if (std::isfinite(n.tolerance_mm))
+    throw InputError(in_path + ": --tolerance inserts targets into programs kincal writes (from CSV or G-code), "
+                     "not yet into a " + std::string(format_name(in_format)) + " program it filters");
   const NativeProgram p = read_native_program(in_path, in_format);
   ControllerProgramResult r;
   if (!p.unresolved.empty()) {
@@ -82,6 +89,28 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
   return r;
 }
 
+// A G-code program's lines with a "G1 " motion line before each pose for every target --tolerance
+// inserted before it; the pose indices renumbered to the refined program's (original: per refined
+// pose, its input index or -1).
+void with_inserted_targets(PoseProgram& prog, const std::vector<int>& original) {
+  std::vector<int> refined_of(prog.poses.size(), -1);
+  for (size_t k = 0; k < original.size(); ++k)
+    if (original[k] >= 0) refined_of[static_cast<size_t>(original[k])] = static_cast<int>(k);
+  std::vector<PoseProgram::Line> lines;
+  int next = 0;  // the first refined pose not yet on a line
+  for (const PoseProgram::Line& l : prog.lines) {
+    if (l.pose >= 0) {
+      const int k = refined_of[static_cast<size_t>(l.pose)];
+      for (; next < k; ++next) lines.push_back({"G1 ", 3, next});
+      next = k + 1;
+      lines.push_back({l.text, l.insert_at, k});
+    } else {
+      lines.push_back(l);
+    }
+  }
+  prog.lines = std::move(lines);
+}
+
 }  // namespace
 
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
@@ -90,15 +119,27 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
   const ControllerFormat in_format = controller_format_of_path(in_path);
   if (in_format != ControllerFormat::Csv && in_format != ControllerFormat::Gcode)
     return compensate_native(robot, in_path, in_format, out_path, opt, w, native);
-  const PoseProgram prog = read_pose_program(in_path);
+  PoseProgram prog = read_pose_program(in_path);
   std::vector<std::string> where_of;
   where_of.reserve(prog.poses.size());
   for (int l : prog.pose_line) where_of.push_back(where(in_path, l));
   ControllerProgramResult r;
-  r.result = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
+  if (std::isfinite(native.tolerance_mm)) {
+    ToleranceResult t = compensate_with_tolerance(robot, prog.poses, where_of, opt, prog.temperature_c,
+                                                  native.tolerance_mm,
+                                                  w.targets == TargetKind::Joints ? PathKind::Joint : PathKind::NominalLine);
+    r.result = std::move(t.result);
+    r.path_before_mm = t.before_mm, r.path_after_mm = t.after_mm, r.inserted = t.inserted;
+    where_of = std::move(t.where);
+    with_inserted_targets(prog, t.original);
+  } else {
+    r.result = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
+  }
   std::vector<OutputFile> files;
   if (w.targets == TargetKind::Joints && (w.format == ControllerFormat::Csv || w.format == ControllerFormat::Gcode)) {
-    files.push_back({out_path, format_joint_program(prog, r.result.q_deg,
+    std::vector<Vec6> qc = r.result.q_deg;  // the controller's numbers
+    for (Vec6& q : qc) joints_to_controller(robot.nominal->spec(), q.data(), 6);
+    files.push_back({out_path, format_joint_program(prog, qc,
                                                     w.format == ControllerFormat::Csv ? ProgramFormat::Csv
                                                                                       : ProgramFormat::Gcode)});
   } else {

@@ -3,6 +3,7 @@
 #include "kincal/io/file.hpp"
 #include "kincal/io/programs.hpp"
 #include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/joint_convention.hpp"
 
 #include <algorithm>
 #include <array>
@@ -288,7 +289,9 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
   where_of.reserve(prog.poses.size());
   for (int l : prog.pose_line) where_of.push_back(where(in_path, l));
   const ProgramResult res = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
-  write_file_atomic(out_path, format_joint_program(prog, res.q_deg, program_format(out_path)));
+  std::vector<Vec6> qc = res.q_deg;  // the controller's numbers
+  for (Vec6& q : qc) joints_to_controller(robot.nominal->spec(), q.data(), 6);
+  write_file_atomic(out_path, format_joint_program(prog, qc, program_format(out_path)));
   return res;
 }
 

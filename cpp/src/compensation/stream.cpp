@@ -1,4 +1,5 @@
 #include "kincal/compensation/stream.hpp"
+#include "kincal/model/joint_convention.hpp"
 
 #include "kincal/io/csv.hpp"
 #include "kincal/io/file.hpp"
@@ -55,7 +56,9 @@ Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
     if (opt_.keep_branch) fail_at("stdin", line_no_, branch_change_message(s.error));
     warning_ = "stdin:" + std::to_string(line_no_) + ": " + branch_change_message(s.error);
   }
-  return s.q_deg;
+  Vec6 q = s.q_deg;  // the cursor keeps the model's angles; the line carries the controller's numbers
+  joints_to_controller(robot_.nominal->spec(), q.data(), 6);
+  return q;
 }
 
 size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap) {

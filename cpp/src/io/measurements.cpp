@@ -1,4 +1,5 @@
 // kincal: the measurement CSV reader and writer (the columns in measurements.hpp).
+#include "kincal/model/joint_convention.hpp"
 #include "kincal/io/measurements.hpp"
 
 #include "kincal/io/csv.hpp"
@@ -142,6 +143,11 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
     s += "\n";
   }
   return s;
+}
+
+void measurements_from_controller(MeasurementSet& m, const ModelSpec& spec) {
+  if (spec.joint_convention.empty()) return;
+  for (Measurement& r : m.rows) joints_from_controller(spec, r.q_deg.data(), static_cast<int>(r.q_deg.size()));
 }
 
 }  // namespace kincal

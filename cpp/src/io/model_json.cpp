@@ -1,4 +1,5 @@
 #include "kincal/io/model_json.hpp"
+#include "kincal/model/joint_convention.hpp"
 
 #include "kincal/model/robots.hpp"
 
@@ -223,6 +224,7 @@ std::string spec_to_json(const ModelSpec& spec) { return spec_json(spec).dump(2)
 std::string robot_to_json(const Robot& robot) {
   json o{{"format", "kincal-model"}, {"version", 2}, {"nominal", spec_json(robot.nominal->spec())}};
   if (robot.identified()) o["calibrated"] = spec_json(robot.calibrated->spec());
+  if (!robot.nominal->spec().joint_convention.empty()) o["joint_convention"] = robot.nominal->spec().joint_convention;
   return o.dump(2) + "\n";
 }
 
@@ -253,9 +255,16 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
     throw InputError(source + ": model version " + (o.contains("version") ? o["version"].dump() : "missing") +
                      " is not supported (this kincal reads versions 1 and 2)");
   ModelPtr nominal, calibrated;
+  std::string convention;  // the controller's joint numbers (joint_convention.hpp)
+  if (o.contains("joint_convention")) {
+    if (!o["joint_convention"].is_string()) throw InputError(source + ": joint_convention: not a string");
+    convention = o["joint_convention"].get<std::string>();
+  }
   try {
-    nominal = std::make_shared<Model>(r.spec(r.at(o, "nominal", "model"), "nominal"));
-    calibrated = o.contains("calibrated") ? std::make_shared<Model>(r.spec(o["calibrated"], "calibrated")) : nominal;
+    nominal = std::make_shared<Model>(with_joint_convention(r.spec(r.at(o, "nominal", "model"), "nominal"), convention));
+    calibrated = o.contains("calibrated")
+                     ? std::make_shared<Model>(with_joint_convention(r.spec(o["calibrated"], "calibrated"), convention))
+                     : nominal;
   } catch (const InputError& e) {
     const std::string m = e.what();
     if (m.rfind(source, 0) == 0) throw;

@@ -1,4 +1,5 @@
-// kincal: native programs (KRL, RAPID) in and out: the readers are krl_reader.cpp and rapid_reader.cpp;
+// kincal: native programs (KRL, RAPID, FANUC LS, URScript) in and out: the readers are krl_reader.cpp,
+// rapid_reader.cpp, ls_reader.cpp and urscript_reader.cpp;
 // the writer replaces each target's value span and keeps every other byte.
 #include "kincal/io/native.hpp"
 
@@ -14,12 +15,17 @@ NativeProgram read_krl_program(const std::string& src_path);
 NativeProgram read_rapid_program(const std::string& path);
 std::string krl_aggregate(const std::string& old, const Pose6& pose, const ControllerTarget& t, bool is_frame);
 std::string rapid_robtarget(const std::string& old, const Pose6& pose, const ControllerTarget& t);
+NativeProgram read_ls_program(const std::string& path);
+std::string ls_position(const std::string& old, const Pose6& pose, const ControllerTarget& t);
+NativeProgram read_urscript_program(const std::string& path);
+std::string urscript_pose(const Pose6& pose);
 
 NativeProgram read_native_program(const std::string& path, ControllerFormat format) {
   if (format == ControllerFormat::Krl) return read_krl_program(path);
   if (format == ControllerFormat::Rapid) return read_rapid_program(path);
-  throw InputError(path + ": kincal reads KRL (.src + .dat) and RAPID (.mod) programs, CSV and G-code; not " +
-                   format_name(format) + " yet");
+  if (format == ControllerFormat::FanucLs) return read_ls_program(path);
+  if (format == ControllerFormat::UrScript) return read_urscript_program(path);
+  throw InputError(path + ": not a native program (" + format_name(format) + ")");
 }
 
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
@@ -27,7 +33,25 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
   std::vector<std::vector<std::string>> lines = p.lines;
   // per line, the replacements from the right so that earlier spans keep their places
   std::map<std::pair<int, int>, std::vector<size_t>> by_line;
-  for (size_t k = 0; k < p.targets.size(); ++k) by_line[{p.targets[k].file, p.targets[k].line}].push_back(k);
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    const NativeTarget& nt = p.targets[k];
+    if (nt.last_line <= nt.line) {
+      by_line[{nt.file, nt.line}].push_back(k);
+      continue;
+    }
+    // a value over several lines (an LS /POS entry): replaced within them, the line count kept
+    auto& f = lines[static_cast<size_t>(nt.file)];
+    std::string joined;
+    for (int l = nt.line; l <= nt.last_line; ++l) joined += f[static_cast<size_t>(l - 1)] + (l < nt.last_line ? "\n" : "");
+    const size_t end = joined.size() - f[static_cast<size_t>(nt.last_line - 1)].size() + nt.end;
+    joined.replace(nt.begin, end - nt.begin, ls_position(joined.substr(nt.begin, end - nt.begin), pose[k], t[k]));
+    size_t b = 0;
+    for (int l = nt.line; l <= nt.last_line; ++l) {
+      const size_t e = l < nt.last_line ? joined.find('\n', b) : joined.size();
+      f[static_cast<size_t>(l - 1)] = joined.substr(b, e - b);
+      b = e + 1;
+    }
+  }
   for (auto& [key, ks] : by_line) {
     std::sort(ks.begin(), ks.end(), [&](size_t a, size_t b) { return p.targets[a].begin > p.targets[b].begin; });
     std::string& l = lines[static_cast<size_t>(key.first)][static_cast<size_t>(key.second - 1)];
@@ -39,8 +63,12 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
         std::string head = l.substr(0, nt.begin);
         for (char& c : head) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
         now = krl_aggregate(old, pose[k], t[k], head.find("FRAME") != std::string::npos);
-      } else {
+      } else if (p.format == ControllerFormat::Rapid) {
         now = rapid_robtarget(old, pose[k], t[k]);
+      } else if (p.format == ControllerFormat::FanucLs) {
+        now = ls_position(old, pose[k], t[k]);
+      } else {
+        now = urscript_pose(pose[k]);
       }
       l.replace(nt.begin, nt.end - nt.begin, now);
     }

@@ -6,6 +6,7 @@
 #include "kincal/compensation/program.hpp"
 #include "kincal/io/controllers.hpp"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -17,11 +18,14 @@ namespace kincal {
 std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::vector<Vec6>& q_deg, TargetKind kind,
                                                  ControllerFormat format, const std::vector<std::string>& where);
 
-/// A native program's frames and what to do with targets computed at run time.
+/// A native program's frames, what to do with targets computed at run time, and the path tolerance.
 struct NativeOptions {
   Pose6 program_tool;  ///< the program's TCP in the model's tool frame (--program-tool)
   Pose6 program_base;  ///< the program's base in the robot's base frame (--program-base)
   bool skip_unresolved = false;  ///< pass run-time targets through with a warning (else an error)
+  /// --tolerance: targets inserted where the real robot's path between two targets leaves the desired
+  /// segment by more (mm; kincal/compensation/tolerance.hpp); NaN: none inserted
+  double tolerance_mm = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Reads a pose program (CSV or G-code; a KRL or RAPID program: see NativeOptions), compensates it and writes it in w.format (every file, or
@@ -30,6 +34,11 @@ struct NativeOptions {
 struct ControllerProgramResult {
   ProgramResult result;
   std::vector<std::string> files;
+  /// the largest deviation of the path between targets from the desired segments (mm), before and after
+  /// --tolerance inserted targets (NaN without --tolerance), and how many it inserted
+  double path_before_mm = std::numeric_limits<double>::quiet_NaN();
+  double path_after_mm = std::numeric_limits<double>::quiet_NaN();
+  int inserted = 0;
 };
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
                                                  const std::string& out_path, const ProgramOptions& opt,

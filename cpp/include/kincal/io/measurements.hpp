@@ -49,4 +49,9 @@ MeasurementSet read_measurements(const std::string& path, int dof);
 MeasurementSet parse_measurements(const std::string& text, const std::string& source, int dof);
 std::string format_measurements(const MeasurementSet& m, int dof);
 
+struct ModelSpec;
+/// The rows' joint angles, read as the controller numbers them, turned into the model's (its joint
+/// convention: kincal/model/joint_convention.hpp); nothing for a model with its own convention.
+void measurements_from_controller(MeasurementSet& m, const ModelSpec& spec);
+
 }  // namespace kincal

@@ -1,4 +1,5 @@
-// kincal: programs the controllers run, read in (KUKA KRL .src with its .dat, ABB RAPID modules) so
+// kincal: programs the controllers run, read in (KUKA KRL .src with its .dat, ABB RAPID modules, FANUC
+// LS programs, URScript) so
 // that their Cartesian targets can be compensated and written back with every other line unchanged,
 // byte for byte. Targets computed at run time (KRL: a target assigned in the program, a geometric
 // operator, a _REL motion; RAPID: Offs, RelTool, CRobT, ...) are listed as unresolved. Every error is
@@ -18,7 +19,8 @@ namespace kincal {
 struct NativeTarget {
   int file = 0;                        ///< index into NativeProgram::paths
   int line = 0;                        ///< 1-based line of the value
-  size_t begin = 0, end = 0;           ///< the value's span in that line ("{...}" / "[[...],...]")
+  size_t begin = 0, end = 0;           ///< the value's span: from begin in `line` to end in `last_line`
+  int last_line = 0;                   ///< the value's last line (0: `line`; FANUC LS: a /POS entry)
   Pose6 pose;                          ///< in the program's frame (mm, KUKA ABC deg)
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();  ///< the program's frame in the robot base
   std::string name;                    ///< declared name, or "" when inline
@@ -39,11 +41,12 @@ struct NativeProgram {
   std::vector<UnresolvedTarget> unresolved;
 };
 
-/// Reads a KRL program (path: the .src; its .dat beside it when present) or a RAPID module.
+/// Reads a KRL program (path: the .src; its .dat beside it when present), a RAPID module, a FANUC LS
+/// program or a URScript program.
 NativeProgram read_native_program(const std::string& path, ControllerFormat format);
 
 /// The program with target k's value replaced by pose[k] (in the program's frame) and the branch data
-/// of t[k] (KRL S and T, RAPID confdata); every other byte unchanged. Files go to out_path (KRL: its
+/// of t[k] (KRL S and T, RAPID confdata, LS CONFIG); every other byte unchanged. Files go to out_path (KRL: its
 /// .src and .dat).
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
                                              const std::vector<ControllerTarget>& t, const std::string& out_path);

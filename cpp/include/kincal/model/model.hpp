@@ -67,6 +67,9 @@ struct ModelSpec {
   /// base_in_instrument, which is also the first's), and the time drift's centre (the drift effect).
   std::vector<SetupFrame> setups;
   double t_mean_s = 0;             ///< the drift's reference time (s, the campaign's mean time)
+  /// How the controller numbers the joints (kincal/model/joint_convention.hpp): "" its own angles are
+  /// the model's; "fanuc": the controller's J3 is the forearm's angle to the horizontal
+  std::string joint_convention;
 };
 
 class Model {

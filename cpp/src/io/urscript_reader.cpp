@@ -1,0 +1,167 @@
+// kincal: URScript programs read in: def/thread/if/while/for blocks closed by end checked; the motions
+// movej, movel, movep (one target) and movec (via and end point) to a pose literal p[x,y,z,rx,ry,rz]
+// (m, rad: a rotation vector) or to a variable assigned one pose literal in the program (the
+// assignment is changed). A joint list [q1..q6] stays as it is; a pose computed at run time
+// (pose_trans, pose_add, get_actual_tcp_pose, ..., a variable assigned more than once or not a
+// literal) is unresolved. Other p[...] (set_tcp, ...) are not targets and stay.
+#include "controller_writers.hpp"
+#include "kincal/io/file.hpp"
+#include "kincal/io/native.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <regex>
+
+namespace kincal {
+
+std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl);
+
+namespace {
+
+// the line without its comment ('#' outside strings)
+std::string code_of(const std::string& l) {
+  bool str = false;
+  for (size_t i = 0; i < l.size(); ++i) {
+    if (l[i] == '"') str = !str;
+    if (l[i] == '#' && !str) return l.substr(0, i);
+  }
+  return l;
+}
+
+// p[x,y,z,rx,ry,rz] in m and rad, as a pose in mm and KUKA ABC degrees
+Pose6 parse_pose(const std::string& lit, const std::string& at) {
+  const std::string inner = lit.substr(2, lit.size() - 3);
+  const auto v = split_top(inner);
+  if (v.size() != 6) throw InputError(at + ": a pose p[...] has 6 values, this one " + std::to_string(v.size()));
+  double x[6];
+  for (int k = 0; k < 6; ++k) {
+    char* end = nullptr;
+    x[k] = std::strtod(v[static_cast<size_t>(k)].c_str(), &end);
+    if (v[static_cast<size_t>(k)].empty() || end == v[static_cast<size_t>(k)].c_str() || *end != '\0' || !std::isfinite(x[k]))
+      throw InputError(at + ": pose value '" + v[static_cast<size_t>(k)] + "' is not a number");
+  }
+  const Vec3 rv(x[3], x[4], x[5]);
+  const double angle = rv.norm();
+  const Mat3 r = angle > 0 ? Mat3(Eigen::AngleAxisd(angle, rv / angle)) : Mat3::Identity();
+  return {Vec3(x[0], x[1], x[2]) * 1000.0, rotation_to_abc(r)};
+}
+
+// the arguments of the call whose '(' is at open, and the position after its ')'
+std::vector<std::string> call_args(const std::string& s, size_t open, size_t& close, const std::string& at) {
+  int depth = 0;
+  for (size_t i = open; i < s.size(); ++i) {
+    if (s[i] == '(' || s[i] == '[') ++depth;
+    if (s[i] == ')' || s[i] == ']') --depth;
+    if (depth == 0) {
+      close = i;
+      return split_top(s.substr(open + 1, i - open - 1));
+    }
+  }
+  throw InputError(at + ": unbalanced parentheses (kincal reads a motion on one line)");
+}
+
+bool is_pose_literal(const std::string& a) {
+  return a.size() > 3 && a[0] == 'p' && a[1] == '[' && a.back() == ']' && a.find('[', 2) == std::string::npos;
+}
+
+}  // namespace
+
+NativeProgram read_urscript_program(const std::string& path) {
+  NativeProgram p;
+  p.format = ControllerFormat::UrScript;
+  p.paths.push_back(path);
+  bool nl = true;
+  p.lines.push_back(krl_lines_of(read_text_file(path), nl));
+  p.final_newline.push_back(nl);
+  const auto& lines = p.lines[0];
+  struct Assign {
+    int line = 0, count = 0;
+    size_t begin = 0, end = 0;
+    bool literal = false, joints = false;
+  };
+  std::map<std::string, Assign> vars;
+  std::vector<std::pair<std::string, int>> blocks;  // opener and line
+  static const std::regex opener(R"(^\s*(def|thread|if|while|for)\b.*:\s*$)"), closer(R"(^\s*end\s*$)");
+  static const std::regex assign(R"(^\s*(?:global\s+|local\s+)?([A-Za-z_]\w*)\s*=\s*(.*?)\s*$)");
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string code = code_of(lines[i]);
+    const int ln = static_cast<int>(i + 1);
+    std::smatch m;
+    if (std::regex_match(code, m, opener)) blocks.push_back({m[1].str(), ln});
+    else if (std::regex_match(code, closer)) {
+      if (blocks.empty()) throw InputError(where(path, ln) + ": 'end' without def, thread, if, while or for");
+      blocks.pop_back();
+    } else if (std::regex_match(code, m, assign) && code.find("==") == std::string::npos) {
+      Assign& a = vars[m[1].str()];
+      ++a.count;
+      a.line = ln;
+      a.literal = is_pose_literal(m[2].str());
+      a.joints = !m[2].str().empty() && m[2].str()[0] == '[';
+      a.begin = static_cast<size_t>(m.position(2));
+      a.end = a.begin + static_cast<size_t>(m.length(2));
+      if (a.literal) parse_pose(m[2].str(), where(path, ln));  // checked where it is written
+    }
+  }
+  if (!blocks.empty())
+    throw InputError(where(path, blocks.back().second) + ": '" + blocks.back().first + "' is not closed by 'end' (end of file)");
+  static const std::regex move(R"(\b(movej|movel|movep|movec)\s*\()");
+  std::map<std::string, bool> used;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string code = code_of(lines[i]);
+    const std::string at = where(path, static_cast<int>(i + 1));
+    for (auto it = std::sregex_iterator(code.begin(), code.end(), move); it != std::sregex_iterator(); ++it) {
+      size_t close = 0;
+      const size_t open = static_cast<size_t>(it->position(0) + it->length(0) - 1);
+      const auto args = call_args(code, open, close, at);
+      const size_t n = (*it)[1].str() == "movec" ? 2 : 1;
+      if (args.size() < n || args[0].empty()) throw InputError(at + ": " + (*it)[1].str() + " needs its target(s)");
+      for (size_t k = 0; k < n; ++k) {
+        const std::string& a = args[k];
+        if (a[0] == '[') continue;  // joints: kept
+        if (is_pose_literal(a)) {
+          NativeTarget t;
+          t.line = static_cast<int>(i + 1);
+          t.begin = code.find(a, open);
+          t.end = t.begin + a.size();
+          t.pose = parse_pose(a, at);
+          p.targets.push_back(t);
+          continue;
+        }
+        if (!std::regex_match(a, std::regex(R"([A-Za-z_]\w*)"))) {
+          p.unresolved.push_back({at, code.substr(code.find_first_not_of(" \t"))});
+          continue;
+        }
+        const auto v = vars.find(a);
+        if (v == vars.end()) throw InputError(at + ": target '" + a + "' is not assigned in the program");
+        if (v->second.joints && v->second.count == 1) continue;  // a joint list: kept
+        if (v->second.count != 1 || !v->second.literal) {
+          p.unresolved.push_back({at, code.substr(code.find_first_not_of(" \t"))});
+          continue;
+        }
+        if (used[a]) continue;
+        used[a] = true;
+        NativeTarget t;
+        t.line = v->second.line;
+        t.begin = v->second.begin;
+        t.end = v->second.end;
+        t.name = a;
+        const std::string& l = lines[static_cast<size_t>(t.line - 1)];
+        t.pose = parse_pose(l.substr(t.begin, t.end - t.begin), where(path, t.line));
+        p.targets.push_back(t);
+      }
+    }
+  }
+  return p;
+}
+
+// a pose literal p[x,y,z,rx,ry,rz] (m, rad) of a pose in mm and ABC degrees
+std::string urscript_pose(const Pose6& pose) {
+  const Vec3 rv = ctl::rotation_vector_of(pose.abc);
+  std::string s = "p[";
+  for (int k = 0; k < 3; ++k) s += (k ? ", " : "") + ctl::fixed(pose.xyz[k] / 1000.0, 8);
+  for (int k = 0; k < 3; ++k) s += ", " + ctl::fixed(rv[k], 10);
+  return s + "]";
+}
+
+}  // namespace kincal

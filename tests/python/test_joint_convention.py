@@ -1,0 +1,156 @@
+"""The controller's joint numbers (issue 19, item 5): a FANUC controller's J3 is the forearm's angle to
+the horizontal. On tests/data/fanuc_like.urdf (axis 2 = +y, axis 3 = -y, as ROS-Industrial FANUC
+URDFs) the URDF's joint 3 is J3 + J2, i.e. J3 = q3 - q2 (hand-converted values below). Truth of the
+synthetic data: the URDF robot with 1 mm / 0.05 deg errors and compliance (seed 13), no noise, 40
+poses, the joint angles then rounded to 1/1024 deg (up to 0.0005 deg of error, the same in both
+files); the same rows identified once as the model's angles (no convention) and once as the
+controller's (J3 converted by hand, --joint-convention fanuc) give the same model to 1e-9 mm. An LS
+joint program written for a fanuc model carries the controller's J3."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kincal
+from kincal import _core
+from kincal import identify as ident
+
+from conftest import run
+
+URDF = Path(__file__).resolve().parents[1] / "data" / "fanuc_like.urdf"
+
+
+@pytest.fixture(scope="module")
+def fanuc():
+    return kincal.load_robot(URDF, joint_convention="fanuc")
+
+
+def test_hand_converted_values(fanuc):
+    q_model = np.array([[10.0, 20.0, 30.0, 40.0, 50.0, 60.0], [0.0, -35.5, -70.25, 0.0, 90.0, 0.0]])
+    hand = np.array([[10.0, 20.0, 10.0, 40.0, 50.0, 60.0], [0.0, -35.5, -34.75, 0.0, 90.0, 0.0]])
+    assert np.array_equal(_core.joints_to_controller(fanuc, q_model), hand)
+    assert np.array_equal(_core.joints_from_controller(fanuc, hand), q_model)
+    plain = kincal.load_robot(URDF)
+    assert np.array_equal(_core.joints_to_controller(plain, q_model), q_model)
+    assert _core.joint_convention(fanuc) == "fanuc" and _core.joint_convention(plain) == ""
+
+
+def test_controller_j3_is_the_forearm_angle(fanuc):
+    # with the controller's J3 held, moving J2 keeps the forearm's (and so the tool's) orientation
+    rot = []
+    for j2 in (-40.0, 0.0, 25.0, 60.0):
+        q = _core.joints_from_controller(fanuc, np.array([[15.0, j2, -20.0, 30.0, 40.0, 50.0]]))
+        rot.append(_core.fk_matrix(fanuc, q[0], False)[:3, :3])
+    assert max(np.abs(r - rot[0]).max() for r in rot) < 1e-12
+
+
+def _model_and_controller_csv(text: str) -> tuple[str, str]:
+    """The rows with q1..q6 on multiples of 1/1024 deg (so that J3 = q3 - q2 and back are exact in
+    binary: both files then give the reader the very same model angles), as the model's angles and
+    as the controller's (J3 converted by hand: J3 = q3 - q2)."""
+    rows = list(csv.DictReader(io.StringIO(text)))
+    files = []
+    for convert in (False, True):
+        out = io.StringIO()
+        w = csv.DictWriter(out, fieldnames=list(rows[0]), lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            q = {f"q{j}": round(float(r[f"q{j}"]) * 1024) / 1024 for j in range(1, 7)}
+            if convert:
+                q["q3"] = q["q3"] - q["q2"]
+            w.writerow({**r, **{k: repr(v) for k, v in q.items()}})
+        files.append(out.getvalue())
+    return files[0], files[1]
+
+
+def test_measurements_in_controller_numbers_identify_the_same_model(tmp_path):
+    robot = kincal.load_robot(URDF)
+    truth = robot.with_calibrated(13, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
+    (tmp_path / "truth.json").write_text(truth.to_json())
+    r = run("kincal", "simulate", "--robot", str(URDF), "--truth", str(tmp_path / "truth.json"), "--poses", "40",
+            "--noise", "0", "--out", str(tmp_path / "sim.csv"))
+    assert r.returncode == 0, r.stderr
+    model_angles, controller = _model_and_controller_csv((tmp_path / "sim.csv").read_text())
+    (tmp_path / "model_angles.csv").write_text(model_angles)
+    (tmp_path / "controller.csv").write_text(controller)
+    a = run("kincal", "identify", "--robot", str(URDF), "--data", str(tmp_path / "model_angles.csv"), "--out",
+            str(tmp_path / "a.json"))
+    b = run("kincal", "identify", "--robot", str(URDF), "--joint-convention", "fanuc", "--data",
+            str(tmp_path / "controller.csv"), "--out", str(tmp_path / "b.json"))
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    ma, mb = kincal.load_robot(tmp_path / "a.json"), kincal.load_robot(tmp_path / "b.json")
+    assert json.loads((tmp_path / "b.json").read_text())["joint_convention"] == "fanuc"
+    q = np.random.default_rng(3).uniform(-60, 60, size=(200, 6))
+    pa, pb = _core.fk(ma, q, True, True), _core.fk(mb, q, True, True)
+    assert np.abs(pa[:, :3] - pb[:, :3]).max() < 1e-9
+
+
+def test_ls_joint_program_and_fk_carry_the_controller_j3(tmp_path, fanuc):
+    cal = kincal.load_robot(URDF).with_calibrated(13, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
+    model = json.loads(cal.to_json())
+    model["joint_convention"] = "fanuc"
+    (tmp_path / "m.json").write_text(json.dumps(model))
+    m = kincal.load_robot(tmp_path / "m.json")
+    q_model = np.array([[5.0, 10.0, -20.0, 10.0, -40.0, 15.0], [8.0, 15.0, -15.0, 12.0, -45.0, 20.0],
+                        [12.0, 20.0, -10.0, 15.0, -50.0, 25.0]])
+    poses = kincal.fk(m, q_model)  # the calibrated robot at q_model: compensation gives q_model back
+    (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n" + "".join(",".join(f"{v:.12f}" for v in p) + "\n" for p in poses))
+    for tool in ("kincal", "kincal-compensate"):
+        out = tmp_path / f"j_{tool.replace('-', '_')}.ls"
+        args = ["compensate"] if tool == "kincal" else []
+        r = run(tool, *args, "--model", str(tmp_path / "m.json"), "--program", str(tmp_path / "p.csv"), "--out", str(out))
+        assert r.returncode == 0, r.stderr
+        j = np.array([[float(x) for x in re.findall(r"J\d=\s*(-?\d+\.\d+) deg", b)]
+                      for b in re.findall(r"P\[\d+\]\{(.*?)\};", out.read_text(), re.S)])
+        hand = q_model.copy()
+        hand[:, 2] = q_model[:, 2] - q_model[:, 1]
+        assert np.abs(j - hand).max() < 2e-4  # 4 decimals printed, + the compensation's 1e-7
+    # kincal fk reads the controller's numbers
+    (tmp_path / "q.csv").write_text("q1,q2,q3,q4,q5,q6\n" + "".join(",".join(repr(float(v)) for v in q) + "\n" for q in hand))
+    r = run("kincal", "fk", "--robot", str(tmp_path / "m.json"), "--joints", str(tmp_path / "q.csv"), "--out",
+            str(tmp_path / "fk.csv"))
+    assert r.returncode == 0, r.stderr
+    got = np.loadtxt(tmp_path / "fk.csv", delimiter=",", skiprows=1)
+    assert np.abs(got[:, :3] - poses[:, :3]).max() < 1e-6
+
+
+def test_simulate_writes_the_controller_numbers(tmp_path):
+    # the same truth simulated with and without the convention: the same rows, J3 = q3 - q2
+    truth = kincal.load_robot(URDF).with_calibrated(13, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
+    (tmp_path / "truth.json").write_text(truth.to_json())
+    out = {}
+    for conv in ([], ["--joint-convention", "fanuc"]):
+        path = tmp_path / f"sim{len(conv)}.csv"
+        r = run("kincal", "simulate", "--robot", str(URDF), *conv, "--truth", str(tmp_path / "truth.json"), "--poses",
+                "5", "--noise", "0", "--out", str(path))
+        assert r.returncode == 0, r.stderr
+        out[len(conv)] = list(csv.DictReader(io.StringIO(path.read_text())))
+    for a, b in zip(out[0], out[2]):
+        assert float(b["q3"]) == pytest.approx(float(a["q3"]) - float(a["q2"]), abs=1e-9)
+        assert b["x"] == a["x"] and b["q2"] == a["q2"]
+
+
+def test_ik_writes_the_controller_numbers(tmp_path):
+    cal = kincal.load_robot(URDF)
+    model = json.loads(cal.to_json())
+    model["joint_convention"] = "fanuc"
+    (tmp_path / "m.json").write_text(json.dumps(model))
+    q_model = np.array([[5.0, 10.0, -20.0, 10.0, -40.0, 15.0], [12.0, 20.0, -10.0, 15.0, -50.0, 25.0]])
+    poses = kincal.fk(cal, q_model, calibrated=False)
+    (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n" + "".join(",".join(f"{v:.12f}" for v in p) + "\n" for p in poses))
+    r = run("kincal", "ik", "--robot", str(tmp_path / "m.json"), "--poses", str(tmp_path / "p.csv"), "--out",
+            str(tmp_path / "q.csv"), "--all")
+    assert r.returncode == 0, r.stderr
+    rows = np.loadtxt(tmp_path / "q.csv", delimiter=",", skiprows=1)
+    hand = q_model.copy()
+    hand[:, 2] = q_model[:, 2] - q_model[:, 1]  # J3 = q3 - q2
+    for i in range(2):
+        sols = rows[rows[:, 0] == i][:, 3:]
+        assert np.abs(sols - hand[i]).max(axis=1).min() < 1e-8

@@ -1,0 +1,136 @@
+"""FANUC LS and URScript programs read and filtered (issue 19, readers): a hand-written LS program
+(tests/data/programs/tape.ls: /ATTR, comments, UFRAME/UTOOL, I/O, WAIT, a FOR loop, a joint HOME
+position, CNT/FINE, C with its continuation line, a PR[] motion and an Offset motion) and a URScript
+program (tape.script: set_tcp, set_payload, pose variables, a joint list, movej/movel/movec, a while
+loop, I/O, a pose_trans motion) are compensated on the calibrated kr500 (conftest: 1 mm / 0.05 deg
+errors and compliance, seed 9) with filtered targets. A line diff shows that only target values
+change; the new values, read by regular expressions here, are poses at which the controller's
+nominal IK (LS: the branch its CONFIG selects; UR: some IK solution, as a UR takes the one nearest its
+joints) gives joints where the calibrated robot reaches the program's pose (within the printed
+precision). Run-time targets are an error unless --skip-unresolved; malformed programs give file:line
+errors, exit 1, and no output file."""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import kincal
+from kincal import _core
+
+from conftest import run
+from test_native_programs import _changed
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "programs"
+N = r"(-?\d*\.?\d+)"
+LS_POS = (r"P\[(\d+)[^\]]*\]\{\s*GP1:\s*UF : 0, UT : 1,\s*CONFIG : '([^']*)',\s*X =\s*" + N + r"\s*mm,\s*Y =\s*" + N +
+          r"\s*mm,\s*Z =\s*" + N + r"\s*mm,\s*W =\s*" + N + r"\s*deg,\s*P =\s*" + N + r"\s*deg,\s*R =\s*" + N)
+
+
+def _ls_positions(text: str) -> dict:
+    return {int(m.group(1)): (m.group(2), [float(m.group(k)) for k in (3, 4, 5, 8, 7, 6)])
+            for m in re.finditer(LS_POS, text)}
+
+
+def _ur_poses(text: str) -> list:
+    out = []
+    for m in re.finditer(r"(?<!set_tcp\()p\[([^\]]*)\]", text):
+        v = [float(x) for x in m.group(1).split(",")]
+        abc = Rotation.from_rotvec(v[3:]).as_euler("ZYX", degrees=True)
+        out.append(np.array([1000 * v[0], 1000 * v[1], 1000 * v[2], *abc]))
+    return out
+
+
+@pytest.fixture()
+def model(tmp_path, calibrated):
+    path = tmp_path / "m.json"
+    path.write_text(calibrated.to_json())
+    return path
+
+
+def _reaches(calibrated, q, desired, tol_mm) -> bool:
+    p = kincal.fk(calibrated, q)[0]
+    dr = Rotation.from_euler("ZYX", p[3:], degrees=True).inv() * Rotation.from_euler("ZYX", desired[3:], degrees=True)
+    return np.linalg.norm(p[:3] - desired[:3]) < tol_mm and math.degrees(dr.magnitude()) < 1e-3
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_ls_only_target_values_change(tmp_path, model, calibrated, tool):
+    shutil.copy(DATA / "tape.ls", tmp_path / "tape.ls")
+    args = ["compensate"] if tool == "kincal" else []
+    out = tmp_path / "out.ls"
+    base = [*args, "--model", str(model), "--program", str(tmp_path / "tape.ls"), "--out", str(out), "--targets", "filtered"]
+    r = run(tool, *base)
+    assert r.returncode != 0 and not out.exists()
+    assert "tape.ls:36" in r.stderr and "tape.ls:37" in r.stderr  # PR[2] and Offset,PR[3]
+    r = run(tool, *base, "--skip-unresolved")
+    assert r.returncode == 0, r.stderr
+    assert "tape.ls:36" in r.stderr and "warning" in r.stderr
+    a, b = (DATA / "tape.ls").read_text(), out.read_text()
+    changed = _changed(a, b)
+    lines = a.split("\n")
+    # the X/Y/Z and W/P/R lines of P[2..5] (CONFIG where the branch data changes), nothing else
+    xyz = [i + 1 for i, l in enumerate(lines) if l.lstrip().startswith(("X =", "W ="))]
+    assert set(xyz) <= set(changed) and len(xyz) == 8
+    assert all(lines[i - 1].lstrip().startswith(("X =", "W =", "UF : 0, UT : 1,\t\tCONFIG")) for i in changed)
+    desired, new = _ls_positions(a), _ls_positions(b)
+    assert sorted(new) == [2, 3, 4, 5]
+    for n, (config, pose) in new.items():
+        t = {"pose": pose, "fanuc_config": config}
+        q = _core.select_branch(calibrated, "fanuc-ls", t)
+        assert not isinstance(q, str), q
+        assert _reaches(calibrated, q, np.array(desired[n][1]), 5e-3)
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_urscript_only_target_values_change(tmp_path, model, calibrated, tool):
+    args = ["compensate"] if tool == "kincal" else []
+    out = tmp_path / "out.script"
+    base = [*args, "--model", str(model), "--program", str(DATA / "tape.script"), "--out", str(out), "--targets",
+            "filtered"]
+    r = run(tool, *base)
+    assert r.returncode != 0 and "tape.script:19" in r.stderr and not out.exists()  # pose_trans
+    r = run(tool, *base, "--skip-unresolved")
+    assert r.returncode == 0, r.stderr
+    a, b = (DATA / "tape.script").read_text(), out.read_text()
+    assert _changed(a, b) == [5, 6, 11, 12]  # approach, lay_end, the inline movel and movec via points
+    for old, new in zip(a.split("\n"), b.split("\n")):  # only the p[...] values inside the lines change
+        assert re.sub(r"p\[[^\]]*\]", "p[]", old) == re.sub(r"p\[[^\]]*\]", "p[]", new)
+    desired, written = _ur_poses(a), _ur_poses(b)
+    assert len(desired) == len(written) == 5  # approach, lay_end, movel, movec via, pose_trans offset
+    for d, w in zip(desired[:4], written[:4]):
+        sols = [np.asarray(s["q_deg"]) for s in _core.ik_all(calibrated, w) if s["within_limits"]]
+        assert any(_reaches(calibrated, q, d, 1e-3) for q in sols)
+    assert np.allclose(desired[4], written[4])  # the offset inside pose_trans is not a target
+
+
+MALFORMED = [
+    ("tape.ls", lambda s: s.replace("/END\n", ""), "tape.ls:1", "not closed by /END"),
+    ("tape.ls", lambda s: s.replace("L P[3] 200mm", "L P[9] 200mm"), "tape.ls:29", "not declared"),
+    ("tape.ls", lambda s: s.replace("Y =  -600.000", "Y =  -6o0.000"), "tape.ls:62", "not a number"),
+    ("tape.ls", lambda s: s.replace("W =   180.000 deg,\tP =     0.000 deg,\tR =   180.000 deg\n};\nP[5]",
+                                    "W =   180.000 deg\n};\nP[5]"), "tape.ls:61", "no P value"),
+    ("tape.script", lambda s: s[:s.rindex("end")], "tape.script:1", "not closed by 'end'"),
+    ("tape.script", lambda s: s.replace("p[2.0, -0.72, 0.5, 0,", "p[2.0, -0.72, 0.5,"), "tape.script:11", "6 values"),
+    ("tape.script", lambda s: s.replace("-0.48", "-0.4x8"), "tape.script:6", "not a number"),
+    ("tape.script", lambda s: s.replace("movel(lay_end", "movel(lay_start"), "tape.script:16", "not assigned"),
+]
+
+
+@pytest.mark.parametrize("name,edit,where,cause", MALFORMED)
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_malformed_programs(tmp_path, model, name, edit, where, cause, tool):
+    (tmp_path / name).write_text(edit((DATA / name).read_text()))
+    out = tmp_path / ("out" + Path(name).suffix)
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / name), "--out", str(out), "--targets",
+            "filtered", "--skip-unresolved")
+    assert r.returncode != 0
+    assert where + ":" in r.stderr and cause in r.stderr, r.stderr
+    assert not out.exists()

@@ -175,6 +175,8 @@ class ParamLayout:
     @property
     def compliance(self) -> int: ...
     @property
+    def moments(self) -> int: ...
+    @property
     def tool(self) -> int: ...
     @property
     def base(self) -> int: ...
@@ -193,6 +195,8 @@ class ParamLayout:
     @property
     def setup_names(self) -> list[str]: ...
     @property
+    def gravity(self) -> str: ...
+    @property
     def loaded(self) -> list[int]: ...
     @property
     def names(self) -> list[str]: ...
@@ -206,6 +210,7 @@ class ParamLayout:
 class IdentifyOptions:
     compliance: bool
     loss: str
+    gravity: str
     loss_scale_mm: float
     max_iterations: int
     rank_tolerance: float
@@ -222,7 +227,7 @@ class IdentifyOptions:
                  fix: Sequence[str] = ..., compliance_joints: Sequence[int] = ..., effects: Sequence[Effect] = ...,
                  covariance: bool = ..., orientation_weight: float = ..., rank_tolerance: float = ...,
                  weak_tolerance: float = ..., min_torque_share: float = ...,
-                 correlation_threshold: float = ...) -> None: ...
+                 correlation_threshold: float = ..., gravity: str = ...) -> None: ...
 
 class IdentifyResult:
     @property

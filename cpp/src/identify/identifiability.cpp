@@ -61,6 +61,24 @@ void fix_unloaded_compliances(const Model& nominal, const MeasurementSet& data, 
   }
 }
 
+/// With the gravity fitted, compliance x moment is what the points see (point_model.hpp): the first
+/// free compliance is held as the scale, at its start value or kUnitCompliance (res.start), unless
+/// the rows carry several payloads (their known masses then fix the scale).
+void hold_gravity_scale(const MeasurementSet& data, IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  std::set<double> payloads;
+  for (const auto& r : data.rows)
+    if (!std::isnan(r.payload_kg)) payloads.insert(r.payload_kg);
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int c = L.compliance + static_cast<int>(i);
+    if (res.fixed[c]) continue;
+    if (res.start[c] == 0) res.start[c] = kUnitCompliance;
+    if (payloads.size() < 2)
+      res.fix(c, "the scale of the fitted mass moments (no masses: compliance x moment is what the points see)");
+    return;
+  }
+}
+
 /// The order in which the greedy selection keeps parameters: targets, compliances, extra effects,
 /// the joint lines from the second on, then the frames and the first joint line (what is left of
 /// them is a gauge of the others).
@@ -195,7 +213,9 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
       if (std::find(asked.begin(), asked.end(), L.loaded[i]) == asked.end())
         res.fix(L.compliance + static_cast<int>(i), "not in the model");
     }
-  if (opt.compliance && !L.loaded.empty()) fix_unloaded_compliances(nominal, data, opt, res);
+  // with the gravity fitted the model's masses are not what acts: the moments say how loaded a joint is
+  if (opt.compliance && !L.loaded.empty() && !L.fit_gravity) fix_unloaded_compliances(nominal, data, opt, res);
+  if (L.fit_gravity) hold_gravity_scale(data, res);
   for (const auto& name : opt.fix) {
     auto it = std::find(L.names.begin(), L.names.end(), name);
     if (it == L.names.end()) throw InputError("identify: no parameter named '" + name + "'");
@@ -215,11 +235,14 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
     if (!penalised) order.push_back(i);
   }
   // what the generic campaign determines but the data do not means the data are too few or too alike
+  // with the gravity fitted, judged at generic moments (at zero moments no compliance has an effect)
+  const std::vector<double> xp = pm.probe(x, res.fixed);
   IdentifyResult generic = res;
-  select_independent(linearize(pm, generic_campaign(nominal, data), x, opt.orientation_weight).jacobian, order, opt,
+  select_independent(linearize(pm, generic_campaign(nominal, data), xp, opt.orientation_weight).jacobian, order, opt,
                      generic);
-  Linearization lin = linearize(pm, data, x, opt.orientation_weight);
+  Linearization lin = linearize(pm, data, xp, opt.orientation_weight);
   select_independent(lin.jacobian, order, opt, res);
+  if (xp != x) lin = linearize(pm, data, x, opt.orientation_weight);
   std::string missing;
   int n_missing = 0;
   // only what the data make exactly redundant counts (near the weak threshold the two may differ)

@@ -377,15 +377,16 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   check_effect_columns(nominal, data, effects);
   const double t_ref = reference_temperature(nominal, data, effects);
   const double t_mean = reference_time(data, effects);
-  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean));
-  PointModel pm(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean);
+  const bool fit_gravity = opt.compliance && gravity_fitted(nominal, opt.gravity);
+  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity));
+  PointModel pm(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity);
   pm.prepare_payloads(data);
   res.start = pm.start(data);
   res.fixed.assign(res.layout.size, false);
   res.fixed_reason.assign(res.layout.size, "");
   start_carried_effects(nominal, opt, res);
-  std::vector<double> x = res.start;
   fix_unobservable(nominal, data, opt, res);
+  std::vector<double> x = res.start;
   // stage 1: the frames on the nominal geometry; then what the data cannot determine is held
   fit_frames(pm, nominal, data, opt, x, res);
   const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res);

@@ -1,7 +1,8 @@
 // kincal: PointModel's gravity state and the Jacobian terms through the gravity torque.
 // The deflection K tau(q) depends on the geometry through the gravity torque: moving a joint line
 // moves the links (their centres of mass) and the axes the torque is taken about; moving the tool
-// frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter).
+// frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter), and the
+// columns of the fitted gravity's mass moments (point_model.hpp), which act only through tau.
 // K tau itself acts in row_frames() (point_model.cpp); these are its derivatives.
 #include "kincal/identify/point_model.hpp"
 
@@ -118,6 +119,18 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
         }
       }
       apply(4 * i + c, dtau);
+    }
+  }
+  // the fitted gravity's moments: one of link k along d adds G_{k+1} d to A_j of every joint j <= k,
+  // so dtau_j = wc_j . (G_{k+1} d x g) = G_{k+1} d . B_j
+  for (size_t i = 0; i < layout_.moment_links.size(); ++i) {
+    const int k = layout_.moment_links[i];
+    for (int c = 0; c < 2; ++c) {
+      const Vec3 s = gr[k + 1] * (c == 0 ? u_[k] : v_[k]);
+      std::array<double, kMaxJoints> dtau{};
+      for (int j : layout_.loaded)
+        if (j <= k) dtau[j] = s.dot(B[j]);
+      apply(layout_.moments + 2 * static_cast<int>(i) + c, dtau);
     }
   }
   if (mp != 0) {

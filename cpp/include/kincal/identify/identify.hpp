@@ -20,6 +20,7 @@ namespace kincal {
 
 struct IdentifyOptions {
   bool compliance = true;          ///< identify the joint compliances
+  std::string gravity = "auto";    ///< their torques: "masses" (the model's), "fit" (moments), "auto" (fit without masses)
   std::string loss = "huber";      ///< "none", "huber", "cauchy"
   double loss_scale_mm = 0.1;      ///< where the robust loss bends
   int max_iterations = 100;

@@ -173,7 +173,7 @@ std::vector<double> fitted_gravity_point(const PointModel& pm, const Measurement
   std::normal_distribution<double> nd(0, 1);
   for (int i = 0; i < L.size; ++i) {
     if (i >= L.compliance && i < L.moments) x[i] = 0.003 * (1.0 + 0.3 * nd(rng));
-    else if (i >= L.moments && i < L.tool) x[i] = 4e5 * nd(rng);  // kg mm: deflections of ~0.01 deg
+    else if (i >= L.moments && i < L.tool) x[i] = 0.4 * nd(rng);  // t m: deflections of ~0.01 deg
     else x[i] += nd(rng) * (L.units[i] == "rad" ? 0.001 : 1.0);
   }
   return x;
@@ -195,7 +195,7 @@ TEST(PointModel, GravityModeFromTheMassTable) {
   EXPECT_EQ(L.moments, L.compliance + static_cast<int>(L.loaded.size()));
   EXPECT_EQ(L.tool, L.moments + 10);
   EXPECT_EQ(L.names[L.moments], "link2.moment_u");
-  EXPECT_EQ(L.units[L.moments + 9], "kg mm");
+  EXPECT_EQ(L.units[L.moments + 9], "t m");
   EXPECT_EQ(ParamLayout(without, 3).moment_links.size(), 0u);
 }
 
@@ -214,7 +214,7 @@ TEST(PointModel, JacobianMatchesFiniteDifferencesFittedGravity) {
 TEST(PointModel, FittedGravityOrientationJacobianAndWrittenModel) {
   // 6-D rows: the Jacobian of the moments and compliances, position and orientation rows, against
   // central differences relative to each column's largest entry (the test above is absolute for
-  // columns below 1, as the moments' are: 1e-6 mm per kg mm); and the model written from the parameters (its mass table of unit masses) predicts
+  // columns below 1); and the model written from the parameters (its mass table of unit masses) predicts
   // every point as the measurement model does, so fk and compensate apply the fitted deflection
   SimulationOptions so;
   so.poses = 12;
@@ -232,7 +232,7 @@ TEST(PointModel, FittedGravityOrientationJacobianAndWrittenModel) {
     std::vector<double> J(6 * L.size), r(6);
     ASSERT_EQ(row_residuals(pm, row, ResidualKind::pose, w, r.data(), J.data()), 6);
     for (int i = L.compliance; i < L.tool; ++i) {
-      const double h = L.units[i] == "kg mm" ? 1e3 : 1e-5;  // moments: 4e5 kg mm
+      const double h = L.units[i] == "t m" ? 1e-3 : 1e-5;  // moments: 0.4 t m
       std::vector<double> xp = x, xm = x, rp(6), rm(6);
       xp[i] += h;
       xm[i] -= h;

@@ -5,6 +5,7 @@
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -190,6 +191,56 @@ Linearization linearize(PointModel& pm, const MeasurementSet& data, const std::v
   return lin;
 }
 
+/// With the gravity fitted: the moments the data show at x (one Gauss-Newton step of every free
+/// parameter but the compliances, each of those at the held one's value: the moments are linear
+/// then), and, as fix_unloaded_compliances does with masses, the compliance of a joint whose torque
+/// from them stays below opt.min_torque_share of the largest held. Returns x with those moments: the
+/// point at which the data's columns are judged (at zero moments no compliance has an effect, and
+/// at generic ones a joint that gravity barely loads would look identifiable).
+std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
+                                   const IdentifyOptions& opt, IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  std::vector<double> xs = pm.probe(x, res.fixed);  // compliances set; its generic moments dropped:
+  for (int i = L.moments; i < L.tool; ++i) xs[i] = x[i];
+  const Linearization lin = linearize(pm, data, xs, opt.orientation_weight);
+  std::vector<int> cols;
+  for (int i = 0; i < L.size; ++i)
+    if (!res.fixed[i] && (i < L.compliance || i >= L.moments)) cols.push_back(i);
+  Eigen::MatrixXd A(lin.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
+  Eigen::VectorXd nrm(A.cols());
+  for (size_t c = 0; c < cols.size(); ++c) {
+    nrm[c] = lin.jacobian.col(cols[c]).norm();
+    A.col(c) = lin.jacobian.col(cols[c]) / (nrm[c] > 0 ? nrm[c] : 1.0);
+  }
+  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
+  const Eigen::VectorXd step = -A.completeOrthogonalDecomposition().solve(r);
+  for (size_t c = 0; c < cols.size(); ++c)
+    if (cols[c] >= L.moments && cols[c] < L.tool && nrm[c] > 0) xs[cols[c]] += step[c] / nrm[c];
+  // the joints' torques from those moments over the measured poses
+  pm.set_params(xs);
+  const Model fitted(pm.spec());
+  std::vector<double> tmax(L.dof, 0.0);
+  VecQ tau;
+  for (const auto& row : data.rows) {
+    gravity_torque(fitted, row.q_deg * kDeg, tau);
+    for (int j = 0; j < L.dof; ++j) tmax[j] = std::max(tmax[j], std::abs(tau[j]));
+  }
+  double top = 0;
+  int top_j = 0;
+  for (int j : L.loaded)
+    if (tmax[j] > top) top = tmax[j], top_j = j;
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int j = L.loaded[i], c = L.compliance + static_cast<int>(i);
+    if (res.fixed[c] || !(tmax[j] < opt.min_torque_share * top)) continue;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "gravity torque too small to see it (fitted moments: %.1f%% of joint %d's)",
+                  100.0 * tmax[j] / top, top_j + 1);
+    res.fix(c, buf);
+    xs[c] = x[c];
+  }
+  return xs;
+}
+
 }  // namespace
 
 void fix_unobservable(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
@@ -235,8 +286,8 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
     if (!penalised) order.push_back(i);
   }
   // what the generic campaign determines but the data do not means the data are too few or too alike
-  // with the gravity fitted, judged at generic moments (at zero moments no compliance has an effect)
-  const std::vector<double> xp = pm.probe(x, res.fixed);
+  // with the gravity fitted, judged at the moments the data show (fitted_moments)
+  const std::vector<double> xp = res.layout.fit_gravity ? fitted_moments(pm, data, x, opt, res) : x;
   IdentifyResult generic = res;
   select_independent(linearize(pm, generic_campaign(nominal, data), xp, opt.orientation_weight).jacobian, order, opt,
                      generic);

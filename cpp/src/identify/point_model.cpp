@@ -87,7 +87,7 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
   }
   for (int j : loaded) names.push_back("joint" + std::to_string(j + 1) + ".compliance"), units.push_back("deg/kNm");
   for (int k : moment_links)
-    for (const char* s : {".moment_u", ".moment_v"}) names.push_back("link" + std::to_string(k + 1) + s), units.push_back("kg mm");
+    for (const char* s : {".moment_u", ".moment_v"}) names.push_back("link" + std::to_string(k + 1) + s), units.push_back("t m");
   std::vector<std::string> frames = {"tool"};
   if (setup_names.empty()) frames.push_back("base");
   for (const std::string& sn : setup_names) frames.push_back("base[" + sn + "]");
@@ -160,7 +160,7 @@ void PointModel::set_params(const std::vector<double>& x) {
       const int k = layout_.moment_links[i];
       const double* a = &x[layout_.moments + 2 * i];
       spec_.joints[k].mass_kg = kUnitMass;
-      spec_.joints[k].com = com0_[static_cast<size_t>(k)] + (a[0] * u_[k] + a[1] * v_[k]) / kUnitMass;
+      spec_.joints[k].com = com0_[static_cast<size_t>(k)] + (a[0] * u_[k] + a[1] * v_[k]) * (kMomentUnit / kUnitMass);
     }
   }
   const Vec3 phim(x[layout_.tool + 3], x[layout_.tool + 4], x[layout_.tool + 5]);
@@ -439,7 +439,7 @@ std::vector<double> PointModel::probe(std::vector<double> x, const std::vector<b
   reach = std::max(reach, nominal_.tool().translation().norm());
   const double pattern[] = {0.83, -0.41, 0.57, 0.29, -0.66, 0.72, 0.38, -0.91, 0.47, 0.62, -0.35, 0.78};
   for (int i = L.moments; i < L.tool; ++i)
-    if (!fixed[i] && x[i] == 0) x[i] = kUnitMass * std::max(reach, 100.0) * pattern[(i - L.moments) % 12];
+    if (!fixed[i] && x[i] == 0) x[i] = kUnitMass * std::max(reach, 100.0) * pattern[(i - L.moments) % 12] / kMomentUnit;
   return x;
 }
 

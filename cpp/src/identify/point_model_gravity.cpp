@@ -121,12 +121,12 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
       apply(4 * i + c, dtau);
     }
   }
-  // the fitted gravity's moments: one of link k along d adds G_{k+1} d to A_j of every joint j <= k,
-  // so dtau_j = wc_j . (G_{k+1} d x g) = G_{k+1} d . B_j
+  // the fitted gravity's moments: one of link k along d adds G_{k+1} d (kMomentUnit kg mm) to A_j of
+  // every joint j <= k, so dtau_j = wc_j . (G_{k+1} d x g) = G_{k+1} d . B_j
   for (size_t i = 0; i < layout_.moment_links.size(); ++i) {
     const int k = layout_.moment_links[i];
     for (int c = 0; c < 2; ++c) {
-      const Vec3 s = gr[k + 1] * (c == 0 ? u_[k] : v_[k]);
+      const Vec3 s = gr[k + 1] * (c == 0 ? u_[k] : v_[k]) * kMomentUnit;
       std::array<double, kMaxJoints> dtau{};
       for (int j : layout_.loaded)
         if (j <= k) dtau[j] = s.dot(B[j]);

@@ -16,7 +16,8 @@
 //                along u and v (mm), with u, v unit vectors normal to the nominal axis;
 //   per gravity-loaded joint 1: compliance (deg per kN m, absolute);
 //   with the gravity fitted (no mass table, see below) per link from the first loaded joint's on 2:
-//        its first moment across its joint's axis, along u and v (kg mm);
+//        its first moment across its joint's axis, along u and v (t m = 1e6 kg mm: columns of the
+//        order of the others', so that the covariance's conditioning is not lost to units);
 //   tool 6: translation (mm) and rotation vector (rad, R = R0 Exp(phi));
 //   base 6 per setup: the same for the base frame in the instrument frame ("base.x" for one setup,
 //        "base[NAME].x" for several), relative to the model's frame of that setup name (its setups)
@@ -56,6 +57,8 @@ namespace kincal {
 /// The fitted gravity's mass of every fitted link (kg) and the held compliance's start value
 /// (deg/kNm) when the model has none: only their products with the moments are determined.
 constexpr double kUnitMass = 1.0, kUnitCompliance = 0.01;
+/// kg mm per unit of a fitted moment parameter (t m)
+constexpr double kMomentUnit = 1e6;
 
 /// Whether identification fits the gravity's mass moments: mode "fit", or "auto" and no link of the
 /// model has a mass; "masses" uses the model's (InputError when it has none, or for another mode).
@@ -75,7 +78,7 @@ struct ParamLayout {
   double t_mean = 0;                  ///< the drift's reference time (s)
   std::vector<std::string> setup_names;  ///< by setup code (empty: one setup, no setup column)
   std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry", "base[B].ry"
-  std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm", "kg mm"
+  std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm", "t m"
   /// setups: the names of the data's setups (by code); none or one: a single placement "base.*".
   /// fit_gravity: the moments of every link from the first loaded joint's on are parameters.
   ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,

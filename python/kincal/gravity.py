@@ -30,12 +30,12 @@ def report(fit: "_core.IdentifyResult") -> dict:
     the held scale and what the written masses mean."""
     if fit.layout.gravity != "fit":
         return {"source": "masses", "text": "the model's link masses and centres of mass"}
-    out = {"source": "fit",
-           "text": "no mass table: each link's first moment across its joint's axis identified with the "
-                   "compliances (compliance x moment is what the points see)",
-           "link_masses": "effective (1 kg per fitted link, centre of mass placed to give the identified "
-                          "torques); the compliances are relative to the held one; a different payload "
-                          "would not be scaled right unless the data carried several payloads"}
+    out: dict = {"source": "fit",
+                 "text": "no mass table: each link's first moment across its joint's axis identified with the "
+                         "compliances (compliance x moment is what the points see)",
+                 "link_masses": "effective (1 kg per fitted link, centre of mass placed to give the identified "
+                                "torques); the compliances are relative to the held one; a different payload "
+                                "would not be scaled right unless the data carried several payloads"}
     held = _held_scale(fit)
     if held:
         out["held_scale"] = held

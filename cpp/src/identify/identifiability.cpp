@@ -5,6 +5,7 @@
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
@@ -213,9 +214,31 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
     A.col(c) = lin.jacobian.col(cols[c]) / (nrm[c] > 0 ? nrm[c] : 1.0);
   }
   const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
-  const Eigen::VectorXd step = -A.completeOrthogonalDecomposition().solve(r);
-  for (size_t c = 0; c < cols.size(); ++c)
-    if (cols[c] >= L.moments && cols[c] < L.tool && nrm[c] > 0) xs[cols[c]] += step[c] / nrm[c];
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  const Eigen::VectorXd step = -cod.solve(r);
+  // a link's pair of moments is seen when it stands out of its noise: chi-square (2 degrees of
+  // freedom) of the pair with the step's covariance above its 99% quantile; the others are held at
+  // zero (the bilinear form is flat along a compliance whose moments vanish)
+  const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
+  const double s2 = (r + A * step).squaredNorm() / dofres;
+  const Eigen::MatrixXd cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  for (size_t c = 0; c + 1 < cols.size(); ++c) {
+    const int i = cols[c];
+    if (i < L.moments || i >= L.tool || (i - L.moments) % 2 != 0 || cols[c + 1] != i + 1) continue;
+    const Eigen::Vector2d a = step.segment<2>(static_cast<Eigen::Index>(c));
+    const Eigen::Matrix2d ca = cov.block<2, 2>(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c));
+    const Eigen::FullPivLU<Eigen::Matrix2d> lu(ca);
+    const double chi2 = lu.isInvertible() ? a.dot(lu.solve(a)) : 0.0;
+    if (chi2 > 9.21 && nrm[c] > 0 && nrm[c + 1] > 0) {
+      xs[i] += step[c] / nrm[c];
+      xs[i + 1] += step[c + 1] / nrm[c + 1];
+      continue;
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "moment not seen by these poses (chi-square %.1f of its pair, below 9.21)", chi2);
+    res.fix(i, buf);
+    res.fix(i + 1, buf);
+  }
   // the joints' torques from those moments over the measured poses
   pm.set_params(xs);
   const Model fitted(pm.spec());
@@ -231,10 +254,13 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
     if (tmax[j] > top) top = tmax[j], top_j = j;
   for (size_t i = 0; i < L.loaded.size(); ++i) {
     const int j = L.loaded[i], c = L.compliance + static_cast<int>(i);
-    if (res.fixed[c] || !(tmax[j] < opt.min_torque_share * top)) continue;
+    if (res.fixed[c] || (top > 0 && !(tmax[j] < opt.min_torque_share * top))) continue;
     char buf[200];
-    std::snprintf(buf, sizeof buf, "gravity torque too small to see it (fitted moments: %.1f%% of joint %d's)",
-                  100.0 * tmax[j] / top, top_j + 1);
+    if (top > 0)
+      std::snprintf(buf, sizeof buf, "gravity torque too small to see it (fitted moments: %.1f%% of joint %d's)",
+                    100.0 * tmax[j] / top, top_j + 1);
+    else
+      std::snprintf(buf, sizeof buf, "no gravity deflection seen by these poses (no fitted moment stands out)");
     res.fix(c, buf);
     xs[c] = x[c];
   }

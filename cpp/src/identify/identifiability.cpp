@@ -222,6 +222,7 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
   const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
   const double s2 = (r + A * step).squaredNorm() / dofres;
   const Eigen::MatrixXd cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  int seen = 0;
   for (size_t c = 0; c + 1 < cols.size(); ++c) {
     const int i = cols[c];
     if (i < L.moments || i >= L.tool || (i - L.moments) % 2 != 0 || cols[c + 1] != i + 1) continue;
@@ -232,6 +233,7 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
     if (chi2 > 9.21 && nrm[c] > 0 && nrm[c + 1] > 0) {
       xs[i] += step[c] / nrm[c];
       xs[i + 1] += step[c + 1] / nrm[c + 1];
+      ++seen;
       continue;
     }
     char buf[160];
@@ -251,7 +253,7 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
   double top = 0;
   int top_j = 0;
   for (int j : L.loaded)
-    if (tmax[j] > top) top = tmax[j], top_j = j;
+    if (seen > 0 && tmax[j] > top) top = tmax[j], top_j = j;  // none seen: every compliance held
   for (size_t i = 0; i < L.loaded.size(); ++i) {
     const int j = L.loaded[i], c = L.compliance + static_cast<int>(i);
     if (res.fixed[c] || (top > 0 && !(tmax[j] < opt.min_torque_share * top))) continue;

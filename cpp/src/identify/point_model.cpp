@@ -40,18 +40,6 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
 
 }  // namespace
 
-bool gravity_fitted(const Model& nominal, const std::string& mode) {
-  bool masses = false;
-  for (const JointSpec& j : nominal.spec().joints) masses = masses || j.mass_kg > 0;
-  if (mode == "fit") return true;
-  if (mode == "auto") return !masses;
-  if (mode != "masses") throw InputError("identify: unknown gravity mode '" + mode + "' (auto, masses, fit)");
-  if (!masses)
-    throw InputError("identify: --gravity masses, but the model '" + nominal.spec().name +
-                     "' has no link masses (no inertial data): use --gravity fit (or auto)");
-  return false;
-}
-
 ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr,
                          const std::vector<std::string>& setups, double tm, bool fit_g)
     : dof(nominal.dof()), n_targets(nt), fit_gravity(fit_g), effect_list(eff), t_ref(tr), t_mean(tm) {
@@ -125,14 +113,7 @@ PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Ef
   }
   w_.resize(n);
   p_.resize(n);
-  // zero moments: a_k = m (c_k - p_k) + M_{k+1} (p_{k+1} - p_k) = 0 with every fitted link's mass m
-  com0_.assign(static_cast<size_t>(n), Vec3::Zero());
-  for (int k : layout_.moment_links) {
-    const double beyond = n - 1 - k;  // the fitted links beyond k, kUnitMass each
-    Vec3 c = nominal.point(k);
-    if (k + 1 < n) c -= beyond * (nominal.point(k + 1) - nominal.point(k));
-    com0_[static_cast<size_t>(k)] = c;
-  }
+  init_fitted_gravity();
   std::vector<double> x(layout_.size, 0.0);
   for (size_t i = 0; i < layout_.loaded.size(); ++i)
     x[layout_.compliance + i] = nominal.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
@@ -154,15 +135,7 @@ void PointModel::set_params(const std::vector<double>& x) {
   }
   for (size_t i = 0; i < layout_.loaded.size(); ++i)
     spec_.joints[layout_.loaded[i]].compliance_deg_per_knm = x[layout_.compliance + i];
-  if (layout_.fit_gravity) {  // the fitted moments as a mass table (point_model.hpp)
-    for (int j = 0; j < n; ++j) spec_.joints[j].mass_kg = 0, spec_.joints[j].com.setZero();
-    for (size_t i = 0; i < layout_.moment_links.size(); ++i) {
-      const int k = layout_.moment_links[i];
-      const double* a = &x[layout_.moments + 2 * i];
-      spec_.joints[k].mass_kg = kUnitMass;
-      spec_.joints[k].com = com0_[static_cast<size_t>(k)] + (a[0] * u_[k] + a[1] * v_[k]) * (kMomentUnit / kUnitMass);
-    }
-  }
+  if (layout_.fit_gravity) fitted_masses(x);
   const Vec3 phim(x[layout_.tool + 3], x[layout_.tool + 4], x[layout_.tool + 5]);
   rm_ = nominal_.tool().linear() * so3::exp(phim);
   jrm_ = so3::right_jacobian(phim);
@@ -417,30 +390,6 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
         J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
   }
   return y;
-}
-
-std::vector<double> PointModel::probe(std::vector<double> x, const std::vector<bool>& fixed) const {
-  const ParamLayout& L = layout_;
-  if (!L.fit_gravity) return x;
-  double held = 0;  // the held compliance (the scale), else the largest
-  for (size_t i = 0; i < L.loaded.size(); ++i) {
-    const int c = L.compliance + static_cast<int>(i);
-    if (fixed[c] && x[c] != 0) held = x[c];
-  }
-  for (size_t i = 0; i < L.loaded.size() && held == 0; ++i) held = x[L.compliance + i];
-  if (held == 0) held = kUnitCompliance;
-  for (size_t i = 0; i < L.loaded.size(); ++i) {
-    const int c = L.compliance + static_cast<int>(i);
-    if (!fixed[c] && x[c] == 0) x[c] = held;
-  }
-  // generic moments of a robot's size: a fixed irregular pattern, none zero, none alike
-  double reach = 0;
-  for (int j = 0; j < L.dof; ++j) reach = std::max(reach, nominal_.point(j).norm());
-  reach = std::max(reach, nominal_.tool().translation().norm());
-  const double pattern[] = {0.83, -0.41, 0.57, 0.29, -0.66, 0.72, 0.38, -0.91, 0.47, 0.62, -0.35, 0.78};
-  for (int i = L.moments; i < L.tool; ++i)
-    if (!fixed[i] && x[i] == 0) x[i] = kUnitMass * std::max(reach, 100.0) * pattern[(i - L.moments) % 12] / kMomentUnit;
-  return x;
 }
 
 std::vector<double> PointModel::start(const MeasurementSet& data) const {

@@ -150,6 +150,8 @@ class PointModel {
   Vec3 tm_;
   std::vector<Vec3> w_, p_;
   std::vector<Vec3> com0_;  ///< with the gravity fitted: each link's centre of mass at zero moments
+  void init_fitted_gravity();                       ///< com0_ from the nominal geometry
+  void fitted_masses(const std::vector<double>& x);  ///< the moments of x as spec_'s mass table
   const Model& model_for(double payload) const;
   void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;
   /// Gravity at the commanded angles: frames, centres of mass, moment arms and joint torques.

@@ -78,9 +78,12 @@ std::vector<Parameter> parameters_of(const ParamLayout& L) {
     if (i < L.compliance) {
       p.kind = "joint_geometry";
       p.joint = (i - L.joints) / 4 + 1;
-    } else if (i < L.tool) {
+    } else if (i < L.moments) {
       p.kind = "compliance";
       p.joint = L.loaded[i - L.compliance] + 1;
+    } else if (i < L.tool) {
+      p.kind = "gravity_moment";
+      p.joint = L.moment_links[(i - L.moments) / 2] + 1;
     } else if (i < L.base) {
       p.kind = "tool";
     } else if (i < L.targets) {
@@ -203,7 +206,7 @@ void define_identify(py::module_& m) {
   py::class_<Parameter>(m, "Parameter", "One parameter of the identification vector")
       .def_readonly("name", &Parameter::name, "e.g. 'joint3.tilt_u', 'base.ry', 'joint2.te_sin1'")
       .def_readonly("kind", &Parameter::kind,
-                    "'joint_geometry', 'compliance', 'tool', 'base', 'target' or the effect's name")
+                    "'joint_geometry', 'compliance', 'gravity_moment', 'tool', 'base', 'target' or the effect's name")
       .def_readonly("joint", &Parameter::joint, "joint (or link) from 1; 0 when none")
       .def_readonly("target", &Parameter::target, "target from 0; -1 when none")
       .def_readonly("setup", &Parameter::setup, "setup code (from 0) of a base frame parameter; -1 for the others")
@@ -223,6 +226,7 @@ void define_identify(py::module_& m) {
       {"size", &ParamLayout::size, "number of parameters"},
       {"joints", &ParamLayout::joints, "offset of the joint geometry (4 per joint)"},
       {"compliance", &ParamLayout::compliance, "offset of the compliances (1 per gravity-loaded joint)"},
+      {"moments", &ParamLayout::moments, "offset of the fitted gravity's mass moments (2 per link; none with masses)"},
       {"tool", &ParamLayout::tool, "offset of the tool frame (6)"},
       {"base", &ParamLayout::base, "offset of the base frames in the instrument frame (6 per setup)"},
       {"targets", &ParamLayout::targets, "offset of the target offsets (3 per target)"},
@@ -234,6 +238,8 @@ void define_identify(py::module_& m) {
       .def_readonly("t_ref", &ParamLayout::t_ref, "reference temperature of thermal_expansion (degC)")
       .def_readonly("t_mean", &ParamLayout::t_mean, "reference time of the drift (s)")
       .def_readonly("setup_names", &ParamLayout::setup_names, "the setups by code (empty: a single one)")
+      .def_property_readonly("gravity", [](const ParamLayout& L) { return L.fit_gravity ? "fit" : "masses"; },
+                             "where the compliances' gravity torques come from: 'masses' (the model's) or 'fit'")
       .def_property_readonly("loaded", [](const ParamLayout& L) { return joints_to_one(L.loaded); },
                              "joints (from 1) with a compliance parameter: the gravity-loaded ones")
       .def_readonly("names", &ParamLayout::names, "one per parameter, e.g. 'joint3.tilt_u', 'base.ry'")
@@ -258,8 +264,10 @@ void define_identify(py::module_& m) {
                        const std::vector<Effect>& effects, bool covariance, double orientation_weight,
                        double rank_tolerance, double weak_tolerance, double min_torque_share,
                        double correlation_threshold, double prior_scale,
-                       const std::optional<std::vector<std::pair<std::string, double>>>& prior_sd) {
+                       const std::optional<std::vector<std::pair<std::string, double>>>& prior_sd,
+                       const std::string& gravity) {
              IdentifyOptions o;
+             o.gravity = gravity;
              o.compliance = compliance, o.compliance_joints = joints_from_one(compliance_joints), o.effects = effects;
              o.loss = loss, o.loss_scale_mm = loss_scale_mm, o.max_iterations = max_iterations;
              o.fix = fix, o.covariance = covariance, o.orientation_weight = orientation_weight;
@@ -276,9 +284,11 @@ void define_identify(py::module_& m) {
            py::arg("orientation_weight") = def.orientation_weight, py::arg("rank_tolerance") = def.rank_tolerance,
            py::arg("weak_tolerance") = def.weak_tolerance, py::arg("min_torque_share") = def.min_torque_share,
            py::arg("correlation_threshold") = def.correlation_threshold, py::arg("prior_scale") = def.prior_scale,
-           py::arg("prior_sd") = py::none())
+           py::arg("prior_sd") = py::none(), py::arg("gravity") = def.gravity)
       .def_readwrite("compliance", &IdentifyOptions::compliance, "identify the joint compliances")
       .def_readwrite("loss", &IdentifyOptions::loss, "'none', 'huber' or 'cauchy'")
+      .def_readwrite("gravity", &IdentifyOptions::gravity,
+                     "the compliances' gravity torques: 'masses', 'fit' (mass moments identified) or 'auto'")
       .def_readwrite("loss_scale_mm", &IdentifyOptions::loss_scale_mm,
                      "where the robust loss bends on a row's residual norm (mm); 0: from the data")
       .def_readwrite("prior_sd", &IdentifyOptions::prior_sd,

@@ -193,6 +193,8 @@ class ParamLayout:
     @property
     def compliance(self) -> int: ...
     @property
+    def moments(self) -> int: ...
+    @property
     def tool(self) -> int: ...
     @property
     def base(self) -> int: ...
@@ -211,6 +213,8 @@ class ParamLayout:
     @property
     def setup_names(self) -> list[str]: ...
     @property
+    def gravity(self) -> str: ...
+    @property
     def loaded(self) -> list[int]: ...
     @property
     def names(self) -> list[str]: ...
@@ -224,6 +228,7 @@ class ParamLayout:
 class IdentifyOptions:
     compliance: bool
     loss: str
+    gravity: str
     loss_scale_mm: float
     max_iterations: int
     rank_tolerance: float
@@ -243,7 +248,7 @@ class IdentifyOptions:
                  covariance: bool = ..., orientation_weight: float = ..., rank_tolerance: float = ...,
                  weak_tolerance: float = ..., min_torque_share: float = ...,
                  correlation_threshold: float = ..., prior_scale: float = ...,
-                 prior_sd: Optional[Sequence[tuple[str, float]]] = ...) -> None: ...
+                 prior_sd: Optional[Sequence[tuple[str, float]]] = ..., gravity: str = ...) -> None: ...
 
 class IdentifyResult:
     @property

@@ -135,7 +135,8 @@ def cmd_identify(args) -> None:
                          prior_scale=priors.parse_prior_scale(args.prior_scale),
                          holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
                          progress=_progress("identify"), orientation_weight=args.orientation_weight,
-                         fold_progress=campaign._step_progress("cross-validation, fold"), hold_out_setups=args.hold_out_setups)
+                         fold_progress=campaign._step_progress("cross-validation, fold"), hold_out_setups=args.hold_out_setups,
+                         gravity=args.gravity)
     if sys.stderr.isatty():
         print(file=sys.stderr)
     if args.tool_targets:
@@ -394,6 +395,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "placement) whole, its placement and targets refitted, instead of folds")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
+    sp.add_argument("--gravity", choices=["auto", "masses", "fit"], default="auto", help="the compliances' gravity "
+                    "torques: the model's masses, or mass moments identified (fit); auto: fit when it has no masses")
     model_opts(sp)
     sp.set_defaults(func=cmd_identify)
 

@@ -15,7 +15,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core, grouping, priors
+from . import _core, gravity as _gravity, grouping, priors
 from ._core import Robot
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, validate  # noqa: F401  (kincal.identify.validate, as before)
@@ -194,14 +194,14 @@ def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
 def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
             orientation_weight: float = 100.0, max_iterations: int = 100,
             fix: Sequence[str] = (), penalties: Sequence = (), prior_sd: Optional[dict] = None,
-            prior_scale: float = 0.0) -> "_core.IdentifyOptions":
+            prior_scale: float = 0.0, gravity: str = "auto") -> "_core.IdentifyOptions":
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
     joint_map smoothness penalty. ``prior_sd`` (kinds in file units, priors.DEFAULT_PRIOR_SD) times
     ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals."""
     effects = list(effects)
-    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss,
+    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss, gravity=gravity,
                               loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
                               effects=effects, covariance=covariance, orientation_weight=orientation_weight)
     o.penalties = [(str(n), float(w)) for n, w in penalties]
@@ -276,7 +276,7 @@ class Identification:
             "condition_number": f.condition_number,
             "observability_index": f.observability_index,
             "correlations": [{"a": a, "b": b, "r": r} for a, b, r in f.correlations],
-            "iterations": f.iterations,
+            "iterations": f.iterations, "gravity": _gravity.report(f),
             "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f.rms_mm, "max_mm": f.max_mm,
                     "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
@@ -292,8 +292,8 @@ class Identification:
     def summary(self) -> str:
         f, v = self.fit, self.validation
         lines = [f"identified {int(np.sum(~np.asarray(f.fixed)))} of {f.layout.size} parameters "
-                 f"({', '.join(['geometry'] + self.effect_labels())}) in {f.iterations} iterations"]
-        lines.append("")
+                 f"({', '.join(['geometry'] + self.effect_labels())}) in {f.iterations} iterations",
+                 _gravity.summary_line(f), ""]
         lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
                      f"{'mean after':>12}{'max before':>12}{'max after':>12}")
         lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}{'':>24}"
@@ -401,7 +401,7 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
              fold_progress: Optional[Callable[[int, int], None]] = None,
-             penalties: Sequence = (), hold_out_setups: bool = False) -> Identification:
+             penalties: Sequence = (), hold_out_setups: bool = False, gravity: str = "auto") -> Identification:
     """Identify the robot's parameters from measurements.
 
     ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread).
@@ -434,7 +434,8 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     auto = prior_scale is None or prior_scale == "auto"
     opts, cv_opts = (options(effects, loss=loss, loss_scale_mm=loss_scale_mm or 0.0, covariance=cov,
                              orientation_weight=orientation_weight, penalties=penalties, prior_sd=prior_sd,
-                             prior_scale=1.0 if auto else float(prior_scale)) for cov in (True, False))
+                             prior_scale=1.0 if auto else float(prior_scale), gravity=gravity)
+                     for cov in (True, False))
     fit = priors.Fitter(robot, prior_model, auto_scale=auto, seed=seed)
     every_row = np.ones(len(data["pose"]), dtype=bool)
     if hold_out_setups:

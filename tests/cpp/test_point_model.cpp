@@ -155,3 +155,103 @@ TEST(PointModel, OrientationJacobianMatchesFiniteDifferences) {
     }
   }
 }
+
+namespace {
+
+/// The kr500 without a mass table (a URDF without inertials): every link mass zero.
+ModelSpec massless_kr500() {
+  ModelSpec s = kr500_spec();
+  for (JointSpec& j : s.joints) j.mass_kg = 0, j.com.setZero();
+  return s;
+}
+
+/// A parameter point of the fitted gravity: the geometry moved, compliances and moments non-zero.
+std::vector<double> fitted_gravity_point(const PointModel& pm, const MeasurementSet& d, unsigned seed) {
+  const ParamLayout& L = pm.layout();
+  std::vector<double> x = pm.start(d);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> nd(0, 1);
+  for (int i = 0; i < L.size; ++i) {
+    if (i >= L.compliance && i < L.moments) x[i] = 0.003 * (1.0 + 0.3 * nd(rng));
+    else if (i >= L.moments && i < L.tool) x[i] = 0.4 * nd(rng);  // t m: deflections of ~0.01 deg
+    else x[i] += nd(rng) * (L.units[i] == "rad" ? 0.001 : 1.0);
+  }
+  return x;
+}
+
+}  // namespace
+
+TEST(PointModel, GravityModeFromTheMassTable) {
+  const Model with(kr500_spec()), without(massless_kr500());
+  EXPECT_FALSE(gravity_fitted(with, "auto"));
+  EXPECT_TRUE(gravity_fitted(without, "auto"));
+  EXPECT_TRUE(gravity_fitted(with, "fit"));
+  EXPECT_FALSE(gravity_fitted(with, "masses"));
+  EXPECT_THROW(gravity_fitted(without, "masses"), InputError);
+  EXPECT_THROW(gravity_fitted(with, "guess"), InputError);
+  // the fitted layout: 2 moments per link from the first loaded joint's (A2) on, after the compliances
+  const ParamLayout L(without, 3, {}, 20.0, {}, 0, true);
+  ASSERT_EQ(L.moment_links, (std::vector<int>{1, 2, 3, 4, 5}));
+  EXPECT_EQ(L.moments, L.compliance + static_cast<int>(L.loaded.size()));
+  EXPECT_EQ(L.tool, L.moments + 10);
+  EXPECT_EQ(L.names[L.moments], "link2.moment_u");
+  EXPECT_EQ(L.units[L.moments + 9], "t m");
+  EXPECT_EQ(ParamLayout(without, 3).moment_links.size(), 0u);
+}
+
+TEST(PointModel, JacobianMatchesFiniteDifferencesFittedGravity) {
+  // truth: kr500 with compliance; the model without masses, its gravity torques from fitted moments
+  // (and the kr500's 300 kg payload, known), at a random point: every column against central
+  // differences, the moments' included (they act through the torque only)
+  const MeasurementSet d = small_campaign(Model(truth_spec(4, 0.003)), kTargets);
+  const Model nominal(massless_kr500());
+  PointModel pm(nominal, 3, {}, 20.0, {}, 0, true);
+  const std::vector<double> x = fitted_gravity_point(pm, d, 11);
+  const auto worst = jacobian_errors(pm, x, d);
+  for (int i = 0; i < pm.layout().size; ++i) EXPECT_LT(worst[i], 1e-6) << pm.layout().names[i];
+}
+
+TEST(PointModel, FittedGravityOrientationJacobianAndWrittenModel) {
+  // 6-D rows: the Jacobian of the moments and compliances, position and orientation rows, against
+  // central differences relative to each column's largest entry (the test above is absolute for
+  // columns below 1); and the model written from the parameters (its mass table of unit masses) predicts
+  // every point as the measurement model does, so fk and compensate apply the fitted deflection
+  SimulationOptions so;
+  so.poses = 12;
+  so.noise_mm = 0.02;
+  so.orientation_noise_deg = 0.01;
+  so.targets = {Vec3(0, 0, 0)};
+  const MeasurementSet d = simulate(Model(truth_spec(6, 0.003)), so);
+  const Model nominal(massless_kr500());
+  PointModel pm(nominal, 1, {}, 20.0, {}, 0, true);
+  const ParamLayout& L = pm.layout();
+  const std::vector<double> x = fitted_gravity_point(pm, d, 12);
+  const double w = 100.0;
+  for (const auto& row : d.rows) {
+    pm.set_params(x);
+    std::vector<double> J(6 * L.size), r(6);
+    ASSERT_EQ(row_residuals(pm, row, ResidualKind::pose, w, r.data(), J.data()), 6);
+    for (int i = L.compliance; i < L.tool; ++i) {
+      const double h = L.units[i] == "t m" ? 1e-3 : 1e-5;  // moments: 0.4 t m
+      std::vector<double> xp = x, xm = x, rp(6), rm(6);
+      xp[i] += h;
+      xm[i] -= h;
+      pm.set_params(xp);
+      row_residuals(pm, row, ResidualKind::pose, w, rp.data(), nullptr);
+      pm.set_params(xm);
+      row_residuals(pm, row, ResidualKind::pose, w, rm.data(), nullptr);
+      double scale = 0;
+      for (int k = 0; k < 6; ++k) scale = std::max(scale, std::abs(J[k * L.size + i]));
+      ASSERT_GT(scale, 0) << L.names[i];
+      for (int k = 0; k < 6; ++k)
+        EXPECT_LT(std::abs((rp[k] - rm[k]) / (2 * h) - J[k * L.size + i]) / scale, 1e-6) << L.names[i] << " row " << k;
+    }
+  }
+  pm.set_params(x);
+  const Model written(pm.spec());
+  const std::vector<Vec3> targets = {Vec3(x[L.targets], x[L.targets + 1], x[L.targets + 2])};
+  const std::vector<double> e = point_errors(written, targets, d);
+  ASSERT_EQ(e.size(), d.rows.size());
+  for (size_t i = 0; i < d.rows.size(); ++i)
+    EXPECT_NEAR(e[i], (pm.predict(d.rows[i], nullptr) - d.rows[i].xyz).norm(), 1e-9);
+}

@@ -5,6 +5,8 @@
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -58,6 +60,24 @@ void fix_unloaded_compliances(const Model& nominal, const MeasurementSet& data, 
                     static_cast<int>(std::max_element(tmax.begin(), tmax.end()) - tmax.begin()) + 1);
       res.fix(L.compliance + static_cast<int>(i), buf);
     }
+  }
+}
+
+/// With the gravity fitted, compliance x moment is what the points see (point_model.hpp): the first
+/// free compliance is held as the scale, at its start value or kUnitCompliance (res.start), unless
+/// the rows carry several payloads (their known masses then fix the scale).
+void hold_gravity_scale(const MeasurementSet& data, IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  std::set<double> payloads;
+  for (const auto& r : data.rows)
+    if (!std::isnan(r.payload_kg)) payloads.insert(r.payload_kg);
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int c = L.compliance + static_cast<int>(i);
+    if (res.fixed[c]) continue;
+    if (res.start[c] == 0) res.start[c] = kUnitCompliance;
+    if (payloads.size() < 2)
+      res.fix(c, "the scale of the fitted mass moments (no masses: compliance x moment is what the points see)");
+    return;
   }
 }
 
@@ -195,6 +215,83 @@ void at_prior(const Linearization& lin, const IdentifyResult& generic, const std
   }
 }
 
+/// With the gravity fitted: the moments the data show at x (one Gauss-Newton step of every free
+/// parameter but the compliances, each of those at the held one's value: the moments are linear
+/// then), and, as fix_unloaded_compliances does with masses, the compliance of a joint whose torque
+/// from them stays below opt.min_torque_share of the largest held. Returns x with those moments: the
+/// point at which the data's columns are judged (at zero moments no compliance has an effect, and
+/// at generic ones a joint that gravity barely loads would look identifiable).
+std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
+                                   const IdentifyOptions& opt, IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  std::vector<double> xs = pm.probe(x, res.fixed);  // compliances set; its generic moments dropped:
+  for (int i = L.moments; i < L.tool; ++i) xs[i] = x[i];
+  const Linearization lin = linearize(pm, data, xs, opt.orientation_weight);
+  std::vector<int> cols;
+  for (int i = 0; i < L.size; ++i)
+    if (!res.fixed[i] && (i < L.compliance || i >= L.moments)) cols.push_back(i);
+  Eigen::MatrixXd A(lin.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
+  Eigen::VectorXd nrm(A.cols());
+  for (size_t c = 0; c < cols.size(); ++c) {
+    nrm[c] = lin.jacobian.col(cols[c]).norm();
+    A.col(c) = lin.jacobian.col(cols[c]) / (nrm[c] > 0 ? nrm[c] : 1.0);
+  }
+  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  const Eigen::VectorXd step = -cod.solve(r);
+  // a link's pair of moments is seen when it stands out of its noise: chi-square (2 degrees of
+  // freedom) of the pair with the step's covariance above its 99% quantile; the others are held at
+  // zero (the bilinear form is flat along a compliance whose moments vanish)
+  const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
+  const double s2 = (r + A * step).squaredNorm() / dofres;
+  const Eigen::MatrixXd cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  int seen = 0;
+  for (size_t c = 0; c + 1 < cols.size(); ++c) {
+    const int i = cols[c];
+    if (i < L.moments || i >= L.tool || (i - L.moments) % 2 != 0 || cols[c + 1] != i + 1) continue;
+    const Eigen::Vector2d a = step.segment<2>(static_cast<Eigen::Index>(c));
+    const Eigen::Matrix2d ca = cov.block<2, 2>(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c));
+    const Eigen::FullPivLU<Eigen::Matrix2d> lu(ca);
+    const double chi2 = lu.isInvertible() ? a.dot(lu.solve(a)) : 0.0;
+    if (chi2 > 9.21 && nrm[c] > 0 && nrm[c + 1] > 0) {
+      xs[i] += step[c] / nrm[c];
+      xs[i + 1] += step[c + 1] / nrm[c + 1];
+      ++seen;
+      continue;
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "moment not seen by these poses (chi-square %.1f of its pair, below 9.21)", chi2);
+    res.fix(i, buf);
+    res.fix(i + 1, buf);
+  }
+  // the joints' torques from those moments over the measured poses
+  pm.set_params(xs);
+  const Model fitted(pm.spec());
+  std::vector<double> tmax(L.dof, 0.0);
+  VecQ tau;
+  for (const auto& row : data.rows) {
+    gravity_torque(fitted, row.q_deg * kDeg, tau);
+    for (int j = 0; j < L.dof; ++j) tmax[j] = std::max(tmax[j], std::abs(tau[j]));
+  }
+  double top = 0;
+  int top_j = 0;
+  for (int j : L.loaded)
+    if (seen > 0 && tmax[j] > top) top = tmax[j], top_j = j;  // none seen: every compliance held
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int j = L.loaded[i], c = L.compliance + static_cast<int>(i);
+    if (res.fixed[c] || (top > 0 && !(tmax[j] < opt.min_torque_share * top))) continue;
+    char buf[200];
+    if (top > 0)
+      std::snprintf(buf, sizeof buf, "gravity torque too small to see it (fitted moments: %.1f%% of joint %d's)",
+                    100.0 * tmax[j] / top, top_j + 1);
+    else
+      std::snprintf(buf, sizeof buf, "no gravity deflection seen by these poses (no fitted moment stands out)");
+    res.fix(c, buf);
+    xs[c] = x[c];
+  }
+  return xs;
+}
+
 }  // namespace
 
 void fix_unobservable(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
@@ -218,7 +315,9 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
       if (std::find(asked.begin(), asked.end(), L.loaded[i]) == asked.end())
         res.fix(L.compliance + static_cast<int>(i), "not in the model");
     }
-  if (opt.compliance && !L.loaded.empty()) fix_unloaded_compliances(nominal, data, opt, res);
+  // with the gravity fitted the model's masses are not what acts: the moments say how loaded a joint is
+  if (opt.compliance && !L.loaded.empty() && !L.fit_gravity) fix_unloaded_compliances(nominal, data, opt, res);
+  if (L.fit_gravity) hold_gravity_scale(data, res);
   for (const auto& name : opt.fix) {
     auto it = std::find(L.names.begin(), L.names.end(), name);
     if (it == L.names.end()) throw InputError("identify: no parameter named '" + name + "'");
@@ -239,16 +338,20 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
     if (!penalised) order.push_back(i);
   }
   // what the generic campaign determines but the data do not means the data are too few or too alike
+  // with the gravity fitted, judged at the moments the data show (fitted_moments)
+  const std::vector<double> xp = res.layout.fit_gravity ? fitted_moments(pm, data, x, opt, res) : x;
   IdentifyResult generic = res;
-  select_independent(linearize(pm, generic_campaign(nominal, data), x, opt.orientation_weight).jacobian, order, opt,
+  select_independent(linearize(pm, generic_campaign(nominal, data), xp, opt.orientation_weight).jacobian, order, opt,
                      generic);
-  Linearization lin = linearize(pm, data, x, opt.orientation_weight);
+  Linearization lin = linearize(pm, data, xp, opt.orientation_weight);
   res.at_prior.assign(L.size, false);
   if (std::any_of(prior_sd.begin(), prior_sd.end(), [](double s) { return std::isfinite(s); })) {
     at_prior(lin, generic, order, opt, prior_sd, res);
+    if (xp != x) lin = linearize(pm, data, x, opt.orientation_weight);
     return lin;
   }
   select_independent(lin.jacobian, order, opt, res);
+  if (xp != x) lin = linearize(pm, data, x, opt.orientation_weight);
   std::string missing;
   int n_missing = 0;
   // only what the data make exactly redundant counts (near the weak threshold the two may differ)

@@ -285,8 +285,7 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   ceres::Solver::Summary summary;
   AllRows all(pm, data, x, frames, opt.orientation_weight);
   ceres::Problem problem(problem_options(all));
-  // a scale from the data is not known yet: the frames are a start, fitted by least squares then
-  std::unique_ptr<ceres::LossFunction> loss = make_loss(opt, opt.loss_scale_mm);
+  std::unique_ptr<ceres::LossFunction> loss = make_loss(opt, opt.loss_scale_mm);  // a scale from the data: none yet
   pm.set_params(x);
   pm.set_frames_only(true, &data);  // only the base and target columns are needed here
   solve(problem, all, loss.get(), opt, summary, Report::silent);
@@ -383,21 +382,6 @@ void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summ
     }
 }
 
-/// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
-/// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r).
-double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, int row_size) {
-  const Eigen::Index n = static_cast<Eigen::Index>(lin.residuals.size());
-  Eigen::MatrixXd J(n, static_cast<Eigen::Index>(determined.size()));
-  for (size_t k = 0; k < determined.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = lin.jacobian.col(determined[k]);
-  const Eigen::Map<const Eigen::VectorXd> r(lin.residuals.data(), n);
-  const Eigen::VectorXd step = (J.transpose() * J).ldlt().solve(J.transpose() * r);
-  const Eigen::VectorXd after = r - J * step;
-  std::vector<double> position;
-  for (Eigen::Index i = 0; i < n; i += row_size)
-    for (int c = 0; c < 3; ++c) position.push_back(after[i + c]);
-  return robust_noise(position, determined.size());
-}
-
 /// The stage-2 solves: each a Levenberg-Marquardt run on a set of free parameters from the current
 /// x, at a loss scale (0: least squares), with the options' penalties and the priors given. The
 /// last problem stays for the covariance.
@@ -461,15 +445,16 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   check_effect_columns(nominal, data, effects);
   const double t_ref = reference_temperature(nominal, data, effects);
   const double t_mean = reference_time(data, effects);
-  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean));
-  PointModel pm(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean);
+  const bool fit_gravity = opt.compliance && gravity_fitted(nominal, opt.gravity);
+  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity));
+  PointModel pm(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity);
   pm.prepare_payloads(data);
   res.start = pm.start(data);
   res.fixed.assign(res.layout.size, false);
   res.fixed_reason.assign(res.layout.size, "");
   start_carried_effects(nominal, opt, res);
-  std::vector<double> x = res.start;
   fix_unobservable(nominal, data, opt, res);
+  std::vector<double> x = res.start;
   // stage 1: the frames on the nominal geometry; then what the data cannot determine is held (or,
   // with priors, left to them)
   fit_frames(pm, nominal, data, opt, x, res);

@@ -41,15 +41,18 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
 }  // namespace
 
 ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr,
-                         const std::vector<std::string>& setups, double tm)
-    : dof(nominal.dof()), n_targets(nt), effect_list(eff), t_ref(tr), t_mean(tm) {
+                         const std::vector<std::string>& setups, double tm, bool fit_g)
+    : dof(nominal.dof()), n_targets(nt), fit_gravity(fit_g), effect_list(eff), t_ref(tr), t_mean(tm) {
   if (setups.size() > 1) setup_names = setups;
   n_setups = setup_names.empty() ? 1 : static_cast<int>(setup_names.size());
   for (int j = 0; j < dof; ++j)
     if (nominal.gravity_loaded(j)) loaded.push_back(j);
   joints = 0;
   compliance = 4 * dof;
-  tool = compliance + static_cast<int>(loaded.size());
+  moments = compliance + static_cast<int>(loaded.size());
+  if (fit_gravity && !loaded.empty())
+    for (int k = loaded.front(); k < dof; ++k) moment_links.push_back(k);
+  tool = moments + 2 * static_cast<int>(moment_links.size());
   base = tool + 6;
   targets = base + 6 * n_setups;
   effects = targets + 3 * n_targets;
@@ -71,6 +74,8 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
     for (const char* s : {".move_u", ".move_v"}) names.push_back(p + s), units.push_back("mm");
   }
   for (int j : loaded) names.push_back("joint" + std::to_string(j + 1) + ".compliance"), units.push_back("deg/kNm");
+  for (int k : moment_links)
+    for (const char* s : {".moment_u", ".moment_v"}) names.push_back("link" + std::to_string(k + 1) + s), units.push_back("t m");
   std::vector<std::string> frames = {"tool"};
   if (setup_names.empty()) frames.push_back("base");
   for (const std::string& sn : setup_names) frames.push_back("base[" + sn + "]");
@@ -88,8 +93,8 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
 }
 
 PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects, double t_ref,
-                       const std::vector<std::string>& setups, double t_mean)
-    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref, setups, t_mean) {
+                       const std::vector<std::string>& setups, double t_mean, bool fit_gravity)
+    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref, setups, t_mean, fit_gravity) {
   const int n = nominal.dof();
   // every setup's corrections are relative to the model's frame of that name, or its base frame
   place_.resize(static_cast<size_t>(layout_.n_setups));
@@ -108,6 +113,7 @@ PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Ef
   }
   w_.resize(n);
   p_.resize(n);
+  init_fitted_gravity();
   std::vector<double> x(layout_.size, 0.0);
   for (size_t i = 0; i < layout_.loaded.size(); ++i)
     x[layout_.compliance + i] = nominal.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
@@ -129,6 +135,7 @@ void PointModel::set_params(const std::vector<double>& x) {
   }
   for (size_t i = 0; i < layout_.loaded.size(); ++i)
     spec_.joints[layout_.loaded[i]].compliance_deg_per_knm = x[layout_.compliance + i];
+  if (layout_.fit_gravity) fitted_masses(x);
   const Vec3 phim(x[layout_.tool + 3], x[layout_.tool + 4], x[layout_.tool + 5]);
   rm_ = nominal_.tool().linear() * so3::exp(phim);
   jrm_ = so3::right_jacobian(phim);

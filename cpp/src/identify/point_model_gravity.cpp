@@ -1,13 +1,75 @@
 // kincal: PointModel's gravity state and the Jacobian terms through the gravity torque.
 // The deflection K tau(q) depends on the geometry through the gravity torque: moving a joint line
 // moves the links (their centres of mass) and the axes the torque is taken about; moving the tool
-// frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter).
+// frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter), and the
+// columns of the fitted gravity's mass moments (point_model.hpp), which act only through tau.
 // K tau itself acts in row_frames() (point_model.cpp); these are its derivatives.
 #include "kincal/identify/point_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace kincal {
+
+bool gravity_fitted(const Model& nominal, const std::string& mode) {
+  bool masses = false;
+  for (const JointSpec& j : nominal.spec().joints) masses = masses || j.mass_kg > 0;
+  if (mode == "fit") return true;
+  if (mode == "auto") return !masses;
+  if (mode != "masses") throw InputError("identify: unknown gravity mode '" + mode + "' (auto, masses, fit)");
+  if (!masses)
+    throw InputError("identify: --gravity masses, but the model '" + nominal.spec().name +
+                     "' has no link masses (no inertial data): use --gravity fit (or auto)");
+  return false;
+}
+
+void PointModel::init_fitted_gravity() {
+  const int n = layout_.dof;
+  // zero moments: a_k = m (c_k - p_k) + M_{k+1} (p_{k+1} - p_k) = 0 with every fitted link's mass m
+  com0_.assign(static_cast<size_t>(n), Vec3::Zero());
+  for (int k : layout_.moment_links) {
+    const double beyond = n - 1 - k;  // the fitted links beyond k, kUnitMass each
+    Vec3 c = nominal_.point(k);
+    if (k + 1 < n) c -= beyond * (nominal_.point(k + 1) - nominal_.point(k));
+    com0_[static_cast<size_t>(k)] = c;
+  }
+}
+
+void PointModel::fitted_masses(const std::vector<double>& x) {  // the moments as a mass table (point_model.hpp)
+  const int n = layout_.dof;
+  for (int j = 0; j < n; ++j) spec_.joints[j].mass_kg = 0, spec_.joints[j].com.setZero();
+  for (size_t i = 0; i < layout_.moment_links.size(); ++i) {
+    const int k = layout_.moment_links[i];
+    const double* a = &x[layout_.moments + 2 * i];
+    spec_.joints[k].mass_kg = kUnitMass;
+    spec_.joints[k].com = com0_[static_cast<size_t>(k)] + (a[0] * u_[k] + a[1] * v_[k]) * (kMomentUnit / kUnitMass);
+  }
+}
+
+std::vector<double> PointModel::probe(std::vector<double> x, const std::vector<bool>& fixed) const {
+  const ParamLayout& L = layout_;
+  if (!L.fit_gravity) return x;
+  double held = 0;  // the held compliance (the scale), else the largest
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int c = L.compliance + static_cast<int>(i);
+    if (fixed[c] && x[c] != 0) held = x[c];
+  }
+  for (size_t i = 0; i < L.loaded.size() && held == 0; ++i) held = x[L.compliance + i];
+  if (held == 0) held = kUnitCompliance;
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int c = L.compliance + static_cast<int>(i);
+    if (!fixed[c] && x[c] == 0) x[c] = held;
+  }
+  // generic moments of a robot's size: a fixed irregular pattern, none zero, none alike
+  double reach = 0;
+  for (int j = 0; j < L.dof; ++j) reach = std::max(reach, nominal_.point(j).norm());
+  reach = std::max(reach, nominal_.tool().translation().norm());
+  const double pattern[] = {0.83, -0.41, 0.57, 0.29, -0.66, 0.72, 0.38, -0.91, 0.47, 0.62, -0.35, 0.78};
+  for (int i = L.moments; i < L.tool; ++i)
+    if (!fixed[i] && x[i] == 0) x[i] = kUnitMass * std::max(reach, 100.0) * pattern[(i - L.moments) % 12] / kMomentUnit;
+  return x;
+}
 
 void PointModel::gravity_state(const Model& model, const Measurement& m, GravityState& gs) const {
   const int n = layout_.dof;
@@ -118,6 +180,18 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
         }
       }
       apply(4 * i + c, dtau);
+    }
+  }
+  // the fitted gravity's moments: one of link k along d adds G_{k+1} d (kMomentUnit kg mm) to A_j of
+  // every joint j <= k, so dtau_j = wc_j . (G_{k+1} d x g) = G_{k+1} d . B_j
+  for (size_t i = 0; i < layout_.moment_links.size(); ++i) {
+    const int k = layout_.moment_links[i];
+    for (int c = 0; c < 2; ++c) {
+      const Vec3 s = gr[k + 1] * (c == 0 ? u_[k] : v_[k]) * kMomentUnit;
+      std::array<double, kMaxJoints> dtau{};
+      for (int j : layout_.loaded)
+        if (j <= k) dtau[j] = s.dot(B[j]);
+      apply(layout_.moments + 2 * static_cast<int>(i) + c, dtau);
     }
   }
   if (mp != 0) {

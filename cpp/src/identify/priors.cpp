@@ -2,6 +2,7 @@
 #include "kincal/identify/priors.hpp"
 
 #include "kincal/effects/effects.hpp"
+#include "kincal/identify/identifiability.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,7 +28,7 @@ std::vector<double> prior_sds(const ParamLayout& L, const IdentifyOptions& opt) 
     // the ranges of the kind: [first, last) and the unit its parameters have there ("": any)
     std::vector<std::tuple<int, int, std::string>> ranges;
     if (kind == "joint_mm" || kind == "joint_rad") ranges.emplace_back(L.joints, L.compliance, kind.substr(6));
-    else if (kind == "compliance") ranges.emplace_back(L.compliance, L.tool, "");
+    else if (kind == "compliance") ranges.emplace_back(L.compliance, L.moments, "");
     else if (kind == "tool_mm" || kind == "tool_rad") ranges.emplace_back(L.tool, L.base, kind.substr(5));
     else if (kind == "base_mm" || kind == "base_rad") ranges.emplace_back(L.base, L.targets, kind.substr(5));
     else if (kind == "target_mm") ranges.emplace_back(L.targets, L.effects, "");
@@ -70,5 +71,20 @@ double robust_noise(std::vector<double> v, std::size_t p) {
 }
 
 double loss_threshold(double noise_mm, int row_size) { return noise_mm * std::sqrt(row_size == 6 ? 12.592 : 7.815); }
+
+/// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
+/// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r).
+double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, int row_size) {
+  const Eigen::Index n = static_cast<Eigen::Index>(lin.residuals.size());
+  Eigen::MatrixXd J(n, static_cast<Eigen::Index>(determined.size()));
+  for (size_t k = 0; k < determined.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = lin.jacobian.col(determined[k]);
+  const Eigen::Map<const Eigen::VectorXd> r(lin.residuals.data(), n);
+  const Eigen::VectorXd step = (J.transpose() * J).ldlt().solve(J.transpose() * r);
+  const Eigen::VectorXd after = r - J * step;
+  std::vector<double> position;
+  for (Eigen::Index i = 0; i < n; i += row_size)
+    for (int c = 0; c < 3; ++c) position.push_back(after[i + c]);
+  return robust_noise(position, determined.size());
+}
 
 }  // namespace kincal

@@ -15,8 +15,9 @@ namespace kincal {
 
 /// Fix what the options and the measured poses rule out: targets never measured, compliances not
 /// asked for (opt.compliance, opt.compliance_joints) or of a joint with less than
-/// opt.min_torque_share of the largest gravity torque over the poses, and the parameters named in
-/// opt.fix (InputError for an unknown name).
+/// opt.min_torque_share of the largest gravity torque over the poses (with masses), and the
+/// parameters named in opt.fix (InputError for an unknown name). With the gravity fitted, the first
+/// free compliance is held as the moments' scale (its res.start set to kUnitCompliance if zero).
 void fix_unobservable(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
                       IdentifyResult& res);
 
@@ -31,10 +32,13 @@ struct Linearization {
 /// Jacobian columns (opt.rank_tolerance: redundant, opt.weak_tolerance: too weakly seen), on the
 /// data and on a generic campaign (100 random poses in the limits of the nominal model, the targets
 /// measured, the same kind of rows). Throws InputError when the data leave redundant what the
-/// generic campaign determines (too few or too similar poses). Returns the data's linearization at
-/// x (pm's parameters are then x). With priors (prior_sd: one per parameter, finite where it has
-/// one) what only the data leave undetermined is no error: it stays free, determined by its prior
-/// (res.at_prior), or is held when it has none.
+/// generic campaign determines (too few or too similar poses). With the gravity fitted (no mass
+/// table, point_model.hpp) the columns are judged at the moments the data show (one Gauss-Newton
+/// step from x): a link's moments that do not stand out of their noise are held at zero, and the
+/// compliance of a joint they barely load (opt.min_torque_share) is held, all of them when no moment
+/// is seen. Returns the data's linearization at x (pm's parameters are then x). With priors
+/// (prior_sd: one per parameter, finite where it has one) what only the data leave undetermined is
+/// no error: it stays free, determined by its prior (res.at_prior), or is held when it has none.
 Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
                                  const std::vector<double>& prior_sd = {});

@@ -27,6 +27,7 @@ std::vector<std::pair<std::string, double>> default_prior_sd();
 
 struct IdentifyOptions {
   bool compliance = true;          ///< identify the joint compliances
+  std::string gravity = "auto";    ///< their torques: "masses" (the model's), "fit" (moments), "auto" (fit without masses)
   std::string loss = "huber";      ///< "none", "huber", "cauchy"
   /// where the robust loss bends on a row's residual norm (mm); 0: from the data (after a
   /// least-squares start, from the residuals' robust spread, re-estimated once after the robust fit)

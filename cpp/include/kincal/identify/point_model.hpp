@@ -15,6 +15,9 @@
 //   per joint 4: axis tilt along u and v (rad; w' = normalise(w + a_u u + a_v v)) and the axis moved
 //                along u and v (mm), with u, v unit vectors normal to the nominal axis;
 //   per gravity-loaded joint 1: compliance (deg per kN m, absolute);
+//   with the gravity fitted (no mass table, see below) per link from the first loaded joint's on 2:
+//        its first moment across its joint's axis, along u and v (t m = 1e6 kg mm: columns of the
+//        order of the others', so that the covariance's conditioning is not lost to units);
 //   tool 6: translation (mm) and rotation vector (rad, R = R0 Exp(phi));
 //   base 6 per setup: the same for the base frame in the instrument frame ("base.x" for one setup,
 //        "base[NAME].x" for several), relative to the model's frame of that setup name (its setups)
@@ -22,6 +25,20 @@
 //   per target 3: offset in the tool frame (mm, absolute);
 //   per extra effect (transmission_error 2 per harmonic order, backlash 1, thermal_expansion 1,
 //   drift 6), see effects.hpp (the registry).
+// Gravity without a mass table ("fit"): the torque about joint j is tau_j = w_j . (A_j x g) with
+// A_j = sum_{k>=j} G_{k+1} a_k (+ the payload's known part), a_k a constant vector of link k (its mass
+// times its centre of mass from p_k, plus the mass beyond it times p_{k+1} - p_k): linear in the
+// a_k. Along w_k, a_k only moves a constant vector of link k-1 (G_{k+1} w_k = G_k w_k), so only its
+// 2 components across w_k count: every gravity torque is reached with those. Compliance times these
+// moments is what the points see: K_j a_k, unchanged by K -> K / s, a -> s a. That scale is held:
+// the compliance of the first loaded joint asked for stays at its start value (its nominal one, or
+// kUnitCompliance), and the fitted moments are "effective" ones at that compliance; every other
+// compliance is free, its ratio to the held one identified. This bilinear form (not one product
+// K_j a_k per pair, which the points would also see) keeps one moment per link, so that the result
+// is a mass table: every fitted link gets kUnitMass kg at its centre of mass p_k + (a_k - M_{k+1}
+// (p_{k+1} - p_k)) / kUnitMass, which fk, compensate and kincal-compensate apply as they apply any
+// masses. The payload's mass stays the model's (a constant payload is absorbed by the moments; only
+// several payloads in the data fix the absolute scale, and then the scale is not held).
 // Rows with a measured orientation (a, b, c) add 3 residuals: the weighted rotation vector from the
 // measured to the predicted tool frame.
 #pragma once
@@ -37,10 +54,22 @@
 
 namespace kincal {
 
+/// The fitted gravity's mass of every fitted link (kg) and the held compliance's start value
+/// (deg/kNm) when the model has none: only their products with the moments are determined.
+constexpr double kUnitMass = 1.0, kUnitCompliance = 0.01;
+/// kg mm per unit of a fitted moment parameter (t m)
+constexpr double kMomentUnit = 1e6;
+
+/// Whether identification fits the gravity's mass moments: mode "fit", or "auto" and no link of the
+/// model has a mass; "masses" uses the model's (InputError when it has none, or for another mode).
+bool gravity_fitted(const Model& nominal, const std::string& mode);
+
 /// Layout of the identification parameter vector for a model, a number of targets and the setups.
 struct ParamLayout {
   int dof = 0, n_targets = 0, n_setups = 1;
-  int joints = 0, compliance = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
+  int joints = 0, compliance = 0, moments = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
+  bool fit_gravity = false;           ///< the gravity's mass moments are parameters (no mass table)
+  std::vector<int> moment_links;      ///< the link (joint index) of every pair of moment parameters
   int drift = -1;                     ///< offset of the drift's 6 parameters (-1: no drift)
   std::vector<int> loaded;            ///< joint of every compliance parameter
   std::vector<Effect> effect_list;    ///< extra effects, their parameters from `effects` on
@@ -49,17 +78,18 @@ struct ParamLayout {
   double t_mean = 0;                  ///< the drift's reference time (s)
   std::vector<std::string> setup_names;  ///< by setup code (empty: one setup, no setup column)
   std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry", "base[B].ry"
-  std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm"
+  std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm", "t m"
   /// setups: the names of the data's setups (by code); none or one: a single placement "base.*".
+  /// fit_gravity: the moments of every link from the first loaded joint's on are parameters.
   ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,
-              const std::vector<std::string>& setups = {}, double t_mean = 0);
+              const std::vector<std::string>& setups = {}, double t_mean = 0, bool fit_gravity = false);
 };
 
 /// Evaluates the measurement model and its analytic Jacobian for one parameter vector.
 class PointModel {
  public:
   PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,
-             const std::vector<std::string>& setups = {}, double t_mean = 0);
+             const std::vector<std::string>& setups = {}, double t_mean = 0, bool fit_gravity = false);
   const ParamLayout& layout() const { return layout_; }
   /// Set the parameters (size layout().size); builds the current model.
   void set_params(const std::vector<double>& x);
@@ -77,7 +107,12 @@ class PointModel {
   Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
   /// Starting parameters: nominal geometry, each setup's base frame from the best rigid fit (Horn)
   /// of the nominal prediction of the tool point to that setup's rows, targets at the tool point.
+  /// With the gravity fitted: every moment zero (no link torque), compliances nominal.
   std::vector<double> start(const MeasurementSet& data) const;
+  /// With the gravity fitted: generic non-zero moments (and free zero compliances at the held one's
+  /// value) in place of x's, for judging what the data determine: at zero moments a compliance has
+  /// no effect, whatever the data (the bilinear form's saddle).
+  std::vector<double> probe(std::vector<double> x, const std::vector<bool>& fixed) const;
 
  private:
   const Model& nominal_;
@@ -114,6 +149,9 @@ class PointModel {
   Mat3 rm_, jrm_;
   Vec3 tm_;
   std::vector<Vec3> w_, p_;
+  std::vector<Vec3> com0_;  ///< with the gravity fitted: each link's centre of mass at zero moments
+  void init_fitted_gravity();                       ///< com0_ from the nominal geometry
+  void fitted_masses(const std::vector<double>& x);  ///< the moments of x as spec_'s mass table
   const Model& model_for(double payload) const;
   void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;
   /// Gravity at the commanded angles: frames, centres of mass, moment arms and joint torques.

@@ -37,4 +37,11 @@ double robust_noise(std::vector<double> position, std::size_t p);
 /// would down-weight most clean rows, whose norms add three coordinates).
 double loss_threshold(double noise_mm, int row_size);
 
+struct Linearization;
+
+/// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
+/// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r), row_size residuals
+/// per row, the first 3 of each the position.
+double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, int row_size);
+
 }  // namespace kincal

@@ -15,20 +15,7 @@ namespace kincal {
 
 namespace {
 
-std::string upper(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
-// the line without its comment (';' outside strings)
-std::string code_of(const std::string& l) {
-  bool str = false;
-  for (size_t i = 0; i < l.size(); ++i) {
-    if (l[i] == '"') str = !str;
-    if (l[i] == ';' && !str) return l.substr(0, i);
-  }
-  return l;
-}
+std::string code_of(const std::string& l) { return code_before(l, ';'); }
 
 }  // namespace
 
@@ -65,7 +52,7 @@ Pose6 parse_aggregate(const std::string& agg, const std::string& at) {
   for (const std::string& item : split_top(agg.substr(1, agg.size() - 2))) {
     size_t k = 0;
     while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
-    const std::string key = upper(item.substr(0, k));
+    const std::string key = upper_case(item.substr(0, k));
     std::string val = item.substr(k);
     val.erase(0, val.find_first_not_of(" \t"));
     static const char* keys[6] = {"X", "Y", "Z", "A", "B", "C"};
@@ -86,29 +73,6 @@ Pose6 parse_aggregate(const std::string& agg, const std::string& at) {
 
 }  // namespace
 
-std::vector<std::string> split_top(const std::string& s) {
-  std::vector<std::string> out;
-  int depth = 0;
-  bool str = false;
-  std::string cur;
-  for (char c : s) {
-    if (c == '"') str = !str;
-    if (!str && (c == '{' || c == '[' || c == '(')) ++depth;
-    if (!str && (c == '}' || c == ']' || c == ')')) --depth;
-    if (!str && depth == 0 && c == ',') {
-      out.push_back(cur);
-      cur.clear();
-      continue;
-    }
-    cur += c;
-  }
-  out.push_back(cur);
-  for (auto& x : out) {
-    const size_t a = x.find_first_not_of(" \t\r"), b = x.find_last_not_of(" \t\r");
-    x = a == std::string::npos ? std::string() : x.substr(a, b - a + 1);
-  }
-  return out;
-}
 
 NativeProgram read_krl_program(const std::string& src_path) {
   NativeProgram p;
@@ -142,9 +106,9 @@ NativeProgram read_krl_program(const std::string& src_path) {
     for (size_t i = 0; i < p.lines[f].size(); ++i) {
       const std::string code = code_of(p.lines[f][i]);
       const std::string at = where(p.paths[f], static_cast<int>(i + 1));
-      std::string first = upper(code.substr(code.find_first_not_of(" \t") == std::string::npos ? code.size() : code.find_first_not_of(" \t")));
+      std::string first = upper_case(code.substr(code.find_first_not_of(" \t") == std::string::npos ? code.size() : code.find_first_not_of(" \t")));
       first = first.substr(0, first.find_first_of(" \t(\r"));
-      if (first == "GLOBAL" && std::regex_search(upper(code), std::regex(R"(^\s*GLOBAL\s+DEF(FCT)?\b)")))
+      if (first == "GLOBAL" && std::regex_search(upper_case(code), std::regex(R"(^\s*GLOBAL\s+DEF(FCT)?\b)")))
         first = "DEF";
       if (first == open || (f == 0 && first == "DEFFCT")) {
         if (open_line && !closed && f == 1) throw InputError(at + ": DEFDAT inside DEFDAT");
@@ -157,7 +121,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
       std::smatch m;
       if (std::regex_match(code, m, decl_re)) {
         Decl d;
-        d.type = upper(m[1].str());
+        d.type = upper_case(m[1].str());
         d.file = static_cast<int>(f);
         d.line = static_cast<int>(i + 1);
         d.has_value = m[4].matched;
@@ -165,11 +129,11 @@ NativeProgram read_krl_program(const std::string& src_path) {
           d.begin = static_cast<size_t>(m.position(4));
           d.end = d.begin + static_cast<size_t>(m.length(4));
         }
-        decls[upper(m[2].str())] = d;
+        decls[upper_case(m[2].str())] = d;
       } else if (f == 0 && std::regex_search(code, m, assign_re)) {
-        const auto it = decls.find(upper(m[1].str()));
+        const auto it = decls.find(upper_case(m[1].str()));
         if (it != decls.end()) it->second.assigned = true;
-        else decls[upper(m[1].str())].assigned = true;  // declared later or elsewhere: computed at run time
+        else decls[upper_case(m[1].str())].assigned = true;  // declared later or elsewhere: computed at run time
       }
     }
     if (!open_line) throw InputError(p.paths[f] + ": no " + open + " in the file");
@@ -183,7 +147,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
     std::smatch m;
     if (!std::regex_match(code, m, motion_re)) continue;
     const std::string at = where(p.paths[0], static_cast<int>(i + 1));
-    const std::string kind = upper(m[1].str());
+    const std::string kind = upper_case(m[1].str());
     std::vector<std::string> args = split_top(m[2].str());
     const size_t n_targets = kind.find("CIRC") != std::string::npos ? 2 : 1;
     if (args.size() < n_targets) throw InputError(at + ": " + kind + " needs " + std::to_string(n_targets) + " target(s)");
@@ -206,7 +170,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
         p.targets.push_back(t);
         continue;
       }
-      const std::string key = upper(arg);
+      const std::string key = upper_case(arg);
       if (key.empty() || key[0] == '$') {
         p.unresolved.push_back({at, code});
         continue;
@@ -244,7 +208,7 @@ std::string krl_aggregate(const std::string& old, const Pose6& pose, const Contr
   for (std::string& item : items) {
     size_t k = 0;
     while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
-    const std::string key = upper(item.substr(0, k));
+    const std::string key = upper_case(item.substr(0, k));
     const std::string sep = item.substr(k, item.find_first_not_of(" \t", k) - k);
     const std::string name = item.substr(0, k);
     for (int f = 0; f < 6; ++f)

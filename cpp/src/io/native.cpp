@@ -7,6 +7,7 @@
 #include "kincal/io/file.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 
 namespace kincal {
@@ -84,6 +85,44 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
     out.push_back({path, text});
   }
   return out;
+}
+
+std::vector<std::string> split_top(const std::string& s) {
+  std::vector<std::string> out;
+  int depth = 0;
+  bool str = false;
+  std::string cur;
+  for (char c : s) {
+    if (c == '"') str = !str;
+    if (!str && (c == '{' || c == '[' || c == '(')) ++depth;
+    if (!str && (c == '}' || c == ']' || c == ')')) --depth;
+    if (!str && depth == 0 && c == ',') {
+      out.push_back(cur);
+      cur.clear();
+      continue;
+    }
+    cur += c;
+  }
+  out.push_back(cur);
+  for (auto& x : out) {
+    const size_t a = x.find_first_not_of(" \t\r"), b = x.find_last_not_of(" \t\r");
+    x = a == std::string::npos ? std::string() : x.substr(a, b - a + 1);
+  }
+  return out;
+}
+
+std::string upper_case(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string code_before(const std::string& line, char comment) {
+  bool str = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    if (line[i] == '"') str = !str;
+    if (line[i] == comment && !str) return line.substr(0, i);
+  }
+  return line;
 }
 
 }  // namespace kincal

@@ -18,19 +18,7 @@ std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl);
 
 namespace {
 
-std::string upper(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::string code_of(const std::string& l) {
-  bool str = false;
-  for (size_t i = 0; i < l.size(); ++i) {
-    if (l[i] == '"') str = !str;
-    if (l[i] == '!' && !str) return l.substr(0, i);
-  }
-  return l;
-}
+std::string code_of(const std::string& l) { return code_before(l, '!'); }
 
 std::vector<double> numbers(const std::string& part, size_t n, const std::string& at, const char* what) {
   const std::string s = part.size() >= 2 && part.front() == '[' && part.back() == ']' ? part.substr(1, part.size() - 2) : "";
@@ -110,7 +98,7 @@ NativeProgram read_rapid_program(const std::string& path) {
     if (std::regex_match(code, m, decl_re)) {
       Decl d;
       d.line = static_cast<int>(i + 1);
-      d.robtarget = upper(m[2].str()) == "ROBTARGET";
+      d.robtarget = upper_case(m[2].str()) == "ROBTARGET";
       d.has_value = m[5].matched;
       if (d.has_value) {
         d.begin = static_cast<size_t>(m.position(5));
@@ -118,7 +106,7 @@ NativeProgram read_rapid_program(const std::string& path) {
         d.value = m[5].str();
         if (d.robtarget) parse_robtarget(d.value, at);  // checked here, where it is declared
       }
-      decls[upper(m[3].str())] = d;
+      decls[upper_case(m[3].str())] = d;
     }
   }
   if (!module_line) throw InputError(path + ": no MODULE in the file");
@@ -132,13 +120,13 @@ NativeProgram read_rapid_program(const std::string& path) {
     if (code.find(';') == std::string::npos) throw InputError(at + ": a motion over several lines (kincal reads one per line)");
     std::vector<std::string> args = split_top(m[2].str());
     while (!args.empty() && !args[0].empty() && args[0][0] == '\\') args.erase(args.begin());  // \Conc ...
-    const size_t n_targets = upper(m[1].str()).rfind("MOVEC", 0) == 0 ? 2 : 1;
+    const size_t n_targets = upper_case(m[1].str()).rfind("MOVEC", 0) == 0 ? 2 : 1;
     if (args.size() < n_targets + 2) throw InputError(at + ": " + m[1].str() + " needs target(s), speed and zone");
     // the work object: \WObj:=name anywhere in the statement
     Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
     std::smatch w;
-    if (std::regex_search(code, w, std::regex(R"(\\WObj\s*:=\s*(\w+))", std::regex::icase)) && upper(w[1].str()) != "WOBJ0") {
-      const auto it = decls.find(upper(w[1].str()));
+    if (std::regex_search(code, w, std::regex(R"(\\WObj\s*:=\s*(\w+))", std::regex::icase)) && upper_case(w[1].str()) != "WOBJ0") {
+      const auto it = decls.find(upper_case(w[1].str()));
       if (it == decls.end() || it->second.robtarget || !it->second.has_value)
         throw InputError(at + ": work object '" + w[1].str() + "' is not declared with a value in the module");
       const auto parts = split_top(it->second.value.substr(1, it->second.value.size() - 2));
@@ -165,7 +153,7 @@ NativeProgram read_rapid_program(const std::string& path) {
         p.unresolved.push_back({at, code});
         continue;
       }
-      const auto it = decls.find(upper(arg));
+      const auto it = decls.find(upper_case(arg));
       if (it == decls.end() || !it->second.robtarget)
         throw InputError(at + ": target '" + arg + "' is not declared as a robtarget in the module");
       if (!it->second.has_value || !std::regex_search(lines[static_cast<size_t>(it->second.line - 1)],
@@ -173,8 +161,8 @@ NativeProgram read_rapid_program(const std::string& path) {
         p.unresolved.push_back({at, code});  // a VAR, or no value: set at run time
         continue;
       }
-      if (used.count(upper(arg))) continue;
-      used[upper(arg)] = p.targets.size();
+      if (used.count(upper_case(arg))) continue;
+      used[upper_case(arg)] = p.targets.size();
       const Decl& d = it->second;
       NativeTarget t;
       t.line = d.line;

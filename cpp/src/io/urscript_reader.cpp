@@ -19,15 +19,7 @@ std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl);
 
 namespace {
 
-// the line without its comment ('#' outside strings)
-std::string code_of(const std::string& l) {
-  bool str = false;
-  for (size_t i = 0; i < l.size(); ++i) {
-    if (l[i] == '"') str = !str;
-    if (l[i] == '#' && !str) return l.substr(0, i);
-  }
-  return l;
-}
+std::string code_of(const std::string& l) { return code_before(l, '#'); }
 
 // p[x,y,z,rx,ry,rz] in m and rad, as a pose in mm and KUKA ABC degrees
 Pose6 parse_pose(const std::string& lit, const std::string& at) {

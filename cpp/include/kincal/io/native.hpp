@@ -54,4 +54,11 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
 /// Splits s at top-level commas (outside brackets, braces, parentheses and strings); trims blanks.
 std::vector<std::string> split_top(const std::string& s);
 
+/// s in upper case (ASCII).
+std::string upper_case(std::string s);
+
+/// The line without its comment: everything from the first `comment` character outside a
+/// "string" on (KRL ';', RAPID '!', URScript '#').
+std::string code_before(const std::string& line, char comment);
+
 }  // namespace kincal

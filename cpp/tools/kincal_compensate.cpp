@@ -15,6 +15,7 @@
 #include "kincal/io/csv.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/model_json.hpp"
+#include "kincal/model/joint_convention.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -103,6 +104,17 @@ int run_fivebar(const std::string& fit_path, const std::string& matrix_path, con
   return 0;
 }
 
+/// The robot of --model, with --joint-convention for a built-in robot (a model JSON carries its own).
+kincal::Robot robot_with_convention(const std::string& model, const std::string& convention) {
+  kincal::Robot robot = kincal::load_robot(model);
+  if (convention.empty()) return robot;
+  if (model.size() >= 5 && model.compare(model.size() - 5, 5, ".json") == 0)
+    throw kincal::InputError(model + ": a model JSON carries its joint convention (\"joint_convention\"); "
+                             "--joint-convention is for a built-in robot");
+  auto m = std::make_shared<kincal::Model>(kincal::with_joint_convention(robot.nominal->spec(), convention));
+  return kincal::Robot{m, m};
+}
+
 /// "+1", "-1" or six comma-separated signs; empty: none given
 std::vector<double> parse_directions(const std::string& text) {
   std::vector<double> out;
@@ -138,6 +150,7 @@ int main(int argc, char** argv) {
   std::vector<double> program_tool, program_base;
   bool skip_unresolved = false;
   std::optional<double> tolerance;
+  std::string joint_convention;
   app.add_option("--model", model, "built-in robot name or model JSON");
   app.add_option("--fivebar", fivebar, "five-bar hidden robot: FIT.json of kincal hidden-robot fit");
   app.add_option("--matrix", matrix, "five-bar: MATRIX.json of kincal hidden-robot matrix");
@@ -161,6 +174,10 @@ int main(int argc, char** argv) {
   app.add_option("--tolerance", tolerance, "insert targets where the path between two targets leaves the desired "
                                            "segment by more than this (mm)");
   app.add_option("--max-targets-per-file", max_per_file, "split longer KRL / LS programs into parts (default: 2000)");
+  app.add_option("--joint-convention", joint_convention,
+                 "how the controller numbers a built-in robot's joints (a model JSON carries its own): fanuc, J3 is "
+                 "the forearm's angle to the horizontal")
+      ->check(CLI::IsMember({"fanuc"}));
   app.add_option("--frame", frame, "frame of the program poses")->check(CLI::IsMember({"base", "instrument"}));
   app.add_flag("--stream", stream, "read pose lines on stdin, write joint lines on stdout, flushed");
   app.add_flag("--finite-difference", fd, "the paper's finite-difference Jacobian (eq. 7)");
@@ -191,7 +208,7 @@ int main(int argc, char** argv) {
     if (temperature) opt.temperature_c = *temperature;
     opt.keep_branch = keep_branch;
     opt.initial_direction = parse_directions(initial_direction);
-    const kincal::Robot robot = kincal::load_robot(model);
+    const kincal::Robot robot = robot_with_convention(model, joint_convention);
     if (opt.instrument_frame && !robot.identified())
       throw kincal::InputError(model + ": --frame instrument needs an identified model (kincal identify)");
     if (stream) {

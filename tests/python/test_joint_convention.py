@@ -154,3 +154,32 @@ def test_ik_writes_the_controller_numbers(tmp_path):
     for i in range(2):
         sols = rows[rows[:, 0] == i][:, 3:]
         assert np.abs(sols - hand[i]).max(axis=1).min() < 1e-8
+
+
+def test_kincal_compensate_takes_the_convention_for_a_builtin_robot(tmp_path):
+    # kr500 (axes 2 and 3 parallel) with --joint-convention fanuc: kincal-compensate writes what kincal
+    # compensate writes, and against the plain run only J3 changes, by s q2 with one sign s for all rows
+    q = np.array([[5.0, -80.0, 100.0, 10.0, 40.0, 15.0], [-20.0, -60.0, 80.0, -15.0, 50.0, 25.0]])
+    poses = kincal.fk(kincal.load_robot("kr500"), q)
+    (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n" + "".join(",".join(f"{v:.12f}" for v in p) + "\n" for p in poses))
+    out = {}
+    for name, cmd in (("plain", ["kincal-compensate"]), ("cpp", ["kincal-compensate", "--joint-convention", "fanuc"]),
+                      ("py", ["kincal", "compensate", "--joint-convention", "fanuc"])):
+        r = run(*cmd, "--model", "kr500", "--program", str(tmp_path / "p.csv"), "--out", str(tmp_path / f"{name}.csv"))
+        assert r.returncode == 0, r.stderr
+        out[name] = (tmp_path / f"{name}.csv").read_text()
+    assert out["cpp"] == out["py"]
+    cols = lambda text: {k: np.array([float(row[k]) for row in csv.DictReader(io.StringIO(text))]) for k in
+                         ("q1", "q2", "q3", "q4", "q5", "q6")}
+    plain, conv = cols(out["plain"]), cols(out["cpp"])
+    for k in ("q1", "q2", "q4", "q5", "q6"):
+        assert np.array_equal(plain[k], conv[k])
+    s = np.round((conv["q3"] - plain["q3"]) / plain["q2"])
+    assert abs(s[0]) == 1 and np.all(s == s[0])
+    assert np.abs(conv["q3"] - (plain["q3"] + s[0] * plain["q2"])).max() < 2e-6
+    # a model JSON carries its own convention: the option is refused there, naming the file
+    (tmp_path / "m.json").write_text(kincal.load_robot("kr500").to_json())
+    r = run("kincal-compensate", "--model", str(tmp_path / "m.json"), "--joint-convention", "fanuc", "--program",
+            str(tmp_path / "p.csv"), "--out", str(tmp_path / "x.csv"))
+    assert r.returncode != 0 and "m.json" in r.stderr and "joint_convention" in r.stderr
+    assert not (tmp_path / "x.csv").exists()

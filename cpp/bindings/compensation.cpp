@@ -131,6 +131,7 @@ void define_compensation(py::module_& m) {
         d["path_before_mm"] = res.path_before_mm;
         d["path_after_mm"] = res.path_after_mm;
         d["inserted"] = res.inserted;
+        d["targets_note"] = res.targets_note;
         return d;
       },
       py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS, py::arg("format") = py::none(),

@@ -247,6 +247,7 @@ int main(int argc, char** argv) {
     for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());
     std::fprintf(stderr, "%s: %zu poses, at most %d iterations, largest residual %.3g\n", out.c_str(),
                  res.q_deg.size(), res.max_iterations, res.max_residual);
+    if (!cr.targets_note.empty()) std::fprintf(stderr, "%s: %s\n", out.c_str(), cr.targets_note.c_str());
     if (tolerance)
       std::fprintf(stderr, "%s: path between targets: largest deviation from the desired segments %.4f mm before, "
                    "%.4f mm after %d inserted target(s)\n", out.c_str(), cr.path_before_mm, cr.path_after_mm,

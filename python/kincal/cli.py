@@ -74,7 +74,7 @@ def cmd_compensate(args) -> None:
     it = np.asarray(res["iterations"])
     print(f"{args.out}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
-    if line := programs.summary(res):
+    for line in programs.summary(res):
         print(f"{args.out}: {line}", file=sys.stderr)
 
 

@@ -67,9 +67,10 @@ def compensate(robot, args, comp_kwargs: dict) -> dict:
                                           skip_unresolved=args.skip_unresolved, tolerance=args.tolerance)
 
 
-def summary(res: dict) -> str:
-    """The --tolerance line of the summary ('' without --tolerance)."""
+def summary(res: dict) -> list[str]:
+    """The summary's lines on a native program's targets (joints or filtered) and on --tolerance."""
+    lines = [res["targets_note"]] if res.get("targets_note") else []
     if res.get("inserted") is None or res["path_before_mm"] != res["path_before_mm"]:  # NaN: no --tolerance
-        return ""
-    return (f"path between targets: largest deviation from the desired segments {res['path_before_mm']:.4f} mm "
-            f"before, {res['path_after_mm']:.4f} mm after {res['inserted']} inserted target(s)")
+        return lines
+    return lines + [f"path between targets: largest deviation from the desired segments {res['path_before_mm']:.4f} mm "
+                    f"before, {res['path_after_mm']:.4f} mm after {res['inserted']} inserted target(s)"]

@@ -8,6 +8,7 @@
 #include "kincal/model/joint_convention.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -50,10 +51,6 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
   if (w.format != in_format)
     throw InputError(out_path + ": a " + format_name(in_format) + " program is written back as " +
                      format_name(in_format) + " (not " + format_name(w.format) + ")");
-  if (w.targets != TargetKind::Filtered)
-    throw InputError(in_path + ": a " + std::string(format_name(in_format)) +
-                     " program is rewritten with filtered targets: give --targets filtered (joint targets in a native "
-                     "program are not done yet)");
   if (std::isfinite(n.tolerance_mm))
     throw InputError(in_path + ": --tolerance inserts targets into programs kincal writes (from CSV or G-code), "
                      "not yet into a " + std::string(format_name(in_format)) + " program it filters");
@@ -79,11 +76,29 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
   const auto warnings = std::move(r.result.warnings);
   r.result = compensate_poses(robot, poses, where_of, opt);
   r.result.warnings.insert(r.result.warnings.begin(), warnings.begin(), warnings.end());
-  const auto targets = controller_targets(robot, r.result.q_deg, TargetKind::Filtered, in_format, where_of);
-  std::vector<Pose6> back;
-  for (size_t k = 0; k < targets.size(); ++k)
-    back.push_back(iso_to_pose((base * p.targets[k].frame).inverse() * pose_to_iso(targets[k].pose) * tool));
-  const auto files = write_native_program(p, back, targets, out_path);
+  // joint targets where every motion to the target interpolates in joints; the others filtered, so that
+  // LIN / MoveL / L / movel keep their straight line
+  std::vector<bool> joints(p.targets.size());
+  std::vector<Vec6> q_filtered;
+  std::vector<std::string> where_filtered;
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    joints[k] = w.targets == TargetKind::Joints && p.targets[k].joint_motion;
+    if (!joints[k]) q_filtered.push_back(r.result.q_deg[k]), where_filtered.push_back(where_of[k]);
+  }
+  auto targets = controller_targets(robot, r.result.q_deg, TargetKind::Joints, in_format, where_of);
+  const auto filtered = controller_targets(robot, q_filtered, TargetKind::Filtered, in_format, where_filtered);
+  std::vector<Pose6> back(targets.size());
+  for (size_t k = 0, f = 0; k < targets.size(); ++k) {
+    if (joints[k]) continue;
+    targets[k] = filtered[f++];
+    back[k] = iso_to_pose((base * p.targets[k].frame).inverse() * pose_to_iso(targets[k].pose) * tool);
+  }
+  const size_t n_joints = static_cast<size_t>(std::count(joints.begin(), joints.end(), true));
+  r.targets_note = std::to_string(n_joints) + " target(s) written as joints, " +
+                   std::to_string(targets.size() - n_joints) + " as filtered poses";
+  if (w.targets == TargetKind::Joints && n_joints < targets.size())
+    r.targets_note += " (targets of linear and circular motions, or named elsewhere in the program, stay Cartesian)";
+  const auto files = write_native_program(p, back, targets, joints, out_path);
   write_files_atomic(files);
   for (const auto& f : files) r.files.push_back(f.path);
   return r;

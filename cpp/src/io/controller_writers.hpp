@@ -11,6 +11,14 @@
 
 namespace kincal::ctl {
 
+/// The printed precision of joint targets: KRL and RAPID 1e-6 deg (KRL REAL is single precision: about
+/// 1e-5 deg kept), FANUC LS 1e-4 deg and mm (the controller keeps single precision), URScript 1e-10 rad
+/// (6e-9 deg); positions in mm.
+constexpr int kJointDecimals = 6;
+constexpr int kMmDecimals = 4;
+constexpr int kLsDecimals = 4;
+constexpr int kRadDecimals = 10;
+
 /// v with the given decimals, never "-0.000"; InputError when v is not finite.
 std::string fixed(double v, int decimals);
 /// The joint speed in percent (1..100) and the linear speed in mm/s of the options (defaults 20, 250).

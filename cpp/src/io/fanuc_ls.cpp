@@ -13,7 +13,6 @@ namespace kincal::ctl {
 
 namespace {
 
-constexpr int kDecimals = 4;  // 1e-4 deg, 1e-4 mm (the controller keeps single precision)
 
 std::string attr(const std::string& name, size_t lines) {
   return "/PROG  " + name + "\n/ATTR\nOWNER\t\t= MNEDITOR;\nCOMMENT\t\t= \"kincal\";\nPROG_SIZE\t= 0;\n"
@@ -31,7 +30,7 @@ std::string line_no(size_t n) {
 
 std::string value(const char* label, double v, const char* unit) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%s=%11s %s", label, fixed(v, kDecimals).c_str(), unit);
+  std::snprintf(buf, sizeof buf, "%s=%11s %s", label, fixed(v, kLsDecimals).c_str(), unit);
   return buf;
 }
 

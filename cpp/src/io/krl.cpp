@@ -10,8 +10,6 @@ namespace kincal::ctl {
 
 namespace {
 
-constexpr int kJointDecimals = 6;  // 1e-6 deg (KRL REAL is single precision: about 1e-5 deg kept)
-constexpr int kMmDecimals = 4;
 
 std::string header(const std::string& kind) { return "&ACCESS RVP\n&REL 1\n" + kind; }
 

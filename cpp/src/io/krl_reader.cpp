@@ -42,6 +42,7 @@ struct Decl {
   std::string type;
   int file = 0, line = 0;
   size_t begin = 0, end = 0;
+  size_t type_begin = 0, type_end = 0;  // the type's span
   bool has_value = false, assigned = false;
 };
 
@@ -124,6 +125,8 @@ NativeProgram read_krl_program(const std::string& src_path) {
         d.type = upper_case(m[1].str());
         d.file = static_cast<int>(f);
         d.line = static_cast<int>(i + 1);
+        d.type_begin = static_cast<size_t>(m.position(1));
+        d.type_end = d.type_begin + static_cast<size_t>(m.length(1));
         d.has_value = m[4].matched;
         if (d.has_value) {
           d.begin = static_cast<size_t>(m.position(4));
@@ -142,6 +145,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
   }
   // the motions, in order
   std::map<std::string, size_t> used;
+  std::map<std::string, int> motions;  // per declared target, the motions to it
   for (size_t i = 0; i < p.lines[0].size(); ++i) {
     const std::string code = code_of(p.lines[0][i]);
     std::smatch m;
@@ -152,6 +156,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
     const size_t n_targets = kind.find("CIRC") != std::string::npos ? 2 : 1;
     if (args.size() < n_targets) throw InputError(at + ": " + kind + " needs " + std::to_string(n_targets) + " target(s)");
     const size_t base_pos = static_cast<size_t>(m.position(2));
+    const bool ptp = kind == "PTP" || kind == "SPTP";
     for (size_t a = 0; a < n_targets; ++a) {
       std::string arg = args[a];
       arg = arg.substr(0, arg.find_first_of(" \t") == std::string::npos || arg[0] == '{' ? arg.size() : arg.find_first_of(" \t"));
@@ -167,6 +172,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
         t.begin = p.lines[0][i].find(arg, base_pos);
         t.end = t.begin + arg.size();
         t.pose = parse_aggregate(arg, at);
+        t.joint_motion = ptp;
         p.targets.push_back(t);
         continue;
       }
@@ -184,7 +190,11 @@ NativeProgram read_krl_program(const std::string& src_path) {
         p.unresolved.push_back({at, code});
         continue;
       }
-      if (used.count(key)) continue;
+      ++motions[key];
+      if (used.count(key)) {
+        p.targets[used[key]].joint_motion &= ptp;
+        continue;
+      }
       used[key] = p.targets.size();
       NativeTarget t;
       t.file = d.file;
@@ -194,8 +204,18 @@ NativeProgram read_krl_program(const std::string& src_path) {
       t.name = arg;
       t.pose = parse_aggregate(p.lines[static_cast<size_t>(d.file)][static_cast<size_t>(d.line - 1)].substr(d.begin, d.end - d.begin),
                                where(p.paths[static_cast<size_t>(d.file)], d.line));
+      t.joint_motion = ptp;
+      t.joint_edits.push_back({d.file, d.line, d.type_begin, d.type_end, d.type == "E6POS" ? "E6AXIS" : "AXIS"});
       p.targets.push_back(t);
     }
+  }
+  // a declared target named anywhere but in its declaration and its motions stays Cartesian
+  for (NativeTarget& t : p.targets) {
+    if (t.name.empty() || !t.joint_motion) continue;
+    int named = 0;
+    for (const auto& file : p.lines)
+      for (const std::string& l : file) named += word_count(code_of(l), t.name);
+    t.joint_motion = named == motions[upper_case(t.name)] + 1;
   }
   return p;
 }
@@ -220,6 +240,15 @@ std::string krl_aggregate(const std::string& old, const Pose6& pose, const Contr
   for (size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + items[i];
   if (!is_frame && !has_s) out += ",S " + std::to_string(t.kuka_s);
   if (!is_frame && !has_t) out += ",T " + std::to_string(t.kuka_t);
+  return out + "}";
+}
+
+// a KRL aggregate of a Cartesian target as an axis target {A1 .., .., A6 ..}, its external axes E1..E6 kept
+std::string krl_axis(const std::string& old, const Vec6& q_deg) {
+  std::string out = "{";
+  for (int j = 0; j < 6; ++j) out += std::string(j ? "," : "") + "A" + std::to_string(j + 1) + " " + ctl::fixed(q_deg[j], ctl::kJointDecimals);
+  for (const std::string& item : split_top(old.substr(1, old.size() - 2)))
+    if (std::regex_match(item, std::regex(R"(E[1-6]\b.*)", std::regex::icase))) out += "," + item;
   return out + "}";
 }
 

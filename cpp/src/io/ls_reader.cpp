@@ -9,6 +9,8 @@
 #include "kincal/io/native.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <iterator>
 #include <cstdlib>
 #include <map>
 #include <regex>
@@ -87,8 +89,11 @@ NativeProgram read_ls_program(const std::string& path) {
   std::map<int, LsPos> pos;
   struct Use {
     int n, line;
+    bool joint;  // a J motion
   };
   std::vector<Use> uses;
+  std::vector<std::string> mn;  // the /MN statements but comments
+  static const std::regex comment(R"(^\s*\d+:\s*!)");
   static const std::regex motion(R"(^\s*\d+:\s*([JLCA])\s+(.*)$)"), cont(R"(^\s*:\s*(.*)$)");
   static const std::regex ref(R"(^(P|PR)\[\s*(R\[)?\s*(\d+))");
   static const std::regex runtime(R"((Offset|VOFFSET|\bINC\b))", std::regex::icase);
@@ -125,10 +130,12 @@ NativeProgram read_ls_program(const std::string& path) {
     if (sec == None) throw InputError(at + ": an LS program starts with /PROG");
     if (sec == End) throw InputError(at + ": text after /END");
     if (sec == Mn) {
+      if (!std::regex_search(s, comment)) mn.push_back(s);
       std::string rest;
       const bool is_cont = want_circ_end && std::regex_match(s, m, cont);
+      char kind = 'C';
       if (is_cont) rest = m[1].str();
-      else if (std::regex_match(s, m, motion)) rest = m[2].str(), want_circ_end = m[1].str() == "C";
+      else if (std::regex_match(s, m, motion)) rest = m[2].str(), kind = m[1].str()[0], want_circ_end = kind == 'C';
       else continue;
       if (is_cont) want_circ_end = false;
       const bool ends = rest.find(';') != std::string::npos;
@@ -139,7 +146,7 @@ NativeProgram read_ls_program(const std::string& path) {
         p.unresolved.push_back({at, s.substr(a)});
         continue;
       }
-      uses.push_back({std::stoi(r[3].str()), ln});
+      uses.push_back({std::stoi(r[3].str()), ln, kind == 'J'});
     } else if (sec == Pos) {
       if (!open_pos) {
         if (!std::regex_match(s, m, pos_open)) throw InputError(at + ": expected P[n]{ in /POS");
@@ -159,6 +166,8 @@ NativeProgram read_ls_program(const std::string& path) {
   if (!prog_line) throw InputError(path + ": no /PROG in the file");
   if (sec != End) throw InputError(where(path, prog_line) + ": /PROG is not closed by /END (end of file)");
   std::map<int, bool> done;
+  std::map<int, int> motions, joint_motions;  // per position, the motions to it and how many are J
+  for (const Use& u : uses) ++motions[u.n], joint_motions[u.n] += u.joint;
   int uf = -1, ut = -1;
   for (const Use& u : uses) {
     const auto it = pos.find(u.n);
@@ -179,6 +188,12 @@ NativeProgram read_ls_program(const std::string& path) {
     t.end = lines[static_cast<size_t>(lp.last - 1)].size();
     t.pose = lp.pose;
     t.name = "P[" + std::to_string(u.n) + "]";
+    // every motion to it a J, and no other statement names it (a P[n] or P[n:comment])
+    const std::regex named(R"(\bP\[\s*)" + std::to_string(u.n) + R"(\s*[:\]])");
+    int mentions = 0;
+    for (const std::string& l : mn)
+      mentions += static_cast<int>(std::distance(std::sregex_iterator(l.begin(), l.end(), named), std::sregex_iterator()));
+    t.joint_motion = joint_motions[u.n] == motions[u.n] && mentions == motions[u.n];
     p.targets.push_back(t);
   }
   return p;
@@ -197,6 +212,19 @@ std::string ls_position(const std::string& old, const Pose6& pose, const Control
     const size_t b = static_cast<size_t>(m.position(1)), len = static_cast<size_t>(m.length(1));
     if (num.size() < len) num.insert(0, len - num.size(), ' ');  // keeps the columns
     s.replace(b, len, num);
+  }
+  return s;
+}
+
+// GP1's lines of a Cartesian position in joint form: CONFIG dropped, X Y Z W P R (with their units)
+// replaced by J1..J6 in deg, the line count and every other field (UF, UT, extended axes) kept
+std::string ls_joint_position(const std::string& old, const Vec6& q_deg) {
+  std::string s = std::regex_replace(old, std::regex(R"(\bCONFIG\s*:\s*'[^']*'\s*,?)"), "");
+  for (int f = 0; f < 6; ++f) {
+    const std::regex re(std::string(R"(\b)") + "XYZWPR"[f] + R"(\s*=\s*[^\s,']+(\s*(mm|deg)\b)?)");
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "J%d=%11s deg", f + 1, ctl::fixed(q_deg[f], ctl::kLsDecimals).c_str());
+    s = std::regex_replace(s, re, buf, std::regex_constants::format_first_only);
   }
   return s;
 }

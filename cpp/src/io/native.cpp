@@ -20,6 +20,10 @@ NativeProgram read_ls_program(const std::string& path);
 std::string ls_position(const std::string& old, const Pose6& pose, const ControllerTarget& t);
 NativeProgram read_urscript_program(const std::string& path);
 std::string urscript_pose(const Pose6& pose);
+std::string krl_axis(const std::string& old, const Vec6& q_deg);
+std::string rapid_jointtarget(const std::string& old, const Vec6& q_deg);
+std::string ls_joint_position(const std::string& old, const Vec6& q_deg);
+std::string urscript_joints(const Vec6& q_deg);
 
 NativeProgram read_native_program(const std::string& path, ControllerFormat format) {
   if (format == ControllerFormat::Krl) return read_krl_program(path);
@@ -30,22 +34,48 @@ NativeProgram read_native_program(const std::string& path, ControllerFormat form
 }
 
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
-                                             const std::vector<ControllerTarget>& t, const std::string& out_path) {
+                                             const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
+                                             const std::string& out_path) {
   std::vector<std::vector<std::string>> lines = p.lines;
-  // per line, the replacements from the right so that earlier spans keep their places
-  std::map<std::pair<int, int>, std::vector<size_t>> by_line;
+  struct Replacement {
+    size_t begin, end;
+    std::string text;
+  };
+  // per line, the replacements (values and edits), applied from the right so that earlier spans keep their places
+  std::map<std::pair<int, int>, std::vector<Replacement>> by_line;
   for (size_t k = 0; k < p.targets.size(); ++k) {
     const NativeTarget& nt = p.targets[k];
+    const bool as_joints = k < joints.size() && joints[k];
+    if (as_joints)
+      for (const NativeEdit& e : nt.joint_edits) by_line[{e.file, e.line}].push_back({e.begin, e.end, e.text});
+    auto& f = lines[static_cast<size_t>(nt.file)];
     if (nt.last_line <= nt.line) {
-      by_line[{nt.file, nt.line}].push_back(k);
+      const std::string& l = f[static_cast<size_t>(nt.line - 1)];
+      const std::string old = l.substr(nt.begin, nt.end - nt.begin);
+      std::string now;
+      if (p.format == ControllerFormat::Krl) {
+        if (as_joints) {
+          now = krl_axis(old, t[k].q_deg);
+        } else {
+          const std::string head = upper_case(l.substr(0, nt.begin));
+          now = krl_aggregate(old, pose[k], t[k], head.find("FRAME") != std::string::npos);
+        }
+      } else if (p.format == ControllerFormat::Rapid) {
+        now = as_joints ? rapid_jointtarget(old, t[k].q_deg) : rapid_robtarget(old, pose[k], t[k]);
+      } else if (p.format == ControllerFormat::FanucLs) {
+        now = as_joints ? ls_joint_position(old, t[k].q_deg) : ls_position(old, pose[k], t[k]);
+      } else {
+        now = as_joints ? urscript_joints(t[k].q_deg) : urscript_pose(pose[k]);
+      }
+      by_line[{nt.file, nt.line}].push_back({nt.begin, nt.end, now});
       continue;
     }
     // a value over several lines (an LS /POS entry): replaced within them, the line count kept
-    auto& f = lines[static_cast<size_t>(nt.file)];
     std::string joined;
     for (int l = nt.line; l <= nt.last_line; ++l) joined += f[static_cast<size_t>(l - 1)] + (l < nt.last_line ? "\n" : "");
     const size_t end = joined.size() - f[static_cast<size_t>(nt.last_line - 1)].size() + nt.end;
-    joined.replace(nt.begin, end - nt.begin, ls_position(joined.substr(nt.begin, end - nt.begin), pose[k], t[k]));
+    const std::string old = joined.substr(nt.begin, end - nt.begin);
+    joined.replace(nt.begin, end - nt.begin, as_joints ? ls_joint_position(old, t[k].q_deg) : ls_position(old, pose[k], t[k]));
     size_t b = 0;
     for (int l = nt.line; l <= nt.last_line; ++l) {
       const size_t e = l < nt.last_line ? joined.find('\n', b) : joined.size();
@@ -53,26 +83,10 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
       b = e + 1;
     }
   }
-  for (auto& [key, ks] : by_line) {
-    std::sort(ks.begin(), ks.end(), [&](size_t a, size_t b) { return p.targets[a].begin > p.targets[b].begin; });
+  for (auto& [key, reps] : by_line) {
+    std::sort(reps.begin(), reps.end(), [](const Replacement& a, const Replacement& b) { return a.begin > b.begin; });
     std::string& l = lines[static_cast<size_t>(key.first)][static_cast<size_t>(key.second - 1)];
-    for (size_t k : ks) {
-      const NativeTarget& nt = p.targets[k];
-      const std::string old = l.substr(nt.begin, nt.end - nt.begin);
-      std::string now;
-      if (p.format == ControllerFormat::Krl) {
-        std::string head = l.substr(0, nt.begin);
-        for (char& c : head) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-        now = krl_aggregate(old, pose[k], t[k], head.find("FRAME") != std::string::npos);
-      } else if (p.format == ControllerFormat::Rapid) {
-        now = rapid_robtarget(old, pose[k], t[k]);
-      } else if (p.format == ControllerFormat::FanucLs) {
-        now = ls_position(old, pose[k], t[k]);
-      } else {
-        now = urscript_pose(pose[k]);
-      }
-      l.replace(nt.begin, nt.end - nt.begin, now);
-    }
+    for (const Replacement& r : reps) l.replace(r.begin, r.end - r.begin, r.text);
   }
   std::vector<OutputFile> out;
   for (size_t f = 0; f < lines.size(); ++f) {
@@ -123,6 +137,16 @@ std::string code_before(const std::string& line, char comment) {
     if (line[i] == comment && !str) return line.substr(0, i);
   }
   return line;
+}
+
+int word_count(const std::string& code, const std::string& name, bool ignore_case) {
+  auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  const std::string hay = ignore_case ? upper_case(code) : code, needle = ignore_case ? upper_case(name) : name;
+  int n = 0;
+  if (needle.empty()) return 0;
+  for (size_t at = hay.find(needle); at != std::string::npos; at = hay.find(needle, at + 1))
+    if ((at == 0 || !word(hay[at - 1])) && (at + needle.size() >= hay.size() || !word(hay[at + needle.size()]))) ++n;
+  return n;
 }
 
 }  // namespace kincal

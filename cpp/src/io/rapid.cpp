@@ -10,8 +10,6 @@ namespace kincal::ctl {
 
 namespace {
 
-constexpr int kJointDecimals = 6;
-constexpr int kMmDecimals = 4;
 constexpr int kQuatDecimals = 9;
 const char* const kNoExternal = "[9E9,9E9,9E9,9E9,9E9,9E9]";
 

@@ -73,7 +73,7 @@ NativeProgram read_rapid_program(const std::string& path) {
   static const std::regex move_re(R"(^\s*(Move(?:J|L|C)\w*)\s+(.*?);?\s*$)", std::regex::icase);
   struct Decl {
     int line = 0;
-    size_t begin = 0, end = 0;
+    size_t begin = 0, end = 0, type_begin = 0, type_end = 0;
     bool has_value = false, robtarget = true;
     std::string value;
   };
@@ -99,6 +99,8 @@ NativeProgram read_rapid_program(const std::string& path) {
       Decl d;
       d.line = static_cast<int>(i + 1);
       d.robtarget = upper_case(m[2].str()) == "ROBTARGET";
+      d.type_begin = static_cast<size_t>(m.position(2));
+      d.type_end = d.type_begin + static_cast<size_t>(m.length(2));
       d.has_value = m[5].matched;
       if (d.has_value) {
         d.begin = static_cast<size_t>(m.position(5));
@@ -112,6 +114,7 @@ NativeProgram read_rapid_program(const std::string& path) {
   if (!module_line) throw InputError(path + ": no MODULE in the file");
   if (!closed) throw InputError(where(path, module_line) + ": MODULE is not closed by ENDMODULE (end of file)");
   std::map<std::string, size_t> used;
+  std::map<std::string, int> motions;  // per declared target, the motions to it
   for (size_t i = 0; i < lines.size(); ++i) {
     const std::string code = code_of(lines[i]);
     std::smatch m;
@@ -121,6 +124,10 @@ NativeProgram read_rapid_program(const std::string& path) {
     std::vector<std::string> args = split_top(m[2].str());
     while (!args.empty() && !args[0].empty() && args[0][0] == '\\') args.erase(args.begin());  // \Conc ...
     const size_t n_targets = upper_case(m[1].str()).rfind("MOVEC", 0) == 0 ? 2 : 1;
+    // MoveJ (not MoveJDO, MoveJSync, ...) becomes MoveAbsJ when its target is written as joints
+    const bool movej = upper_case(m[1].str()) == "MOVEJ";
+    const NativeEdit to_absj{0, static_cast<int>(i + 1), static_cast<size_t>(m.position(1)),
+                             static_cast<size_t>(m.position(1) + m.length(1)), "MoveAbsJ"};
     if (args.size() < n_targets + 2) throw InputError(at + ": " + m[1].str() + " needs target(s), speed and zone");
     // the work object: \WObj:=name anywhere in the statement
     Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
@@ -146,6 +153,8 @@ NativeProgram read_rapid_program(const std::string& path) {
         t.end = t.begin + arg.size();
         t.pose = parse_robtarget(arg, at);
         t.frame = frame;
+        t.joint_motion = movej;
+        t.joint_edits.push_back(to_absj);
         p.targets.push_back(t);
         continue;
       }
@@ -161,7 +170,13 @@ NativeProgram read_rapid_program(const std::string& path) {
         p.unresolved.push_back({at, code});  // a VAR, or no value: set at run time
         continue;
       }
-      if (used.count(upper_case(arg))) continue;
+      ++motions[upper_case(arg)];
+      if (used.count(upper_case(arg))) {
+        NativeTarget& t = p.targets[used[upper_case(arg)]];
+        t.joint_motion &= movej;
+        t.joint_edits.push_back(to_absj);
+        continue;
+      }
       used[upper_case(arg)] = p.targets.size();
       const Decl& d = it->second;
       NativeTarget t;
@@ -171,8 +186,18 @@ NativeProgram read_rapid_program(const std::string& path) {
       t.name = arg;
       t.pose = parse_robtarget(d.value, where(path, d.line));
       t.frame = frame;
+      t.joint_motion = movej;
+      t.joint_edits.push_back({0, d.line, d.type_begin, d.type_end, "jointtarget"});
+      t.joint_edits.push_back(to_absj);
       p.targets.push_back(t);
     }
+  }
+  // a declared target named anywhere but in its declaration and its motions stays Cartesian
+  for (NativeTarget& t : p.targets) {
+    if (t.name.empty() || !t.joint_motion) continue;
+    int named = 0;
+    for (const std::string& l : lines) named += word_count(code_of(l), t.name);
+    t.joint_motion = named == motions[upper_case(t.name)] + 1;
   }
   return p;
 }
@@ -187,6 +212,14 @@ std::string rapid_robtarget(const std::string& old, const Pose6& pose, const Con
   for (int k = 0; k < 4; ++k) s += (k ? "," : "") + ctl::fixed(q[static_cast<size_t>(k)], 9);
   s += "],[";
   for (int k = 0; k < 4; ++k) s += (k ? "," : "") + std::to_string(t.abb_conf[static_cast<size_t>(k)]);
+  return s + "]," + parts[3] + "]";
+}
+
+// a robtarget value as a jointtarget [[q1..q6],[extax]], its external axes kept as written
+std::string rapid_jointtarget(const std::string& old, const Vec6& q_deg) {
+  const auto parts = split_top(old.substr(1, old.size() - 2));
+  std::string s = "[[";
+  for (int j = 0; j < 6; ++j) s += (j ? "," : "") + ctl::fixed(q_deg[j], ctl::kJointDecimals);
   return s + "]," + parts[3] + "]";
 }
 

@@ -9,7 +9,6 @@ namespace kincal::ctl {
 
 namespace {
 
-constexpr int kRadDecimals = 10;  // 1e-10 rad: 6e-9 deg
 constexpr int kMDecimals = 8;     // 1e-8 m: 1e-5 mm
 
 }  // namespace

@@ -98,7 +98,8 @@ NativeProgram read_urscript_program(const std::string& path) {
   if (!blocks.empty())
     throw InputError(where(path, blocks.back().second) + ": '" + blocks.back().first + "' is not closed by 'end' (end of file)");
   static const std::regex move(R"(\b(movej|movel|movep|movec)\s*\()");
-  std::map<std::string, bool> used;
+  std::map<std::string, size_t> used;
+  std::map<std::string, int> motions;  // per variable, the motions to it
   for (size_t i = 0; i < lines.size(); ++i) {
     const std::string code = code_of(lines[i]);
     const std::string at = where(path, static_cast<int>(i + 1));
@@ -107,6 +108,7 @@ NativeProgram read_urscript_program(const std::string& path) {
       const size_t open = static_cast<size_t>(it->position(0) + it->length(0) - 1);
       const auto args = call_args(code, open, close, at);
       const size_t n = (*it)[1].str() == "movec" ? 2 : 1;
+      const bool movej = (*it)[1].str() == "movej";
       if (args.size() < n || args[0].empty()) throw InputError(at + ": " + (*it)[1].str() + " needs its target(s)");
       for (size_t k = 0; k < n; ++k) {
         const std::string& a = args[k];
@@ -117,6 +119,7 @@ NativeProgram read_urscript_program(const std::string& path) {
           t.begin = code.find(a, open);
           t.end = t.begin + a.size();
           t.pose = parse_pose(a, at);
+          t.joint_motion = movej;
           p.targets.push_back(t);
           continue;
         }
@@ -131,8 +134,12 @@ NativeProgram read_urscript_program(const std::string& path) {
           p.unresolved.push_back({at, code.substr(code.find_first_not_of(" \t"))});
           continue;
         }
-        if (used[a]) continue;
-        used[a] = true;
+        ++motions[a];
+        if (used.count(a)) {
+          p.targets[used[a]].joint_motion &= movej;
+          continue;
+        }
+        used[a] = p.targets.size();
         NativeTarget t;
         t.line = v->second.line;
         t.begin = v->second.begin;
@@ -140,9 +147,17 @@ NativeProgram read_urscript_program(const std::string& path) {
         t.name = a;
         const std::string& l = lines[static_cast<size_t>(t.line - 1)];
         t.pose = parse_pose(l.substr(t.begin, t.end - t.begin), where(path, t.line));
+        t.joint_motion = movej;
         p.targets.push_back(t);
       }
     }
+  }
+  // a variable named anywhere but in its assignment and its motions stays a pose
+  for (NativeTarget& t : p.targets) {
+    if (t.name.empty() || !t.joint_motion) continue;
+    int named = 0;
+    for (const std::string& l : lines) named += word_count(code_of(l), t.name, false);
+    t.joint_motion = named == motions[t.name] + 1;
   }
   return p;
 }
@@ -153,6 +168,13 @@ std::string urscript_pose(const Pose6& pose) {
   std::string s = "p[";
   for (int k = 0; k < 3; ++k) s += (k ? ", " : "") + ctl::fixed(pose.xyz[k] / 1000.0, 8);
   for (int k = 0; k < 3; ++k) s += ", " + ctl::fixed(rv[k], 10);
+  return s + "]";
+}
+
+// a joint list [q1..q6] in rad
+std::string urscript_joints(const Vec6& q_deg) {
+  std::string s = "[";
+  for (int j = 0; j < 6; ++j) s += (j ? ", " : "") + ctl::fixed(q_deg[j] * kDeg, ctl::kRadDecimals);
   return s + "]";
 }
 

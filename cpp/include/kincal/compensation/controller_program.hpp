@@ -39,6 +39,8 @@ struct ControllerProgramResult {
   double path_before_mm = std::numeric_limits<double>::quiet_NaN();
   double path_after_mm = std::numeric_limits<double>::quiet_NaN();
   int inserted = 0;
+  /// a native program: how many targets were written as joints and how many as filtered poses ("" otherwise)
+  std::string targets_note;
 };
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
                                                  const std::string& out_path, const ProgramOptions& opt,

@@ -14,6 +14,13 @@
 
 namespace kincal {
 
+/// A change of the program beside a target's value: a span of one line and its new text.
+struct NativeEdit {
+  int file = 0, line = 0;  ///< file index, 1-based line
+  size_t begin = 0, end = 0;
+  std::string text;
+};
+
 /// One Cartesian target of a native program: where its value stands (a span of one line), its
 /// pose in the program's frame, and that frame (RAPID: the work object of its first motion).
 struct NativeTarget {
@@ -24,6 +31,13 @@ struct NativeTarget {
   Pose6 pose;                          ///< in the program's frame (mm, KUKA ABC deg)
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();  ///< the program's frame in the robot base
   std::string name;                    ///< declared name, or "" when inline
+  /// Whether it can be written as a joint target: every motion to it interpolates in joints (KRL PTP /
+  /// SPTP, RAPID MoveJ, LS J, URScript movej) and nothing else in the program names it.
+  bool joint_motion = false;
+  /// The changes besides its value when it is written as joints: KRL the declaration's type (E6POS to
+  /// E6AXIS, POS and FRAME to AXIS), RAPID the declaration's type (robtarget to jointtarget) and every
+  /// MoveJ to it (MoveAbsJ).
+  std::vector<NativeEdit> joint_edits;
 };
 
 /// A target the program computes at run time: not compensated.
@@ -45,11 +59,13 @@ struct NativeProgram {
 /// program or a URScript program.
 NativeProgram read_native_program(const std::string& path, ControllerFormat format);
 
-/// The program with target k's value replaced by pose[k] (in the program's frame) and the branch data
-/// of t[k] (KRL S and T, RAPID confdata, LS CONFIG); every other byte unchanged. Files go to out_path (KRL: its
-/// .src and .dat).
+/// The program with target k's value replaced: when joints[k], by the joints t[k].q_deg (KRL E6AXIS /
+/// AXIS, RAPID jointtarget, LS J1..J6, URScript [q1..q6] in rad; external axes kept) with the target's
+/// joint_edits; otherwise by pose[k] (in the program's frame) with the branch data of t[k] (KRL S and T,
+/// RAPID confdata, LS CONFIG). Every other byte unchanged. Files go to out_path (KRL: its .src and .dat).
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
-                                             const std::vector<ControllerTarget>& t, const std::string& out_path);
+                                             const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
+                                             const std::string& out_path);
 
 /// Splits s at top-level commas (outside brackets, braces, parentheses and strings); trims blanks.
 std::vector<std::string> split_top(const std::string& s);
@@ -60,5 +76,9 @@ std::string upper_case(std::string s);
 /// The line without its comment: everything from the first `comment` character outside a
 /// "string" on (KRL ';', RAPID '!', URScript '#').
 std::string code_before(const std::string& line, char comment);
+
+/// How often name stands in code as a whole word (letters, digits and '_' on neither side);
+/// ignore_case for KRL and RAPID names.
+int word_count(const std::string& code, const std::string& name, bool ignore_case = true);
 
 }  // namespace kincal

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <map>
 #include <regex>
+#include <tuple>
 
 namespace kincal {
 
@@ -19,22 +20,6 @@ std::string code_of(const std::string& l) { return code_before(l, ';'); }
 
 }  // namespace
 
-std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl) {
-  std::vector<std::string> out;
-  size_t b = 0;
-  while (b < text.size()) {
-    const size_t e = text.find('\n', b);
-    if (e == std::string::npos) {
-      out.push_back(text.substr(b));
-      final_nl = false;
-      return out;
-    }
-    out.push_back(text.substr(b, e - b));
-    b = e + 1;
-  }
-  final_nl = true;
-  return out;
-}
 
 namespace {
 
@@ -78,19 +63,11 @@ Pose6 parse_aggregate(const std::string& agg, const std::string& at) {
 NativeProgram read_krl_program(const std::string& src_path) {
   NativeProgram p;
   p.format = ControllerFormat::Krl;
-  p.paths.push_back(src_path);
+  add_program_file(p, src_path);
   const std::string dat_path = ctl::with_ext(src_path, ".dat");
-  {
-    bool nl = true;
-    p.lines.push_back(krl_lines_of(read_text_file(src_path), nl));
-    p.final_newline.push_back(nl);
-  }
   if (FILE* f = std::fopen(dat_path.c_str(), "rb")) {
     std::fclose(f);
-    bool nl = true;
-    p.paths.push_back(dat_path);
-    p.lines.push_back(krl_lines_of(read_text_file(dat_path), nl));
-    p.final_newline.push_back(nl);
+    add_program_file(p, dat_path);
   }
   static const std::regex decl_re(
       R"(^\s*(?:DECL\s+)?(?:GLOBAL\s+)?(E6POS|POS|FRAME|E6AXIS|AXIS)\s+(\w+)\s*(=\s*(\{.*\}))?\s*$)", std::regex::icase);
@@ -125,13 +102,9 @@ NativeProgram read_krl_program(const std::string& src_path) {
         d.type = upper_case(m[1].str());
         d.file = static_cast<int>(f);
         d.line = static_cast<int>(i + 1);
-        d.type_begin = static_cast<size_t>(m.position(1));
-        d.type_end = d.type_begin + static_cast<size_t>(m.length(1));
+        std::tie(d.type_begin, d.type_end) = span_of(m, 1);
         d.has_value = m[4].matched;
-        if (d.has_value) {
-          d.begin = static_cast<size_t>(m.position(4));
-          d.end = d.begin + static_cast<size_t>(m.length(4));
-        }
+        if (d.has_value) std::tie(d.begin, d.end) = span_of(m, 4);
         decls[upper_case(m[2].str())] = d;
       } else if (f == 0 && std::regex_search(code, m, assign_re)) {
         const auto it = decls.find(upper_case(m[1].str()));

@@ -17,8 +17,6 @@
 
 namespace kincal {
 
-std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl);
-
 namespace {
 
 struct LsPos {
@@ -79,10 +77,7 @@ LsPos parse_position(const std::vector<std::string>& lines, int first, int last,
 NativeProgram read_ls_program(const std::string& path) {
   NativeProgram p;
   p.format = ControllerFormat::FanucLs;
-  p.paths.push_back(path);
-  bool nl = true;
-  p.lines.push_back(krl_lines_of(read_text_file(path), nl));
-  p.final_newline.push_back(nl);
+  add_program_file(p, path);
   const auto& lines = p.lines[0];
   enum Section { None, Head, Mn, Pos, End } sec = None;
   int prog_line = 0, open_pos = 0, open_n = 0, gp_first = 0, gp_last = 0;

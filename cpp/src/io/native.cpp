@@ -149,4 +149,37 @@ int word_count(const std::string& code, const std::string& name, bool ignore_cas
   return n;
 }
 
+namespace {
+
+std::vector<std::string> lines_of(const std::string& text, bool& final_nl) {
+  std::vector<std::string> out;
+  size_t b = 0;
+  while (b < text.size()) {
+    const size_t e = text.find('\n', b);
+    if (e == std::string::npos) {
+      out.push_back(text.substr(b));
+      final_nl = false;
+      return out;
+    }
+    out.push_back(text.substr(b, e - b));
+    b = e + 1;
+  }
+  final_nl = true;
+  return out;
+}
+
+}  // namespace
+
+void add_program_file(NativeProgram& p, const std::string& path) {
+  bool nl = true;
+  p.paths.push_back(path);
+  p.lines.push_back(lines_of(read_text_file(path), nl));
+  p.final_newline.push_back(nl);
+}
+
+std::pair<size_t, size_t> span_of(const std::smatch& m, int group) {
+  const size_t b = static_cast<size_t>(m.position(group));
+  return {b, b + static_cast<size_t>(m.length(group))};
+}
+
 }  // namespace kincal

@@ -11,10 +11,9 @@
 #include <cstdlib>
 #include <map>
 #include <regex>
+#include <tuple>
 
 namespace kincal {
-
-std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl);
 
 namespace {
 
@@ -62,10 +61,7 @@ Pose6 parse_robtarget(const std::string& v, const std::string& at) {
 NativeProgram read_rapid_program(const std::string& path) {
   NativeProgram p;
   p.format = ControllerFormat::Rapid;
-  p.paths.push_back(path);
-  bool nl = true;
-  p.lines.push_back(krl_lines_of(read_text_file(path), nl));
-  p.final_newline.push_back(nl);
+  add_program_file(p, path);
   const auto& lines = p.lines[0];
   static const std::regex decl_re(
       R"(^\s*(?:LOCAL\s+|TASK\s+)?(CONST|PERS|VAR)\s+(robtarget|wobjdata)\s+(\w+)\s*(:=\s*(.*?))?\s*;\s*$)",
@@ -99,12 +95,10 @@ NativeProgram read_rapid_program(const std::string& path) {
       Decl d;
       d.line = static_cast<int>(i + 1);
       d.robtarget = upper_case(m[2].str()) == "ROBTARGET";
-      d.type_begin = static_cast<size_t>(m.position(2));
-      d.type_end = d.type_begin + static_cast<size_t>(m.length(2));
+      std::tie(d.type_begin, d.type_end) = span_of(m, 2);
       d.has_value = m[5].matched;
       if (d.has_value) {
-        d.begin = static_cast<size_t>(m.position(5));
-        d.end = d.begin + static_cast<size_t>(m.length(5));
+        std::tie(d.begin, d.end) = span_of(m, 5);
         d.value = m[5].str();
         if (d.robtarget) parse_robtarget(d.value, at);  // checked here, where it is declared
       }
@@ -126,8 +120,8 @@ NativeProgram read_rapid_program(const std::string& path) {
     const size_t n_targets = upper_case(m[1].str()).rfind("MOVEC", 0) == 0 ? 2 : 1;
     // MoveJ (not MoveJDO, MoveJSync, ...) becomes MoveAbsJ when its target is written as joints
     const bool movej = upper_case(m[1].str()) == "MOVEJ";
-    const NativeEdit to_absj{0, static_cast<int>(i + 1), static_cast<size_t>(m.position(1)),
-                             static_cast<size_t>(m.position(1) + m.length(1)), "MoveAbsJ"};
+    const auto [move_begin, move_end] = span_of(m, 1);
+    const NativeEdit to_absj{0, static_cast<int>(i + 1), move_begin, move_end, "MoveAbsJ"};
     if (args.size() < n_targets + 2) throw InputError(at + ": " + m[1].str() + " needs target(s), speed and zone");
     // the work object: \WObj:=name anywhere in the statement
     Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();

@@ -12,10 +12,9 @@
 #include <cstdlib>
 #include <map>
 #include <regex>
+#include <tuple>
 
 namespace kincal {
-
-std::vector<std::string> krl_lines_of(const std::string& text, bool& final_nl);
 
 namespace {
 
@@ -62,10 +61,7 @@ bool is_pose_literal(const std::string& a) {
 NativeProgram read_urscript_program(const std::string& path) {
   NativeProgram p;
   p.format = ControllerFormat::UrScript;
-  p.paths.push_back(path);
-  bool nl = true;
-  p.lines.push_back(krl_lines_of(read_text_file(path), nl));
-  p.final_newline.push_back(nl);
+  add_program_file(p, path);
   const auto& lines = p.lines[0];
   struct Assign {
     int line = 0, count = 0;
@@ -90,8 +86,7 @@ NativeProgram read_urscript_program(const std::string& path) {
       a.line = ln;
       a.literal = is_pose_literal(m[2].str());
       a.joints = !m[2].str().empty() && m[2].str()[0] == '[';
-      a.begin = static_cast<size_t>(m.position(2));
-      a.end = a.begin + static_cast<size_t>(m.length(2));
+      std::tie(a.begin, a.end) = span_of(m, 2);
       if (a.literal) parse_pose(m[2].str(), where(path, ln));  // checked where it is written
     }
   }

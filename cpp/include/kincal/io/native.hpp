@@ -9,7 +9,9 @@
 #include "kincal/core/types.hpp"
 #include "kincal/io/controllers.hpp"
 
+#include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kincal {
@@ -66,6 +68,12 @@ NativeProgram read_native_program(const std::string& path, ControllerFormat form
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
                                              const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
                                              const std::string& out_path);
+
+/// Appends the file at path to p: its path, its lines (without the '\n') and whether it ends in '\n'.
+void add_program_file(NativeProgram& p, const std::string& path);
+
+/// The span [begin, end) of group `group` of a match.
+std::pair<size_t, size_t> span_of(const std::smatch& m, int group);
 
 /// Splits s at top-level commas (outside brackets, braces, parentheses and strings); trims blanks.
 std::vector<std::string> split_top(const std::string& s);

@@ -60,12 +60,10 @@ void define_controllers(py::module_& m) {
         t.q_deg = q;
         set_branch_data(r, t);
         const ArmClass a = arm_class(r, q);
-        py::dict d = target_dict(t);
-        d["behind"] = a.behind;
-        d["elbow_up"] = a.elbow_up;
-        d["wrist_negative"] = a.wrist_negative;
-        d["x_a1"] = a.x_a1;
-        d["elbow_sin"] = a.elbow_sin;
+        py::dict d = target_dict(t);  // with the arm's classification the branch data come from
+        d.attr("update")(py::dict(py::arg("behind") = a.behind, py::arg("elbow_up") = a.elbow_up,
+                                  py::arg("wrist_negative") = a.wrist_negative, py::arg("x_a1") = a.x_a1,
+                                  py::arg("elbow_sin") = a.elbow_sin));
         return d;
       },
       py::arg("robot"), py::arg("q_deg"), "KUKA S/T, ABB confdata, FANUC configuration of the nominal robot at q_deg");

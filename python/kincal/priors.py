@@ -43,13 +43,7 @@ def parse_prior_sd(text: Optional[str]) -> dict:
         if not eq or kind not in _GEOMETRIC + tuple(effects):
             raise ValueError(f"--prior-sd: '{item}': expected KIND=SD with KIND one of "
                              f"{', '.join(_GEOMETRIC + tuple(effects))}")
-        try:
-            v = float(value)
-        except ValueError:
-            raise ValueError(f"--prior-sd: '{item}': the standard deviation must be a number") from None
-        if not (v > 0 and math.isfinite(v)):
-            raise ValueError(f"--prior-sd: '{item}': the standard deviation must be positive")
-        sd[kind] = v
+        sd[kind] = _positive(value, f"--prior-sd: '{item}': the standard deviation must be a positive number")
     return sd
 
 
@@ -73,12 +67,17 @@ def parse_prior_scale(text) -> Optional[float]:
         return 1.0
     if str(text).strip() == "auto":
         return None
+    return _positive(text, f"--prior-scale: '{text}': a positive number or 'auto'")
+
+
+def _positive(text, message: str) -> float:
+    """text as a finite positive number; ValueError(message) otherwise."""
     try:
         v = float(text)
     except ValueError:
-        raise ValueError(f"--prior-scale: '{text}': a positive number or 'auto'") from None
+        raise ValueError(message) from None
     if not (v > 0 and math.isfinite(v)):
-        raise ValueError(f"--prior-scale: '{text}': a positive number or 'auto'")
+        raise ValueError(message)
     return v
 
 

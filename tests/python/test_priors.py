@@ -162,7 +162,7 @@ def test_cli_prior_options(tmp_path):
     out = tmp_path / "model.json"
     for opts, message in ((["--prior-sd", "joint_mm"], "expected KIND=SD"),
                           (["--prior-sd", "elbow_mm=1"], "expected KIND=SD"),
-                          (["--prior-sd", "joint_mm=-1"], "must be positive"),
+                          (["--prior-sd", "joint_mm=-1"], "must be a positive number"),
                           (["--prior-scale", "0"], "a positive number or 'auto'")):
         r = run("kincal", "identify", "--robot", "kr500", "--data", str(data), "--out", str(out), *opts)
         assert r.returncode != 0 and message in r.stderr and not out.exists(), (opts, r.stderr)

@@ -10,7 +10,10 @@ controller's motion is emulated here, independently of kincal's own check: joint
 straight line in joint space; filtered targets (LIN) on the nominal model's straight line between the
 written poses (position linear, orientation by quaternion slerp; the nominal IK solution nearest the
 previous point, from kincal's ik_all). The real robot's position there (the calibrated model's FK)
-is measured at 20 points per segment (s = k/21) against the desired line: at most 0.05 mm."""
+is measured at 20 points per segment (s = k/21) against the desired line: at most 0.05 mm.
+The same line's two ends as hand-written KRL, RAPID, LS and URScript programs (a joint motion to the
+first end, a straight-line motion to the second): the inserted copies of the straight-line motion are
+read back here and the emulated LIN keeps within 0.05 mm as well."""
 
 from __future__ import annotations
 
@@ -141,9 +144,100 @@ def test_gcode_keeps_its_lines_and_gets_inserted_motions(tmp_path, calibrated):
     assert len(out) - len(lines) == _summary(r.stderr)[2] > 0
 
 
-def test_bad_tolerance_and_native_programs(tmp_path, calibrated):
+def test_bad_tolerance(tmp_path, calibrated):
     (tmp_path / "m.json").write_text(calibrated.to_json())
     (tmp_path / "l.csv").write_text("x,y,z,a,b,c\n2000,0,500,180,0,180\n2000,100,500,180,0,180\n")
     r = run("kincal-compensate", "--model", str(tmp_path / "m.json"), "--program", str(tmp_path / "l.csv"), "--out",
             str(tmp_path / "o.csv"), "--tolerance", "-1")
     assert r.returncode != 0 and "--tolerance" in r.stderr and not (tmp_path / "o.csv").exists()
+
+
+def _native_line(lang: str, ends: np.ndarray) -> dict:
+    """The line's two ends as a hand-written program: a joint motion to the first, a straight line to
+    the second (KRL PTP/LIN, RAPID MoveJ/MoveL, LS J/L, URScript movej/movel)."""
+    a, b = ends
+    krl = lambda p: "{" + ",".join(f"{k} {v:.4f}" for k, v in zip("XYZABC", p)) + "}"
+    if lang == "krl":
+        return {"line.src": "DEF line( )\n$VEL.CP = 0.2 ; m/s\nPTP XP1\nLIN XP2 C_DIS\nEND\n",
+                "line.dat": f"DEFDAT line\nDECL E6POS XP1={krl(a)}\nDECL E6POS XP2={krl(b)}\nENDDAT\n"}
+    if lang == "rapid":
+        q = lambda p: ",".join(f"{v:.9f}" for v in np.roll(_abc_rot(p[3:]).as_quat(), 1))
+        rt = lambda p: f"[[{p[0]:.4f},{p[1]:.4f},{p[2]:.4f}],[{q(p)}],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]"
+        return {"line.mod": f"MODULE line\n  CONST robtarget p1:={rt(a)};\n  CONST robtarget p2:={rt(b)};\n"
+                            "  PROC main()\n    MoveJ p1,v500,fine,tool0;\n    MoveL p2,v200,z1,tool0; ! the line\n"
+                            "  ENDPROC\nENDMODULE\n"}
+    if lang == "ls":
+        pos = lambda n, p: (f"P[{n}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
+                            f"\tX = {p[0]:.3f}  mm,\tY = {p[1]:.3f}  mm,\tZ = {p[2]:.3f}  mm,\n"
+                            f"\tW = {p[5]:.3f} deg,\tP = {p[4]:.3f} deg,\tR = {p[3]:.3f} deg\n}};\n")
+        return {"LINE.ls": "/PROG  LINE\n/ATTR\nLINE_COUNT\t= 3;\n/MN\n   1:  J P[1] 20% FINE    ;\n"
+                           "   2:  L P[2] 200mm/sec CNT50    ;\n   3:  !done ;\n/POS\n" + pos(1, a) + pos(2, b) + "/END\n"}
+    p = lambda x: "p[" + ", ".join(f"{v:.8f}" for v in [*(x[:3] / 1000), *_abc_rot(x[3:]).as_rotvec()]) + "]"
+    return {"line.script": f"def line():\n  movej({p(a)}, a=1.4, v=1.05)\n  movel({p(b)}, a=1.2, v=0.2)\nend\n"}
+
+
+def _native_poses(lang: str, files: dict) -> np.ndarray:
+    """The written targets in the order the program moves to them (read here by regular expressions)."""
+    if lang == "krl":
+        dat = dict(re.findall(r"DECL E6POS (XP\d)=(\{[^}]*\})", files["line.dat"]))
+        order = [dat["XP1"]] + re.findall(r"^LIN (\{[^}]*\}) C_DIS$", files["line.src"], re.M) + [dat["XP2"]]
+        return np.array([[float(re.search(k + " " + NUM, t).group(1)) for k in ("X", "Y", "Z", "A", "B", "C")]
+                         for t in order])
+    if lang == "rapid":
+        decl = dict(re.findall(r"robtarget (p\d):=(\[\[.*?\]\]);", files["line.mod"]))
+        order = [decl["p1"]] + re.findall(r"^    MoveL (\[\[.*?\]\]),v200,z1,tool0;$", files["line.mod"], re.M) + [decl["p2"]]
+        out = []
+        for t in order:
+            v = [float(x) for x in re.findall(r"-?\d+\.\d+|-?\d+", t)]
+            out.append([*v[:3], *Rotation.from_quat([v[4], v[5], v[6], v[3]]).as_euler("ZYX", degrees=True)])
+        return np.array(out)
+    if lang == "ls":
+        text = files["LINE.ls"]
+        pos = {int(m.group(1)): [float(m.group(k)) for k in (2, 3, 4, 7, 6, 5)] for m in re.finditer(
+            r"P\[(\d+)\]\{\s*GP1:\s*UF : 0, UT : 1,\s*CONFIG : '[^']*',\s*X =\s*" + NUM + r"\s*mm,\s*Y =\s*" + NUM +
+            r"\s*mm,\s*Z =\s*" + NUM + r"\s*mm,\s*W =\s*" + NUM + r"\s*deg,\s*P =\s*" + NUM + r"\s*deg,\s*R =\s*" + NUM, text)}
+        return np.array([pos[int(n)] for n in re.findall(r"^\s*\d+:\s+[JL] P\[(\d+)\]", text, re.M)])
+    out = []
+    for m in re.finditer(r"p\[([^\]]*)\]", files["line.script"]):
+        v = [float(x) for x in m.group(1).split(",")]
+        out.append([*(1000 * np.array(v[:3])), *Rotation.from_rotvec(v[3:]).as_euler("ZYX", degrees=True)])
+    return np.array(out)
+
+
+@pytest.mark.parametrize("lang", ["krl", "rapid", "ls", "urscript"])
+def test_native_program_straight_line_keeps_within_tolerance(tmp_path, calibrated, lang):
+    # a hand-written program along the Samak line's two ends (1480 mm): --tolerance inserts copies of the
+    # straight-line motion (its speed, zone, tool) before it, every other line is kept; the controller's
+    # LIN through the written targets, emulated here, keeps the real robot within 0.05 mm of the line
+    ends = kincal.line_program(count=2, step_mm=1480.0)
+    files = _native_line(lang, ends)
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    (tmp_path / "out").mkdir()
+    (tmp_path / "m.json").write_text(calibrated.to_json())
+    main = next(n for n in files if not n.endswith(".dat"))
+    r = run("kincal", "compensate", "--model", str(tmp_path / "m.json"), "--program", str(tmp_path / main), "--out",
+            str(tmp_path / "out" / main), "--targets", "filtered", "--tolerance", str(TOL))
+    assert r.returncode == 0, r.stderr
+    out = {n: (tmp_path / "out" / n).read_text() for n in files}
+    written = _native_poses(lang, out)
+    b, a, n = _summary(r.stderr)
+    assert n == len(written) - 2 > 0 and b > TOL and a <= TOL
+    q_first = kincal.compensate(calibrated, ends[:1])["q_deg"][0]
+    assert _deviation(calibrated, _lin_path(calibrated, written, q_first), ends) <= TOL
+    # the lines of the input are all there, in order; what was added is n copies of the line's motion
+    src_in, src_out = files[main].splitlines(), out[main].splitlines()
+    added = [l for l in src_out if l not in src_in]
+    kept = [l for l in src_out if l in src_in]
+    if lang == "ls":  # /MN renumbered: 1 J, n + 1 L, the comment; LINE_COUNT follows
+        assert [re.sub(r"P\[\d+\].*", "", l) for l in src_out[4:n + 7]] == \
+            ["   1:  J "] + [f"{k:4d}:  L " for k in range(2, n + 3)] + [f"{n + 3:4d}:  !done ;"]
+        assert f"LINE_COUNT\t= {n + 3};" in src_out
+    else:
+        assert kept == [l for l in src_in if l in src_out]  # in their order
+        assert len(kept) == len(src_in) - {"krl": 0, "rapid": 2, "urscript": 2}[lang]  # the two targets' lines
+        motion = {"krl": r"LIN \{X .*,S \d+,T \d+\} C_DIS", "rapid": r"    MoveL \[\[.*\]\],v200,z1,tool0;",
+                  "urscript": r"  movel\(p\[.*\], a=1\.2, v=0\.2\)"}[lang]
+        # (URScript's targets are inline: its movej and movel lines change as well)
+        assert sum(bool(re.fullmatch(motion, l)) for l in added) == n + (lang == "urscript")
+        assert len(src_out) == len(src_in) + n

@@ -44,6 +44,63 @@ std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::
 
 namespace {
 
+// --tolerance on a native program: its motions' path in the order of the file
+struct NativePath {
+  ToleranceResult tol;
+  std::vector<Vec6> q_of;                 // per target: the joints of its first motion
+  std::vector<size_t> inserted_before;    // per inserted target: the motion it precedes
+  std::vector<Vec6> q_inserted;
+  std::vector<std::string> warnings;
+};
+
+// The motions to compensated targets, in the order of the file, compensated as one path; a straight-line
+// motion (LIN, MoveL, L, movel) from the target of the motion just before it is followed and bisected
+// until it keeps within tol_mm. Joint motions, arcs, and motions after a target kincal does not know
+// (joints as written, computed at run time) are not followed: the program says nothing of their path.
+NativePath compensate_native_path(const Robot& robot, const NativeProgram& p, const std::vector<Pose6>& poses,
+                                  const ProgramOptions& opt, double tol_mm) {
+  std::vector<Pose6> seq;
+  std::vector<std::string> seq_where;
+  std::vector<size_t> seq_motion;
+  std::vector<PathKind> kinds;
+  for (size_t m = 0; m < p.motions.size(); ++m) {
+    const NativeMotion& mo = p.motions[m];
+    if (mo.target < 0) continue;
+    if (!seq.empty())
+      kinds.push_back(mo.kind == 'L' && seq_motion.back() + 1 == m ? PathKind::NominalLine : PathKind::Unchecked);
+    seq.push_back(poses[static_cast<size_t>(mo.target)]);
+    seq_where.push_back(where(p.paths[0], mo.line));
+    seq_motion.push_back(m);
+  }
+  NativePath r;
+  r.tol = compensate_with_tolerance(robot, seq, seq_where, opt, {}, tol_mm, kinds);
+  r.q_of.assign(p.targets.size(), Vec6::Zero());
+  std::vector<int> first(p.targets.size(), -1);  // per target: its first motion
+  std::vector<size_t> pending;                   // inserted poses before the next motion
+  for (size_t j = 0; j < r.tol.poses.size(); ++j) {
+    if (r.tol.original[j] < 0) {
+      pending.push_back(j);
+      continue;
+    }
+    const size_t m = seq_motion[static_cast<size_t>(r.tol.original[j])];
+    for (const size_t i : pending) r.inserted_before.push_back(m), r.q_inserted.push_back(r.tol.result.q_deg[i]);
+    pending.clear();
+    const size_t k = static_cast<size_t>(p.motions[m].target);
+    const Vec6& q = r.tol.result.q_deg[j];
+    if (first[k] < 0) {
+      first[k] = static_cast<int>(m);
+      r.q_of[k] = q;
+    } else if ((q - r.q_of[k]).cwiseAbs().maxCoeff() > 1e-6) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " %.3g deg away", (q - r.q_of[k]).cwiseAbs().maxCoeff());
+      r.warnings.push_back(where(p.paths[0], p.motions[m].line) + ": this motion's target would be compensated" + buf +
+                           " from its first motion's (" + where(p.paths[0], p.motions[static_cast<size_t>(first[k])].line) +
+                           ": another branch or direction of motion); the first is written");
+    }
+  }
+  return r;
+}
+
 // a KRL or RAPID program with its Cartesian targets filtered, every other byte unchanged
 ControllerProgramResult compensate_native(const Robot& robot, const std::string& in_path, ControllerFormat in_format,
                                           const std::string& out_path, const ProgramOptions& opt,
@@ -51,9 +108,6 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
   if (w.format != in_format)
     throw InputError(out_path + ": a " + format_name(in_format) + " program is written back as " +
                      format_name(in_format) + " (not " + format_name(w.format) + ")");
-  if (std::isfinite(n.tolerance_mm))
-    throw InputError(in_path + ": --tolerance inserts targets into programs kincal writes (from CSV or G-code), "
-                     "not yet into a " + std::string(format_name(in_format)) + " program it filters");
   const NativeProgram p = read_native_program(in_path, in_format);
   ControllerProgramResult r;
   if (!p.unresolved.empty()) {
@@ -74,7 +128,27 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
     where_of.push_back(where(p.paths[static_cast<size_t>(t.file)], t.line));
   }
   const auto warnings = std::move(r.result.warnings);
-  r.result = compensate_poses(robot, poses, where_of, opt);
+  std::vector<Vec6> q_of;  // per target, its compensated joints
+  std::vector<InsertedTarget> inserted;
+  if (std::isfinite(n.tolerance_mm)) {
+    NativePath path = compensate_native_path(robot, p, poses, opt, n.tolerance_mm);
+    r.result = std::move(path.tol.result);
+    r.path_before_mm = path.tol.before_mm, r.path_after_mm = path.tol.after_mm, r.inserted = path.tol.inserted;
+    q_of = std::move(path.q_of);
+    r.result.warnings.insert(r.result.warnings.end(), path.warnings.begin(), path.warnings.end());
+    // the inserted targets filtered (they precede straight-line motions), in the frame of the motion's target
+    std::vector<std::string> where_ins;
+    for (const size_t m : path.inserted_before) where_ins.push_back(where(p.paths[0], p.motions[m].line));
+    const auto ins = controller_targets(robot, path.q_inserted, TargetKind::Filtered, in_format, where_ins);
+    for (size_t j = 0; j < ins.size(); ++j) {
+      const NativeTarget& t = p.targets[static_cast<size_t>(p.motions[path.inserted_before[j]].target)];
+      inserted.push_back({path.inserted_before[j],
+                          iso_to_pose((base * t.frame).inverse() * pose_to_iso(ins[j].pose) * tool), ins[j]});
+    }
+  } else {
+    r.result = compensate_poses(robot, poses, where_of, opt);
+    q_of = r.result.q_deg;
+  }
   r.result.warnings.insert(r.result.warnings.begin(), warnings.begin(), warnings.end());
   // joint targets where every motion to the target interpolates in joints; the others filtered, so that
   // LIN / MoveL / L / movel keep their straight line
@@ -83,9 +157,9 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
   std::vector<std::string> where_filtered;
   for (size_t k = 0; k < p.targets.size(); ++k) {
     joints[k] = w.targets == TargetKind::Joints && p.targets[k].joint_motion;
-    if (!joints[k]) q_filtered.push_back(r.result.q_deg[k]), where_filtered.push_back(where_of[k]);
+    if (!joints[k]) q_filtered.push_back(q_of[k]), where_filtered.push_back(where_of[k]);
   }
-  auto targets = controller_targets(robot, r.result.q_deg, TargetKind::Joints, in_format, where_of);
+  auto targets = controller_targets(robot, q_of, TargetKind::Joints, in_format, where_of);
   const auto filtered = controller_targets(robot, q_filtered, TargetKind::Filtered, in_format, where_filtered);
   std::vector<Pose6> back(targets.size());
   for (size_t k = 0, f = 0; k < targets.size(); ++k) {
@@ -98,7 +172,7 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
                    std::to_string(targets.size() - n_joints) + " as filtered poses";
   if (w.targets == TargetKind::Joints && n_joints < targets.size())
     r.targets_note += " (targets of linear and circular motions, or named elsewhere in the program, stay Cartesian)";
-  const auto files = write_native_program(p, back, targets, joints, out_path);
+  const auto files = write_native_program(p, back, targets, joints, out_path, inserted);
   write_files_atomic(files);
   for (const auto& f : files) r.files.push_back(f.path);
   return r;

@@ -72,7 +72,17 @@ double segment_deviation_mm(const Robot& robot, const Pose6& a, const Pose6& b, 
 ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
                                           const std::vector<std::string>& where, const ProgramOptions& opt,
                                           const std::vector<double>& temperature_c, double tol, PathKind kind) {
+  return compensate_with_tolerance(robot, poses, where, opt, temperature_c, tol,
+                                   std::vector<PathKind>(poses.empty() ? 0 : poses.size() - 1, kind));
+}
+
+ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
+                                          const std::vector<std::string>& where, const ProgramOptions& opt,
+                                          const std::vector<double>& temperature_c, double tol,
+                                          const std::vector<PathKind>& segment_kinds) {
   if (!(tol > 0)) throw InputError("--tolerance must be a positive length in mm");
+  std::vector<PathKind> kinds = segment_kinds;
+  kinds.resize(poses.empty() ? 0 : poses.size() - 1, PathKind::Unchecked);
   ToleranceResult r;
   r.poses = poses;
   r.where = where;
@@ -94,13 +104,14 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
     double worst = 0;
     size_t worst_at = 0;
     for (size_t i = 0; i + 1 < r.poses.size(); ++i) {
+      if (kinds[i] == PathKind::Unchecked) continue;
       EffectContext ca, cb;
       ca.temperature_c = temps[i], cb.temperature_c = temps[i + 1];
       if (opt.compensate && robot.calibrated->needs_dir()) ca.dir = r.result.dir[i + 1], cb.dir = r.result.dir[i + 1];
       double d;
       try {
         d = segment_deviation_mm(robot, iso_to_pose(to_base * pose_to_iso(r.poses[i])),
-                                 iso_to_pose(to_base * pose_to_iso(r.poses[i + 1])), q[i], q[i + 1], kind, ca, cb);
+                                 iso_to_pose(to_base * pose_to_iso(r.poses[i + 1])), q[i], q[i + 1], kinds[i], ca, cb);
       } catch (const InputError& e) {
         throw InputError(r.where[i + 1] + ": " + e.what());
       }
@@ -119,8 +130,11 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
     ToleranceResult next;
     std::vector<double> next_t;
     std::vector<std::string> next_label;
+    std::vector<PathKind> next_kinds;
     for (size_t i = 0; i < r.poses.size(); ++i) {
+      if (i > 0) next_kinds.push_back(kinds[i - 1]);
       if (i > 0 && split[i - 1]) {
+        next_kinds.push_back(kinds[i - 1]);
         next.poses.push_back(interpolate_pose(r.poses[i - 1], r.poses[i], 0.5));
         next.original.push_back(-1);
         next.where.push_back(label[i] + " (a target inserted before it by --tolerance)");
@@ -139,6 +153,7 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
     r.where = std::move(next.where);
     temps = std::move(next_t);
     label = std::move(next_label);
+    kinds = std::move(next_kinds);
   }
 }
 

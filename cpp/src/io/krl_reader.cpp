@@ -133,6 +133,8 @@ NativeProgram read_krl_program(const std::string& src_path) {
     for (size_t a = 0; a < n_targets; ++a) {
       std::string arg = args[a];
       arg = arg.substr(0, arg.find_first_of(" \t") == std::string::npos || arg[0] == '{' ? arg.size() : arg.find_first_of(" \t"));
+      p.motions.push_back(motion_around(code, static_cast<int>(i + 1), ptp ? 'J' : n_targets == 2 ? 'C' : 'L',
+                                        code.find(arg, base_pos), arg.size()));
       if (kind.find("_REL") != std::string::npos || arg.find(':') != std::string::npos) {
         p.unresolved.push_back({at, code});
         continue;
@@ -146,6 +148,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
         t.end = t.begin + arg.size();
         t.pose = parse_aggregate(arg, at);
         t.joint_motion = ptp;
+        p.motions.back().target = static_cast<int>(p.targets.size());
         p.targets.push_back(t);
         continue;
       }
@@ -166,8 +169,10 @@ NativeProgram read_krl_program(const std::string& src_path) {
       ++motions[key];
       if (used.count(key)) {
         p.targets[used[key]].joint_motion &= ptp;
+        p.motions.back().target = static_cast<int>(used[key]);
         continue;
       }
+      p.motions.back().target = static_cast<int>(p.targets.size());
       used[key] = p.targets.size();
       NativeTarget t;
       t.file = d.file;

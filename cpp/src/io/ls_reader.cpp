@@ -88,6 +88,7 @@ NativeProgram read_ls_program(const std::string& path) {
   };
   std::vector<Use> uses;
   std::vector<std::string> mn;  // the /MN statements but comments
+  std::vector<int> motion_pos;  // per motion, its position's number (-1: a run-time target)
   static const std::regex comment(R"(^\s*\d+:\s*!)");
   static const std::regex motion(R"(^\s*\d+:\s*([JLCA])\s+(.*)$)"), cont(R"(^\s*:\s*(.*)$)");
   static const std::regex ref(R"(^(P|PR)\[\s*(R\[)?\s*(\d+))");
@@ -129,19 +130,25 @@ NativeProgram read_ls_program(const std::string& path) {
       std::string rest;
       const bool is_cont = want_circ_end && std::regex_match(s, m, cont);
       char kind = 'C';
-      if (is_cont) rest = m[1].str();
-      else if (std::regex_match(s, m, motion)) rest = m[2].str(), kind = m[1].str()[0], want_circ_end = kind == 'C';
+      size_t rest_at = 0;
+      if (is_cont) rest = m[1].str(), rest_at = static_cast<size_t>(m.position(1));
+      else if (std::regex_match(s, m, motion))
+        rest = m[2].str(), rest_at = static_cast<size_t>(m.position(2)), kind = m[1].str()[0], want_circ_end = kind == 'C';
       else continue;
       if (is_cont) want_circ_end = false;
       const bool ends = rest.find(';') != std::string::npos;
       if (!ends && !want_circ_end) throw InputError(at + ": the motion does not end with ';'");
       std::smatch r;
       if (!std::regex_search(rest, r, ref)) throw InputError(at + ": the motion names no P[n] or PR[n] position");
+      const size_t ref_at = rest_at + static_cast<size_t>(r.position(0));
+      p.motions.push_back(motion_around(s, ln, kind == 'A' ? 'O' : kind, ref_at, s.find(']', ref_at) + 1 - ref_at));
+      motion_pos.push_back(-1);
       if (r[1].str() == "PR" || r[2].matched || std::regex_search(rest, runtime)) {
         p.unresolved.push_back({at, s.substr(a)});
         continue;
       }
       uses.push_back({std::stoi(r[3].str()), ln, kind == 'J'});
+      motion_pos.back() = uses.back().n;
     } else if (sec == Pos) {
       if (!open_pos) {
         if (!std::regex_match(s, m, pos_open)) throw InputError(at + ": expected P[n]{ in /POS");
@@ -183,6 +190,8 @@ NativeProgram read_ls_program(const std::string& path) {
     t.end = lines[static_cast<size_t>(lp.last - 1)].size();
     t.pose = lp.pose;
     t.name = "P[" + std::to_string(u.n) + "]";
+    for (size_t k = 0; k < p.motions.size(); ++k)
+      if (motion_pos[k] == u.n) p.motions[k].target = static_cast<int>(p.targets.size());
     // every motion to it a J, and no other statement names it (a P[n] or P[n:comment])
     const std::regex named(R"(\bP\[\s*)" + std::to_string(u.n) + R"(\s*[:\]])");
     int mentions = 0;
@@ -222,6 +231,34 @@ std::string ls_joint_position(const std::string& old, const Vec6& q_deg) {
     s = std::regex_replace(s, re, buf, std::regex_constants::format_first_only);
   }
   return s;
+}
+
+// The program with its /MN lines numbered 1, 2, ... again (each number in its old width) and LINE_COUNT
+// set to their count: after --tolerance inserted motions.
+std::string ls_renumbered(const std::string& text) {
+  static const std::regex numbered(R"(^(\s*)(\d+):)");
+  std::string out;
+  bool mn = false;
+  int n = 0;
+  size_t b = 0;
+  while (b < text.size()) {
+    size_t e = text.find('\n', b);
+    e = e == std::string::npos ? text.size() : e + 1;
+    std::string l = text.substr(b, e - b);
+    b = e;
+    if (!l.empty() && l[0] == '/') mn = l.compare(0, 3, "/MN") == 0;
+    std::smatch m;
+    if (mn && std::regex_search(l, m, numbered)) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%*d", static_cast<int>(m.length(1) + m.length(2)), ++n);
+      l.replace(0, static_cast<size_t>(m.length(1) + m.length(2)), buf);
+    }
+    out += l;
+  }
+  std::smatch m;
+  if (std::regex_search(out, m, std::regex(R"(\bLINE_COUNT\s*=\s*(\d+))")))
+    out.replace(static_cast<size_t>(m.position(1)), static_cast<size_t>(m.length(1)), std::to_string(n));
+  return out;
 }
 
 }  // namespace kincal

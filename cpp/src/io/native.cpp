@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cctype>
 #include <map>
+#include <regex>
 
 namespace kincal {
 
@@ -24,6 +25,7 @@ std::string krl_axis(const std::string& old, const Vec6& q_deg);
 std::string rapid_jointtarget(const std::string& old, const Vec6& q_deg);
 std::string ls_joint_position(const std::string& old, const Vec6& q_deg);
 std::string urscript_joints(const Vec6& q_deg);
+std::string ls_renumbered(const std::string& text);
 
 NativeProgram read_native_program(const std::string& path, ControllerFormat format) {
   if (format == ControllerFormat::Krl) return read_krl_program(path);
@@ -33,9 +35,60 @@ NativeProgram read_native_program(const std::string& path, ControllerFormat form
   throw InputError(path + ": not a native program (" + format_name(format) + ")");
 }
 
+namespace {
+
+// the value of target k as the program writes it (an LS position: its GP1 lines)
+std::string old_value(const NativeProgram& p, const NativeTarget& nt) {
+  const auto& f = p.lines[static_cast<size_t>(nt.file)];
+  if (nt.last_line <= nt.line) return f[static_cast<size_t>(nt.line - 1)].substr(nt.begin, nt.end - nt.begin);
+  std::string joined;
+  for (int l = nt.line; l <= nt.last_line; ++l) joined += f[static_cast<size_t>(l - 1)] + (l < nt.last_line ? "\n" : "");
+  return joined.substr(nt.begin);
+}
+
+// The lines of the program's first file with each inserted target's motion before the motion it precedes
+// (LS: the new positions P[n] before /END, numbered after the largest in the program).
+void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTarget>& inserted,
+                           std::vector<std::string>& lines) {
+  if (inserted.empty()) return;
+  std::map<int, std::string> before;  // per line: the motions inserted before it
+  std::string positions;
+  int next_p = 0;
+  for (const NativeTarget& nt : p.targets)
+    if (p.format == ControllerFormat::FanucLs) next_p = std::max(next_p, std::stoi(nt.name.substr(2)));
+  for (const std::string& l : lines) {  // joint positions and positions no motion uses count as well
+    std::smatch m;
+    if (p.format == ControllerFormat::FanucLs && std::regex_search(l, m, std::regex(R"(^\s*P\[\s*(\d+))")))
+      next_p = std::max(next_p, std::stoi(m[1].str()));
+  }
+  for (const InsertedTarget& ins : inserted) {
+    const NativeMotion& mo = p.motions[ins.motion];
+    const NativeTarget& nt = p.targets[static_cast<size_t>(mo.target)];
+    const std::string old = old_value(p, nt);
+    std::string value;
+    if (p.format == ControllerFormat::Krl) {
+      value = krl_aggregate(old, ins.pose, ins.target, false);
+    } else if (p.format == ControllerFormat::Rapid) {
+      value = rapid_robtarget(old, ins.pose, ins.target);
+    } else if (p.format == ControllerFormat::UrScript) {
+      value = urscript_pose(ins.pose);
+    } else {
+      value = "P[" + std::to_string(++next_p) + "]";
+      positions += value + "{\n   GP1:\n" + ls_position(old, ins.pose, ins.target) + "\n};\n";
+    }
+    before[mo.line] += mo.indent + mo.head + value + mo.tail + "\n";
+  }
+  for (const auto& [line, text] : before) lines[static_cast<size_t>(line - 1)].insert(0, text);
+  if (positions.empty()) return;
+  for (std::string& l : lines)
+    if (l.compare(0, 4, "/END") == 0) l.insert(0, positions);
+}
+
+}  // namespace
+
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
                                              const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
-                                             const std::string& out_path) {
+                                             const std::string& out_path, const std::vector<InsertedTarget>& inserted) {
   std::vector<std::vector<std::string>> lines = p.lines;
   struct Replacement {
     size_t begin, end;
@@ -88,6 +141,7 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
     std::string& l = lines[static_cast<size_t>(key.first)][static_cast<size_t>(key.second - 1)];
     for (const Replacement& r : reps) l.replace(r.begin, r.end - r.begin, r.text);
   }
+  with_inserted_targets(p, inserted, lines[0]);
   std::vector<OutputFile> out;
   for (size_t f = 0; f < lines.size(); ++f) {
     std::string text;
@@ -95,6 +149,7 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
       text += lines[f][i];
       if (i + 1 < lines[f].size() || p.final_newline[f]) text += '\n';
     }
+    if (p.format == ControllerFormat::FanucLs && !inserted.empty()) text = ls_renumbered(text);
     const std::string path = p.format == ControllerFormat::Krl ? ctl::with_ext(out_path, f == 0 ? ".src" : ".dat") : out_path;
     out.push_back({path, text});
   }
@@ -180,6 +235,18 @@ void add_program_file(NativeProgram& p, const std::string& path) {
 std::pair<size_t, size_t> span_of(const std::smatch& m, int group) {
   const size_t b = static_cast<size_t>(m.position(group));
   return {b, b + static_cast<size_t>(m.length(group))};
+}
+
+NativeMotion motion_around(const std::string& code, int line, char kind, size_t begin, size_t size) {
+  NativeMotion m;
+  m.line = line;
+  m.kind = kind;
+  const size_t ind = std::min(code.find_first_not_of(" \t"), begin);
+  m.indent = code.substr(0, ind);
+  m.head = code.substr(ind, begin - ind);
+  m.tail = code.substr(std::min(begin + size, code.size()));
+  m.tail.erase(m.tail.find_last_not_of(" \t\r") + 1);
+  return m;
 }
 
 }  // namespace kincal

@@ -138,8 +138,12 @@ NativeProgram read_rapid_program(const std::string& path) {
       frame = frame_of(numbers(uf[0], 3, wat, "uframe"), numbers(uf[1], 4, wat, "uframe")) *
               frame_of(numbers(of[0], 3, wat, "oframe"), numbers(of[1], 4, wat, "oframe"));
     }
+    const std::string instr = upper_case(m[1].str());
+    const char kind = instr == "MOVEJ" ? 'J' : instr == "MOVEL" ? 'L' : n_targets == 2 ? 'C' : 'O';
     for (size_t a = 0; a < n_targets; ++a) {
       const std::string& arg = args[a];
+      p.motions.push_back(motion_around(code, static_cast<int>(i + 1), kind, code.find(arg, static_cast<size_t>(m.position(2))),
+                                        arg.size()));
       if (!arg.empty() && arg[0] == '[') {
         NativeTarget t;
         t.line = static_cast<int>(i + 1);
@@ -149,6 +153,7 @@ NativeProgram read_rapid_program(const std::string& path) {
         t.frame = frame;
         t.joint_motion = movej;
         t.joint_edits.push_back(to_absj);
+        p.motions.back().target = static_cast<int>(p.targets.size());
         p.targets.push_back(t);
         continue;
       }
@@ -169,8 +174,10 @@ NativeProgram read_rapid_program(const std::string& path) {
         NativeTarget& t = p.targets[used[upper_case(arg)]];
         t.joint_motion &= movej;
         t.joint_edits.push_back(to_absj);
+        p.motions.back().target = static_cast<int>(used[upper_case(arg)]);
         continue;
       }
+      p.motions.back().target = static_cast<int>(p.targets.size());
       used[upper_case(arg)] = p.targets.size();
       const Decl& d = it->second;
       NativeTarget t;

@@ -105,8 +105,11 @@ NativeProgram read_urscript_program(const std::string& path) {
       const size_t n = (*it)[1].str() == "movec" ? 2 : 1;
       const bool movej = (*it)[1].str() == "movej";
       if (args.size() < n || args[0].empty()) throw InputError(at + ": " + (*it)[1].str() + " needs its target(s)");
+      const std::string name = (*it)[1].str();
+      const char kind = name == "movej" ? 'J' : name == "movel" ? 'L' : n == 2 ? 'C' : 'O';
       for (size_t k = 0; k < n; ++k) {
         const std::string& a = args[k];
+        p.motions.push_back(motion_around(code, static_cast<int>(i + 1), kind, code.find(a, open), a.size()));
         if (a[0] == '[') continue;  // joints: kept
         if (is_pose_literal(a)) {
           NativeTarget t;
@@ -115,6 +118,7 @@ NativeProgram read_urscript_program(const std::string& path) {
           t.end = t.begin + a.size();
           t.pose = parse_pose(a, at);
           t.joint_motion = movej;
+          p.motions.back().target = static_cast<int>(p.targets.size());
           p.targets.push_back(t);
           continue;
         }
@@ -132,8 +136,10 @@ NativeProgram read_urscript_program(const std::string& path) {
         ++motions[a];
         if (used.count(a)) {
           p.targets[used[a]].joint_motion &= movej;
+          p.motions.back().target = static_cast<int>(used[a]);
           continue;
         }
+        p.motions.back().target = static_cast<int>(p.targets.size());
         used[a] = p.targets.size();
         NativeTarget t;
         t.line = v->second.line;

@@ -21,8 +21,9 @@
 
 namespace kincal {
 
-/// The controller's interpolation between two targets.
-enum class PathKind { Joint, NominalLine };
+/// The controller's interpolation between two targets; Unchecked: a segment not followed (an arc, or
+/// a start kincal does not know).
+enum class PathKind { Joint, NominalLine, Unchecked };
 
 /// Points per segment at which the path is followed (interior points s = k / kPathSamples).
 constexpr int kPathSamples = 32;
@@ -44,7 +45,13 @@ struct ToleranceResult {
 };
 
 /// compensate_poses, then segments bisected until each keeps within tolerance_mm (>0). InputError when a
-/// segment still exceeds it after 2^20 subdivisions (a singularity between two targets?).
+/// segment still exceeds it after 2^20 subdivisions (a singularity between two targets?). kinds: per
+/// segment i (from pose i to i + 1), the controller's interpolation; a segment's halves keep its kind.
+ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
+                                          const std::vector<std::string>& where, const ProgramOptions& opt,
+                                          const std::vector<double>& temperature_c, double tolerance_mm,
+                                          const std::vector<PathKind>& kinds);
+/// The same with one kind for every segment.
 ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
                                           const std::vector<std::string>& where, const ProgramOptions& opt,
                                           const std::vector<double>& temperature_c, double tolerance_mm,

@@ -42,6 +42,19 @@ struct NativeTarget {
   std::vector<NativeEdit> joint_edits;
 };
 
+/// One motion statement of a native program, in the order of the file (a circular motion: two, its
+/// via and its end point). --tolerance follows the path from each motion's target to the next.
+struct NativeMotion {
+  int line = 0;         ///< its line in the program's first file (1-based)
+  int target = -1;      ///< its target in NativeProgram::targets; -1: one kincal does not compensate
+  /// 'J' joint interpolation, 'L' a straight line (KRL LIN / SLIN, RAPID MoveL, LS L, URScript movel),
+  /// 'C' an arc, 'O' another motion (RAPID MoveLDO, MoveJSync, ..., URScript movep; not followed)
+  char kind = 'J';
+  /// the statement (without its comment and its indentation) around the target's value: a target
+  /// inserted before it is head + value + tail
+  std::string indent, head, tail;
+};
+
 /// A target the program computes at run time: not compensated.
 struct UnresolvedTarget {
   std::string where;  ///< "file:line"
@@ -54,6 +67,7 @@ struct NativeProgram {
   std::vector<std::vector<std::string>> lines;  ///< every file's lines (without the '\n')
   std::vector<bool> final_newline;              ///< whether each file ends in '\n'
   std::vector<NativeTarget> targets;            ///< in the order the motions first use them
+  std::vector<NativeMotion> motions;            ///< every motion statement, in the order of the file
   std::vector<UnresolvedTarget> unresolved;
 };
 
@@ -61,19 +75,33 @@ struct NativeProgram {
 /// program or a URScript program.
 NativeProgram read_native_program(const std::string& path, ControllerFormat format);
 
+/// A target --tolerance inserts before a straight-line motion: a copy of that motion (indentation,
+/// instruction, speed, zone, tool, ... as written) to an inline filtered target; LS: a new P[n] in /POS.
+struct InsertedTarget {
+  size_t motion = 0;         ///< inserted before NativeProgram::motions[motion]
+  Pose6 pose;                ///< in the program's frame
+  ControllerTarget target;   ///< its branch data
+};
+
 /// The program with target k's value replaced: when joints[k], by the joints t[k].q_deg (KRL E6AXIS /
 /// AXIS, RAPID jointtarget, LS J1..J6, URScript [q1..q6] in rad; external axes kept) with the target's
 /// joint_edits; otherwise by pose[k] (in the program's frame) with the branch data of t[k] (KRL S and T,
-/// RAPID confdata, LS CONFIG). Every other byte unchanged. Files go to out_path (KRL: its .src and .dat).
+/// RAPID confdata, LS CONFIG). Every other byte unchanged but for the inserted targets' lines (an LS
+/// program's /MN lines are then renumbered, and its LINE_COUNT). Files go to out_path (KRL: its .src and .dat).
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
                                              const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
-                                             const std::string& out_path);
+                                             const std::string& out_path,
+                                             const std::vector<InsertedTarget>& inserted = {});
 
 /// Appends the file at path to p: its path, its lines (without the '\n') and whether it ends in '\n'.
 void add_program_file(NativeProgram& p, const std::string& path);
 
 /// The span [begin, end) of group `group` of a match.
 std::pair<size_t, size_t> span_of(const std::smatch& m, int group);
+
+/// A motion of the given kind on a line whose code (the line without its comment) holds its target's
+/// value at [begin, begin + size).
+NativeMotion motion_around(const std::string& code, int line, char kind, size_t begin, size_t size);
 
 /// Splits s at top-level commas (outside brackets, braces, parentheses and strings); trims blanks.
 std::vector<std::string> split_top(const std::string& s);

@@ -101,7 +101,8 @@ NativePath compensate_native_path(const Robot& robot, const NativeProgram& p, co
   return r;
 }
 
-// a KRL or RAPID program with its Cartesian targets filtered, every other byte unchanged
+// a native program (KRL, RAPID, LS, URScript) with its Cartesian targets compensated, as joints or filtered
+// poses, and --tolerance's targets inserted; every other byte unchanged
 ControllerProgramResult compensate_native(const Robot& robot, const std::string& in_path, ControllerFormat in_format,
                                           const std::string& out_path, const ProgramOptions& opt,
                                           const WriterOptions& w, const NativeOptions& n) {

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import kincal
 from kincal import _core
@@ -156,3 +157,70 @@ def test_malformed_programs(tmp_path, model, tool, ext, edit, message):
             "--targets", "filtered")
     assert r.returncode == 1 and message in r.stderr, r.stderr
     assert not any((tmp_path / "out").iterdir())
+
+
+@pytest.mark.parametrize("case,edit,where", [
+    ("krl-copy", ("tape.src", "$VEL.CP = 0.2", "XP2 = XP3\n$VEL.CP = 0.2"), "tape.src:27:"),
+    ("krl-field", ("tape.src", "$VEL.CP = 0.2", "XP2.Z = 650.0\n$VEL.CP = 0.2"), "tape.src:27:"),
+    ("rapid-field", ("tape.mod", "    WaitTime 0.5;", "    paux.trans.z := 650;\n    WaitTime 0.5;"), "tape.mod:18:"),
+])
+def test_targets_assigned_in_the_program_are_run_time(tmp_path, model, case, edit, where):
+    # a target the program assigns (whole or one field) is known at run time only: listed, not compensated
+    # from its declaration (the .src is read before the .dat that declares XP2)
+    name, old, new = edit
+    for f in ("tape.src", "tape.dat", "tape.mod"):
+        text = (DATA / f).read_text()
+        if f == name:
+            assert old in text
+            text = text.replace(old, new, 1)
+        (tmp_path / f).write_text(text)
+    (tmp_path / "out").mkdir()
+    r = run("kincal", "compensate", "--model", str(model), "--program", str(tmp_path / name), "--out",
+            str(tmp_path / "out" / name))
+    assert r.returncode == 1 and "computed at run time" in r.stderr and where in r.stderr, r.stderr
+    assert not any((tmp_path / "out").iterdir())
+
+
+@pytest.mark.parametrize("name", ["tape.src", "tape.mod", "tape.ls", "tape.script"])
+def test_crlf_programs_keep_their_line_ends(tmp_path, model, name):
+    # the same program with CRLF line ends (as controllers and Windows editors write them) comes out as
+    # the LF one does, with CRLF: byte for byte, inserted --tolerance targets included
+    for d, eol in (("lf", b"\n"), ("crlf", b"\r\n")):
+        (tmp_path / d / "out").mkdir(parents=True)
+        for f in DATA.glob(Path(name).stem + ".*"):
+            (tmp_path / d / f.name).write_bytes(f.read_bytes().replace(b"\n", eol))
+        r = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / d / name), "--out",
+                str(tmp_path / d / "out" / name), "--skip-unresolved", "--tolerance", "0.001")
+        assert r.returncode == 0, r.stderr
+    inserted = int(re.search(r"after (\d+) inserted", r.stderr).group(1))
+    assert inserted > 0  # (0.001 mm: the short segments of these programs need targets too)
+    for f in (tmp_path / "lf" / "out").iterdir():
+        lf, crlf = f.read_bytes(), (tmp_path / "crlf" / "out" / f.name).read_bytes()
+        assert b"\r" not in lf and crlf == lf.replace(b"\n", b"\r\n"), f.name
+
+
+def test_program_tool_and_base(tmp_path, model, calibrated):
+    # --program-base B and --program-tool T: a program pose P (in B, of the TCP T) is the model's tool at
+    # B P T^-1 in the robot's base. XP1 (PTP only) is written as joints: the calibrated model's tool there
+    for f in ("tape.src", "tape.dat"):
+        shutil.copy(DATA / f, tmp_path / f)
+    (tmp_path / "out").mkdir()
+    base, tool = [100.0, -50.0, 20.0, 5.0, 0.0, 0.0], [0.0, 0.0, 50.0, 0.0, 0.0, 10.0]
+    r = run("kincal", "compensate", "--model", str(model), "--program", str(tmp_path / "tape.src"), "--out",
+            str(tmp_path / "out" / "tape.src"), "--program-base", ",".join(map(str, base)), "--program-tool",
+            ",".join(map(str, tool)))
+    assert r.returncode == 0, r.stderr
+    m = re.search(r"DECL E6AXIS XP1=\{A1 " + ",A\\d ".join([N] * 6), (tmp_path / "out" / "tape.dat").read_text())
+    assert m
+    q = [float(m.group(k)) for k in range(1, 7)]
+
+    def iso(p):
+        t = np.eye(4)
+        t[:3, :3] = Rotation.from_euler("ZYX", p[3:], degrees=True).as_matrix()
+        t[:3, 3] = p[:3]
+        return t
+
+    want = iso(base) @ iso([2000.0, -740.0, 600.0, 0.0, 90.0, 0.0]) @ np.linalg.inv(iso(tool))
+    got = iso(kincal.fk(calibrated, q)[0])
+    assert np.abs(got[:3, 3] - want[:3, 3]).max() < 1e-3
+    assert np.degrees(Rotation.from_matrix(got[:3, :3].T @ want[:3, :3]).magnitude()) < 1e-4

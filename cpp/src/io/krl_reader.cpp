@@ -105,6 +105,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
         std::tie(d.type_begin, d.type_end) = span_of(m, 1);
         d.has_value = m[4].matched;
         if (d.has_value) std::tie(d.begin, d.end) = span_of(m, 4);
+        d.assigned = decls[upper_case(m[2].str())].assigned;  // (an assignment in the .src, read before its .dat)
         decls[upper_case(m[2].str())] = d;
       } else if (f == 0 && std::regex_search(code, m, assign_re)) {
         const auto it = decls.find(upper_case(m[1].str()));

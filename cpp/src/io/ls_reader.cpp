@@ -96,7 +96,8 @@ NativeProgram read_ls_program(const std::string& path) {
   static const std::regex pos_open(R"(^\s*P\[\s*(\d+)\s*(:[^\]]*)?\]\s*\{\s*$)"), pos_close(R"(^\s*\};\s*$)");
   bool want_circ_end = false;
   for (size_t i = 0; i < lines.size(); ++i) {
-    const std::string& s = lines[i];
+    std::string s = lines[i];
+    if (!s.empty() && s.back() == '\r') s.pop_back();  // a CRLF file
     const int ln = static_cast<int>(i + 1);
     const std::string at = where(path, ln);
     std::smatch m;
@@ -188,6 +189,7 @@ NativeProgram read_ls_program(const std::string& path) {
     t.last_line = lp.last;
     t.begin = 0;
     t.end = lines[static_cast<size_t>(lp.last - 1)].size();
+    if (t.end > 0 && lines[static_cast<size_t>(lp.last - 1)].back() == '\r') --t.end;  // the '\r' stays
     t.pose = lp.pose;
     t.name = "P[" + std::to_string(u.n) + "]";
     for (size_t k = 0; k < p.motions.size(); ++k)

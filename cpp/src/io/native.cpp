@@ -43,7 +43,7 @@ std::string old_value(const NativeProgram& p, const NativeTarget& nt) {
   if (nt.last_line <= nt.line) return f[static_cast<size_t>(nt.line - 1)].substr(nt.begin, nt.end - nt.begin);
   std::string joined;
   for (int l = nt.line; l <= nt.last_line; ++l) joined += f[static_cast<size_t>(l - 1)] + (l < nt.last_line ? "\n" : "");
-  return joined.substr(nt.begin);
+  return joined.substr(nt.begin, joined.size() - f[static_cast<size_t>(nt.last_line - 1)].size() + nt.end - nt.begin);
 }
 
 // The lines of the program's first file with each inserted target's motion before the motion it precedes
@@ -52,6 +52,7 @@ void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTar
                            std::vector<std::string>& lines) {
   if (inserted.empty()) return;
   std::map<int, std::string> before;  // per line: the motions inserted before it
+  const std::string eol = !lines.empty() && !lines[0].empty() && lines[0].back() == '\r' ? "\r\n" : "\n";
   std::string positions;
   int next_p = 0;
   for (const NativeTarget& nt : p.targets)
@@ -74,9 +75,9 @@ void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTar
       value = urscript_pose(ins.pose);
     } else {
       value = "P[" + std::to_string(++next_p) + "]";
-      positions += value + "{\n   GP1:\n" + ls_position(old, ins.pose, ins.target) + "\n};\n";
+      positions += value + "{" + eol + "   GP1:" + eol + ls_position(old, ins.pose, ins.target) + eol + "};" + eol;
     }
-    before[mo.line] += mo.indent + mo.head + value + mo.tail + "\n";
+    before[mo.line] += mo.indent + mo.head + value + mo.tail + eol;
   }
   for (const auto& [line, text] : before) lines[static_cast<size_t>(line - 1)].insert(0, text);
   if (positions.empty()) return;
@@ -191,7 +192,7 @@ std::string code_before(const std::string& line, char comment) {
     if (line[i] == '"') str = !str;
     if (line[i] == comment && !str) return line.substr(0, i);
   }
-  return line;
+  return !line.empty() && line.back() == '\r' ? line.substr(0, line.size() - 1) : line;
 }
 
 int word_count(const std::string& code, const std::string& name, bool ignore_case) {

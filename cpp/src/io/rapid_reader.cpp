@@ -74,6 +74,8 @@ NativeProgram read_rapid_program(const std::string& path) {
     std::string value;
   };
   std::map<std::string, Decl> decls;
+  std::map<std::string, bool> assigned;  // robtargets the module assigns (p := ..., p.trans.z := ...)
+  static const std::regex assign_re(R"(^\s*(\w+)(?:\.\w+|\{[^}]*\})*\s*:=)");
   int module_line = 0;
   bool closed = false;
   for (size_t i = 0; i < lines.size(); ++i) {
@@ -103,6 +105,8 @@ NativeProgram read_rapid_program(const std::string& path) {
         if (d.robtarget) parse_robtarget(d.value, at);  // checked here, where it is declared
       }
       decls[upper_case(m[3].str())] = d;
+    } else if (std::regex_search(code, m, assign_re)) {
+      assigned[upper_case(m[1].str())] = true;
     }
   }
   if (!module_line) throw InputError(path + ": no MODULE in the file");
@@ -164,9 +168,10 @@ NativeProgram read_rapid_program(const std::string& path) {
       const auto it = decls.find(upper_case(arg));
       if (it == decls.end() || !it->second.robtarget)
         throw InputError(at + ": target '" + arg + "' is not declared as a robtarget in the module");
-      if (!it->second.has_value || !std::regex_search(lines[static_cast<size_t>(it->second.line - 1)],
-                                                        std::regex(R"(\bCONST\b|\bPERS\b)", std::regex::icase))) {
-        p.unresolved.push_back({at, code});  // a VAR, or no value: set at run time
+      if (!it->second.has_value || assigned[upper_case(arg)] ||
+          !std::regex_search(lines[static_cast<size_t>(it->second.line - 1)],
+                             std::regex(R"(\bCONST\b|\bPERS\b)", std::regex::icase))) {
+        p.unresolved.push_back({at, code});  // a VAR, no value, or assigned in the module: set at run time
         continue;
       }
       ++motions[upper_case(arg)];

@@ -110,7 +110,7 @@ std::vector<std::string> split_top(const std::string& s);
 std::string upper_case(std::string s);
 
 /// The line without its comment: everything from the first `comment` character outside a
-/// "string" on (KRL ';', RAPID '!', URScript '#').
+/// "string" on (KRL ';', RAPID '!', URScript '#'), and without the '\r' of a CRLF line.
 std::string code_before(const std::string& line, char comment);
 
 /// How often name stands in code as a whole word (letters, digits and '_' on neither side);

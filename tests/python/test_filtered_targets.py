@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import kincal
 from kincal import _core
@@ -122,8 +123,11 @@ def test_branch_data_selects_the_compensated_joints(which, calibrated, urdf_cali
             sel = _core.select_branch(robot, fmt, data)
             assert not isinstance(sel, str), (fmt, q[i], sel)
             assert np.abs(sel - q[i]).max() < 1e-6, (fmt, q[i], sel)
-        reached = kincal.fk(robot, sel)[0]
-        assert np.linalg.norm(reached[:3] - desired[i, :3]) < 1e-6
+            reached = kincal.fk(robot, sel)[0]  # the real robot at the joints the controller takes
+            assert np.linalg.norm(reached[:3] - desired[i, :3]) < 1e-6, fmt
+            dr = Rotation.from_euler("ZYX", reached[3:], degrees=True).inv() * \
+                Rotation.from_euler("ZYX", desired[i, 3:], degrees=True)
+            assert np.degrees(dr.magnitude()) < 1e-6, fmt
     # both sides of the arm's boundaries are in the sample
     assert behind > 10 and elbow_down > 10 and behind < len(q) - 10
 
@@ -145,6 +149,27 @@ def test_kuka_status_and_turn_by_hand_on_kr500(kr500):
     home = _core.branch_data(kr500, np.array([0, -90, 90, 0, 90, 0.0]))
     assert (home["kuka_s"], home["kuka_t"]) == (2, 2)  # 'B010', 'B000010': KUKA's usual home
     assert home["abb_conf"] == [0, 0, 0, 0]
+
+
+def test_abb_confdata_and_fanuc_configuration_by_hand_on_kr500(kr500):
+    """ABB confdata and the FANUC configuration string of kr500 from their definitions (README), with
+    the arm's classification computed here from kr500's published dimensions as in the KUKA test:
+    behind = the wrist centre's x in the A1 system < 0, elbow up = A3 >= phi, wrist flipped = A5 < 0;
+    cf1, cf4, cf6 = floor(q / 90) of axes 1, 4, 6, cfx = 4 behind + 2 elbow down + 1 A5 < 0; FANUC
+    'F' when J5 > 0 else 'N', 'U'/'D', 'B' behind else 'T', then floor((q + 180) / 360) of J1, J4, J6."""
+    rng = np.random.default_rng(6)
+    lim = np.asarray(kr500.limits_deg)
+    phi = math.degrees(math.atan2(55, 1025))
+    for q in rng.uniform(lim[:, 0], lim[:, 1], (500, 6)):
+        a2, a23 = math.radians(q[1]), math.radians(q[1] + q[2])
+        behind = 500 + 1300 * math.cos(a2) + 1025 * math.cos(a23) + 55 * math.sin(a23) < 0
+        up = q[2] >= phi
+        q5 = (q[4] + 180) % 360 - 180
+        cf = [math.floor(q[0] / 90), math.floor(q[3] / 90), math.floor(q[5] / 90), 4 * behind + 2 * (not up) + (q5 < 0)]
+        turns = ", ".join(str(math.floor((q[j] + 180) / 360)) for j in (0, 3, 5))
+        fanuc = f"{'F' if q5 > 0 else 'N'} {'U' if up else 'D'} {'B' if behind else 'T'}, {turns}"
+        d = _core.branch_data(kr500, q)
+        assert d["abb_conf"] == cf and d["fanuc_config"] == fanuc, q
 
 
 def test_fanuc_like_home_is_nut(urdf_calibrated):
@@ -207,3 +232,28 @@ def test_written_filtered_program_brings_back_the_joints(tmp_path, calibrated, e
         assert np.abs(sel - qi).max() < (2e-3 if fmt == "fanuc-ls" else 1e-4)
         reached = kincal.fk(calibrated, sel)[0]
         assert np.linalg.norm(reached[:3] - p[:3]) < (5e-3 if fmt == "fanuc-ls" else 5e-4)
+
+
+def test_written_filtered_urscript_brings_back_the_joints(tmp_path, calibrated):
+    # a UR controller takes no branch data: from the robot's joints it moves to the inverse kinematics
+    # solution nearest them. Emulated here: the p[...] poses read back by regular expressions (m and
+    # rotation vector), each solved by the nominal closed-form IK nearest the previous joints (the robot
+    # starting at the first compensated joints): the compensated joints again, and the real robot there
+    # on the desired pose (printed: 1e-8 m, 1e-10 rad)
+    poses = kincal.line_program(count=30)
+    (tmp_path / "line.csv").write_text("x,y,z,a,b,c\n" + "".join(",".join(f"{v:.10f}" for v in p) + "\n" for p in poses))
+    (tmp_path / "m.json").write_text(calibrated.to_json())
+    out = tmp_path / "prog.script"
+    r = run("kincal-compensate", "--model", str(tmp_path / "m.json"), "--program", str(tmp_path / "line.csv"), "--out",
+            str(out), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    q = kincal.compensate(calibrated, poses)["q_deg"]
+    written = [[float(x) for x in m.group(1).split(",")] for m in re.finditer(r"p\[([^\]]*)\]", out.read_text())]
+    assert len(written) == len(q)
+    ref = q[0]
+    for qi, w, p in zip(q, written, poses):
+        pose = [*(1000 * np.array(w[:3])), *Rotation.from_rotvec(w[3:]).as_euler("ZYX", degrees=True)]
+        sols = [np.asarray(s["q_deg"]) for s in _core.ik_all(calibrated, pose, ref) if s["within_limits"]]
+        ref = min(sols, key=lambda s: np.abs(s - ref).max())
+        assert np.abs(ref - qi).max() < 1e-4
+        assert np.linalg.norm(kincal.fk(calibrated, ref)[0][:3] - p[:3]) < 5e-4

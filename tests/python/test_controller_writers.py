@@ -137,6 +137,17 @@ def test_long_programs_are_split_into_parts(line):
         assert np.abs(reader(out) - q).max() <= tol * 1.0001
 
 
+@pytest.mark.parametrize("out,name", [("r.mod", "r" * 32), ("f.ls", "F" * 36), ("u.script", "u" * 64)])
+def test_names_at_the_limit_are_taken(line, out, name):
+    d, _ = line
+    path = d / "limit" / out
+    path.parent.mkdir(exist_ok=True)
+    r = run("kincal-compensate", "--model", str(d / "model.json"), "--program", str(d / "line.csv"), "--out", str(path),
+            "--name", name)
+    assert r.returncode == 0, r.stderr
+    assert name in path.read_text()
+
+
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
 @pytest.mark.parametrize("out,extra,cause", [
     ("a_name_far_too_long_for_krl.src", [], "longer than the 24 characters"),
@@ -144,6 +155,11 @@ def test_long_programs_are_split_into_parts(line):
     ("prog.src", ["--name", "other"], "a KRL module is named by its files"),
     ("zone.ls", ["--zone", "150"], "CNT value 0..100"),
     ("speed.script", ["--speed", "120"], "percentage in (0, 100]"),
+    ("r.mod", ["--name", "r" * 33], "longer than the 32 characters"),
+    ("f.ls", ["--name", "F" * 37], "longer than the 36 characters"),
+    ("u.script", ["--name", "u" * 65], "longer than the 64 characters"),
+    ("u.script", ["--name", "tape-1"], "only letters, digits and '_'"),
+    ("r.mod", ["--name", "tape 1"], "only letters, digits and '_'"),
 ])
 def test_bad_names_and_options(line, tool, out, extra, cause):
     d, _ = line

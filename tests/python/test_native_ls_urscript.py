@@ -131,6 +131,6 @@ def test_malformed_programs(tmp_path, model, name, edit, where, cause, tool):
     args = ["compensate"] if tool == "kincal" else []
     r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / name), "--out", str(out), "--targets",
             "filtered", "--skip-unresolved")
-    assert r.returncode != 0
+    assert r.returncode == 1, r.stderr
     assert where + ":" in r.stderr and cause in r.stderr, r.stderr
     assert not out.exists()

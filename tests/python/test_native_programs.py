@@ -163,9 +163,15 @@ def test_malformed_programs(tmp_path, model, tool, ext, edit, message):
     ("krl-copy", ("tape.src", "$VEL.CP = 0.2", "XP2 = XP3\n$VEL.CP = 0.2"), "tape.src:27:"),
     ("krl-field", ("tape.src", "$VEL.CP = 0.2", "XP2.Z = 650.0\n$VEL.CP = 0.2"), "tape.src:27:"),
     ("rapid-field", ("tape.mod", "    WaitTime 0.5;", "    paux.trans.z := 650;\n    WaitTime 0.5;"), "tape.mod:18:"),
+    ("krl-rel", ("tape.src", "WAIT SEC 0.5", "LIN_REL {Z 10.0}\nWAIT SEC 0.5"), "tape.src:29:"),
+    ("krl-operator", ("tape.src", "WAIT SEC 0.5", "LIN XP3:{X 0.0,Y 0.0,Z 10.0,A 0.0,B 0.0,C 0.0}\nWAIT SEC 0.5"),
+     "tape.src:29:"),
+    ("rapid-crobt", ("tape.mod", "    WaitTime 0.5;", "    MoveL CRobT(\\Tool:=thead),v100,fine,thead;\n    WaitTime 0.5;"),
+     "tape.mod:19:"),
 ])
-def test_targets_assigned_in_the_program_are_run_time(tmp_path, model, case, edit, where):
-    # a target the program assigns (whole or one field) is known at run time only: listed, not compensated
+def test_targets_assigned_or_computed_in_the_program_are_run_time(tmp_path, model, case, edit, where):
+    # a target the program assigns (whole or one field) or computes (_REL, A:B, CRobT) is known at run time
+    # only: listed, not compensated
     # from its declaration (the .src is read before the .dat that declares XP2)
     name, old, new = edit
     for f in ("tape.src", "tape.dat", "tape.mod"):

@@ -8,6 +8,8 @@ into parts, bad options (a clear error, exit 1, no file)."""
 
 from __future__ import annotations
 
+import io
+import math
 import re
 from pathlib import Path
 
@@ -169,3 +171,54 @@ def test_bad_names_and_options(line, tool, out, extra, cause):
     r = run(tool, *args, "--model", str(d / "model.json"), "--program", str(d / "line.csv"), "--out", str(path), *extra)
     assert r.returncode == 1 and cause in r.stderr, r.stderr
     assert not any(path.parent.iterdir())  # no file, not even half of a KRL pair
+
+
+def test_krl_and_urscript_speed_zone_and_defaults(line):
+    # KRL: BAS(#VEL_PTP, %), $APO.CDIS and C_DIS on every motion but the last; URScript: v in rad/s
+    # (percent of 180 deg/s), r the blend radius in m, 0 on the last motion. Defaults: 20 %, exact stop
+    d, _ = line
+    base = ["kincal-compensate", "--model", str(d / "model.json"), "--program", str(d / "line.csv")]
+    assert run(*base, "--out", str(d / "sz.src"), "--speed", "35", "--zone", "5").returncode == 0
+    src = (d / "sz.src").read_text()
+    assert "BAS(#VEL_PTP,35.0)" in src and "$APO.CDIS=5.000" in src
+    ptp = re.findall(r"^PTP XP\d+( C_DIS)?$", src, re.M)
+    assert len(ptp) == 40 and all(ptp[:-1]) and not ptp[-1]
+    assert run(*base, "--out", str(d / "dflt.src")).returncode == 0
+    src = (d / "dflt.src").read_text()
+    assert "BAS(#VEL_PTP,20.0)" in src and "C_DIS" not in src and "$APO.CDIS" not in src
+    assert run(*base, "--out", str(d / "sz.script"), "--speed", "50", "--zone", "5").returncode == 0
+    moves = re.findall(r"movej\(\[[^\]]*\], a=1\.4, v=([\d.]+), r=([\d.]+)\)", (d / "sz.script").read_text())
+    assert len(moves) == 40 and all(float(v) == pytest.approx(0.5 * math.pi, abs=1e-4) for v, _ in moves)
+    assert all(r == "0.0050" for _, r in moves[:-1]) and moves[-1][1] == "0.0000"
+    assert run(*base, "--out", str(d / "dflt.script")).returncode == 0
+    moves = re.findall(r"v=([\d.]+), r=([\d.]+)\)", (d / "dflt.script").read_text())
+    assert all(float(v) == pytest.approx(0.2 * math.pi, abs=1e-4) and r == "0.0000" for v, r in moves)
+
+
+@pytest.mark.parametrize("fmt", ["csv", "gcode"])
+def test_format_csv_and_gcode_by_option(line, fmt):
+    d, q = line
+    out = d / f"by_option.{fmt}.txt"
+    r = run("kincal", "compensate", "--model", str(d / "model.json"), "--program", str(d / "line.csv"), "--out", str(out),
+            "--format", fmt)
+    assert r.returncode == 0, r.stderr
+    text = out.read_text()
+    if fmt == "csv":
+        got = np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1)[:, :6]
+    else:
+        got = np.array([[float(v) for v in re.findall(r"A\d=(-?\d+\.\d+)", l)] for l in text.splitlines() if "A1=" in l])
+    assert got.shape == q.shape and np.abs(got - q).max() < 1e-6
+
+
+def test_default_split_at_2000_targets(tmp_path, calibrated):
+    # 2,001 targets: KRL and LS programs become two parts a main program calls (the controllers' limit)
+    rng = np.random.default_rng(4)
+    poses = kincal.line_program(count=2001, step_mm=0.5)
+    poses[:, 2] += rng.uniform(0, 1, len(poses))
+    (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n" + "".join(",".join(f"{v:.6f}" for v in p) + "\n" for p in poses))
+    (tmp_path / "m.json").write_text(calibrated.to_json())
+    for ext, stem in ((".src", "big"), (".ls", "BIG")):
+        r = run("kincal-compensate", "--model", str(tmp_path / "m.json"), "--program", str(tmp_path / "p.csv"), "--out",
+                str(tmp_path / f"big{ext}"))
+        assert r.returncode == 0, r.stderr
+        assert sorted(p.name for p in tmp_path.glob(f"*_[0-9]{ext}")) == [f"{stem}_1{ext}", f"{stem}_2{ext}"]

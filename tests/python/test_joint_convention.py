@@ -183,3 +183,25 @@ def test_kincal_compensate_takes_the_convention_for_a_builtin_robot(tmp_path):
             str(tmp_path / "p.csv"), "--out", str(tmp_path / "x.csv"))
     assert r.returncode != 0 and "m.json" in r.stderr and "joint_convention" in r.stderr
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_native_ls_joint_target_carries_the_controller_j3(tmp_path):
+    # an existing LS program on the FANUC URDF model with the convention: its J-only position is written
+    # in joint form, in the controller's numbers (J3 = q3 - q2, by hand)
+    cal = kincal.load_robot(URDF).with_calibrated(13, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
+    model = json.loads(cal.to_json())
+    model["joint_convention"] = "fanuc"
+    (tmp_path / "m.json").write_text(json.dumps(model))
+    q_model = np.array([8.0, 15.0, -15.0, 12.0, -45.0, 20.0])
+    p = kincal.fk(kincal.load_robot(tmp_path / "m.json"), q_model[None, :])[0]
+    (tmp_path / "J.ls").write_text(
+        "/PROG  J\n/MN\n   1:  J P[1] 20% FINE    ;\n/POS\nP[1]{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
+        f"\tX = {p[0]:.4f}  mm,\tY = {p[1]:.4f}  mm,\tZ = {p[2]:.4f}  mm,\n"
+        f"\tW = {p[5]:.4f} deg,\tP = {p[4]:.4f} deg,\tR = {p[3]:.4f} deg\n}};\n/END\n")
+    r = run("kincal-compensate", "--model", str(tmp_path / "m.json"), "--program", str(tmp_path / "J.ls"), "--out",
+            str(tmp_path / "out.ls"))
+    assert r.returncode == 0, r.stderr
+    j = [float(x) for x in re.findall(r"J\d=\s*(-?\d+\.\d+) deg", (tmp_path / "out.ls").read_text())]
+    hand = q_model.copy()
+    hand[2] = q_model[2] - q_model[1]
+    assert len(j) == 6 and np.abs(np.array(j) - hand).max() < 2e-3  # the pose printed to 1e-4 mm / deg

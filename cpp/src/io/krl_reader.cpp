@@ -119,7 +119,6 @@ NativeProgram read_krl_program(const std::string& src_path) {
   }
   // the motions, in order
   std::map<std::string, size_t> used;
-  std::map<std::string, int> motions;  // per declared target, the motions to it
   for (size_t i = 0; i < p.lines[0].size(); ++i) {
     const std::string code = code_of(p.lines[0][i]);
     std::smatch m;
@@ -167,7 +166,6 @@ NativeProgram read_krl_program(const std::string& src_path) {
         p.unresolved.push_back({at, code});
         continue;
       }
-      ++motions[key];
       if (used.count(key)) {
         p.targets[used[key]].joint_motion &= ptp;
         p.motions.back().target = static_cast<int>(used[key]);
@@ -188,14 +186,7 @@ NativeProgram read_krl_program(const std::string& src_path) {
       p.targets.push_back(t);
     }
   }
-  // a declared target named anywhere but in its declaration and its motions stays Cartesian
-  for (NativeTarget& t : p.targets) {
-    if (t.name.empty() || !t.joint_motion) continue;
-    int named = 0;
-    for (const auto& file : p.lines)
-      for (const std::string& l : file) named += word_count(code_of(l), t.name);
-    t.joint_motion = named == motions[upper_case(t.name)] + 1;
-  }
+  keep_named_targets_cartesian(p, ';', true);
   return p;
 }
 

@@ -250,4 +250,17 @@ NativeMotion motion_around(const std::string& code, int line, char kind, size_t 
   return m;
 }
 
+void keep_named_targets_cartesian(NativeProgram& p, char comment, bool ignore_case) {
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    NativeTarget& t = p.targets[k];
+    if (t.name.empty() || !t.joint_motion) continue;
+    int named = 0;
+    for (const auto& file : p.lines)
+      for (const std::string& l : file) named += word_count(code_before(l, comment), t.name, ignore_case);
+    const auto motions = std::count_if(p.motions.begin(), p.motions.end(),
+                                       [&](const NativeMotion& m) { return m.target == static_cast<int>(k); });
+    t.joint_motion = named == motions + 1;  // its declaration (or assignment) and its motions only
+  }
+}
+
 }  // namespace kincal

@@ -112,7 +112,6 @@ NativeProgram read_rapid_program(const std::string& path) {
   if (!module_line) throw InputError(path + ": no MODULE in the file");
   if (!closed) throw InputError(where(path, module_line) + ": MODULE is not closed by ENDMODULE (end of file)");
   std::map<std::string, size_t> used;
-  std::map<std::string, int> motions;  // per declared target, the motions to it
   for (size_t i = 0; i < lines.size(); ++i) {
     const std::string code = code_of(lines[i]);
     std::smatch m;
@@ -174,7 +173,6 @@ NativeProgram read_rapid_program(const std::string& path) {
         p.unresolved.push_back({at, code});  // a VAR, no value, or assigned in the module: set at run time
         continue;
       }
-      ++motions[upper_case(arg)];
       if (used.count(upper_case(arg))) {
         NativeTarget& t = p.targets[used[upper_case(arg)]];
         t.joint_motion &= movej;
@@ -198,13 +196,7 @@ NativeProgram read_rapid_program(const std::string& path) {
       p.targets.push_back(t);
     }
   }
-  // a declared target named anywhere but in its declaration and its motions stays Cartesian
-  for (NativeTarget& t : p.targets) {
-    if (t.name.empty() || !t.joint_motion) continue;
-    int named = 0;
-    for (const std::string& l : lines) named += word_count(code_of(l), t.name);
-    t.joint_motion = named == motions[upper_case(t.name)] + 1;
-  }
+  keep_named_targets_cartesian(p, '!', true);
   return p;
 }
 

@@ -94,7 +94,6 @@ NativeProgram read_urscript_program(const std::string& path) {
     throw InputError(where(path, blocks.back().second) + ": '" + blocks.back().first + "' is not closed by 'end' (end of file)");
   static const std::regex move(R"(\b(movej|movel|movep|movec)\s*\()");
   std::map<std::string, size_t> used;
-  std::map<std::string, int> motions;  // per variable, the motions to it
   for (size_t i = 0; i < lines.size(); ++i) {
     const std::string code = code_of(lines[i]);
     const std::string at = where(path, static_cast<int>(i + 1));
@@ -133,7 +132,6 @@ NativeProgram read_urscript_program(const std::string& path) {
           p.unresolved.push_back({at, code.substr(code.find_first_not_of(" \t"))});
           continue;
         }
-        ++motions[a];
         if (used.count(a)) {
           p.targets[used[a]].joint_motion &= movej;
           p.motions.back().target = static_cast<int>(used[a]);
@@ -153,13 +151,7 @@ NativeProgram read_urscript_program(const std::string& path) {
       }
     }
   }
-  // a variable named anywhere but in its assignment and its motions stays a pose
-  for (NativeTarget& t : p.targets) {
-    if (t.name.empty() || !t.joint_motion) continue;
-    int named = 0;
-    for (const std::string& l : lines) named += word_count(code_of(l), t.name, false);
-    t.joint_motion = named == motions[t.name] + 1;
-  }
+  keep_named_targets_cartesian(p, '#', false);
   return p;
 }
 

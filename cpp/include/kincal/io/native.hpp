@@ -99,6 +99,11 @@ void add_program_file(NativeProgram& p, const std::string& path);
 /// The span [begin, end) of group `group` of a match.
 std::pair<size_t, size_t> span_of(const std::smatch& m, int group);
 
+/// A declared target (or URScript variable) named anywhere but in its declaration and its motions
+/// (code before the comment character; names compared case-insensitively when asked) is not written as
+/// joints: joint_motion false.
+void keep_named_targets_cartesian(NativeProgram& p, char comment, bool ignore_case);
+
 /// A motion of the given kind on a line whose code (the line without its comment) holds its target's
 /// value at [begin, begin + size).
 NativeMotion motion_around(const std::string& code, int line, char kind, size_t begin, size_t size);

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import _core, datasets
+from kincal import _core, datasets, grouping
 from kincal import identify as ident
 
 from conftest import SHARED, run
@@ -153,6 +153,63 @@ def test_ur10_series_b_default_loss_not_worse_than_none():
     none = ident.identify(robot, data, loss="none").validation
     assert default["scheme"].startswith("5-fold, whole configurations")
     assert default["after_rms_mm"] <= 1.0005 * none["after_rms_mm"], (default["after_rms_mm"], none["after_rms_mm"])
+
+
+SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",
+          "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
+
+
+def _few_configurations_ratio(robot, data: dict, seed: int) -> float:
+    """Held-out RMS with the default priors over the one without, both fitted on 15 configurations
+    (whole configurations, drawn at random with ``seed``) and predicting every other row; 0 when the
+    fit without priors refuses the poses (too few or too similar) and the one with them does not."""
+    cfg = grouping.configurations(data)
+    fit = np.isin(cfg.codes, np.random.default_rng(seed).choice(cfg.count, 15, replace=False))
+    train, test = ident.subset(data, fit), ident.subset(data, ~fit)
+    with_priors = _rms(ident.identify(robot, train, k_folds=0), test)
+    try:
+        return with_priors / _rms(ident.identify(robot, train, k_folds=0, prior_sd={}), test)
+    except _core.InputError as e:
+        assert "too few or too similar poses" in str(e)
+        return 0.0
+
+
+@pytest.mark.skipif(not IPA.is_dir(), reason="needs ../shared/data/ipa-robot-accuracy")
+def test_priors_better_with_15_configurations_on_the_ur10():
+    """Few poses on a real robot: UR10 series A-D of ../shared/data/ipa-robot-accuracy (real
+    laser-tracker data, one placement per series). Per series and seed (1-5), 15 whole configurations
+    drawn at random; each model predicts every other row of its series. The default priors (nominal,
+    1 mm / 0.1 deg) against none, median ratio of held-out RMS over the 5 seeds (the issue asks at
+    most 0.85): A 0.735, B 0.815, C 0.817, D 0.644; pooled 0.795. A ratio of 0 is a draw the fit
+    without priors refuses (one of D's); on one of A's it predicts at 28 mm: a 15-pose fit without
+    priors turns the robot's unmodelled 0.4 mm into geometry. On simulated campaigns whose only error
+    is Gaussian noise (kr500, 15 configurations, one target, 0.05 or 0.2 mm) the gain is 3-5%: the
+    data then determine the geometry far better than a 1 mm prior does, so the item is shown here."""
+    robot = kincal.load_robot("ur10")
+    ratios = {s: [_few_configurations_ratio(robot, datasets.read_ipa(IPA / f), seed) for seed in range(1, 6)]
+              for s, f in SERIES.items()}
+    for s in SERIES:
+        assert np.median(ratios[s]) <= 0.85, (s, ratios)
+
+
+@pytest.mark.skipif(not IPA.is_dir(), reason="needs ../shared/data/ipa-robot-accuracy")
+def test_rank_deficient_fit_keeps_stderr_clean(tmp_path):
+    """15 rows of UR10 series B (real data, rows drawn with seed 3) fitted without priors: the free
+    parameters' covariance is near rank deficient, so no parameter gets a standard deviation, and
+    nothing but kincal's own words reaches stderr (Ceres used to log "Covariance matrix is near rank
+    deficient" there, with a glog preamble)."""
+    d = datasets.read_ipa(IPA / SERIES["B"])
+    rows = np.sort(np.random.default_rng(3).permutation(len(d["xyz"]))[:15])
+    data = tmp_path / "b15.csv"
+    data.write_text("pose,q1,q2,q3,q4,q5,q6,x,y,z\n" + "".join(
+        ",".join(f"{v:.12g}" for v in [k, *d["q_deg"][i], *d["xyz"][i]]) + "\n" for k, i in enumerate(rows)))
+    out = tmp_path / "model.json"
+    r = run("kincal", "identify", "--robot", "ur10", "--data", str(data), "--out", str(out), "--prior-sd", "none",
+            "--folds", "0")
+    assert r.returncode == 0, r.stderr
+    assert "Covariance" not in r.stderr and "InitGoogleLogging" not in r.stderr, r.stderr
+    params = json.loads(out.read_text())["identification"]["parameters"]
+    assert sum(not p["fixed"] for p in params) > 20 and all(p["stddev"] is None for p in params)
 
 
 def test_cli_prior_options(tmp_path):

@@ -353,26 +353,26 @@ void store_solution(PointModel& pm, const Model& nominal, const MeasurementSet& 
 }
 
 /// Standard deviations of the free parameters (the others NaN) and their correlations above
-/// opt.correlation_threshold, from the Ceres covariance scaled by the residual variance.
+/// opt.correlation_threshold: (J^T J)^-1 from the SVD of the loss-weighted Jacobian (as Ceres's DENSE_SVD
+/// covariance, left NaN when near rank deficient, without its error line on stderr) times the noise.
 void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summary& summary,
                 const std::vector<int>& free_idx, const IdentifyOptions& opt, IdentifyResult& res) {
   res.stddev.assign(res.layout.size, std::nan(""));
   if (!opt.covariance) return;
-  ceres::Covariance::Options co;
-  co.algorithm_type = ceres::DENSE_SVD;  // the held parameters are out of the block: full rank
-  co.null_space_rank = 0;
-  co.min_reciprocal_condition_number = 1e-14;
-  ceres::Covariance cov(co);
-  std::vector<std::pair<const double*, const double*>> blocks = {{all.z(), all.z()}};
-  if (!cov.Compute(blocks, &problem)) return;
-  const int F = static_cast<int>(free_idx.size());
-  const int nres = all.row_size() * static_cast<int>(all.rows());
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(F, F);
-  cov.GetCovarianceBlock(all.z(), all.z(), C.data());
-  const double dofres = std::max(1, nres - F);
+  ceres::Problem::EvaluateOptions eo;  // the free parameters only
+  eo.parameter_blocks = {all.z()};
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(eo, nullptr, nullptr, nullptr, &crs)) return;
+  const int F = static_cast<int>(free_idx.size()), nres = all.row_size() * static_cast<int>(all.rows());
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+  const Eigen::VectorXd& sv = svd.singularValues();  // reciprocal condition at least 1e-14
+  if (sv.size() < F || !(sv(F - 1) * sv(F - 1) >= 1e-14 * sv(0) * sv(0))) return;
+  Eigen::MatrixXd C = svd.matrixV() * sv.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
   // with priors the cost weighs them by the estimated noise: the posterior covariance is noise^2 (J^T J)^-1
-  const double s2 = res.noise_mm > 0 ? res.noise_mm * res.noise_mm : 2.0 * summary.final_cost / dofres;
-  C *= s2;
+  C *= res.noise_mm > 0 ? res.noise_mm * res.noise_mm : 2.0 * summary.final_cost / std::max(1, nres - F);
   for (int a = 0; a < F; ++a) res.stddev[free_idx[a]] = std::sqrt(std::max(0.0, C(a, a)));
   for (int a = 0; a < F; ++a)
     for (int b = a + 1; b < F; ++b) {

@@ -135,8 +135,8 @@ void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
       h[j] = g.cross(z[j]);
     }
     dtau->resize(n, n);
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) (*dtau)(j, i) = i <= j ? u[j].dot(h[i]) : u[i].dot(h[j]);
+    for (int i = 0; i < n; ++i)  // column by column (column-major)
+      for (int j = 0; j < n; ++j) (*dtau)(j, i) = i <= j ? u[j].dot(h[i]) : u[i].dot(h[j]);
   }
 }
 
@@ -147,13 +147,14 @@ VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd) {
     return q;
   }
   VecQ tau;
-  MatQ dtau;
-  gravity_torque(m, q, tau, dqd ? &dtau : nullptr);
+  gravity_torque(m, q, tau, dqd);  // dqd holds d tau/dq
   VecQ out = q;
   for (int j = 0; j < n; ++j) out[j] += m.compliance(j) * tau[j];
-  if (dqd) {  // d(q + K tau)/dq = I + K dtau/dq
-    *dqd = MatQ::Identity(n, n);
-    for (int j = 0; j < n; ++j) dqd->row(j) += m.compliance(j) * dtau.row(j);
+  if (dqd) {  // d(q + K tau)/dq = I + K dtau/dq, in place, column by column
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) (*dqd)(j, i) *= m.compliance(j);
+      (*dqd)(i, i) += 1.0;
+    }
   }
   return out;
 }

@@ -49,17 +49,21 @@ def main() -> None:
     p.add_argument("--fit", default="B", choices=sorted(SERIES))
     p.add_argument("--out", default="ur10-diagnosis", help="the diagnosis's folder")
     p.add_argument("--joint", action="store_true", help="also identify all four series jointly (one setup each)")
+    p.add_argument("--effects", default="joint_compliance",
+                   help="the model the diagnosis starts from besides the geometry ('' : geometry alone)")
     args = p.parse_args()
     robot = kincal.load_robot("ur10")
     series = {k: datasets.read_ipa(Path(args.data) / v) for k, v in SERIES.items()}
 
     diag, model = diagnose.run(robot, series[args.fit], args.out, title=f"kincal diagnose: UR10 series {args.fit}",
-                               effects="joint_compliance", progress=print)
+                               effects=args.effects or (), progress=print)
     print(diagnose.summary(diag, model, args.out, 0.0))
     for k in sorted(SERIES):
         if k != args.fit:
             print(f"\nseries {k}, the model of series {args.fit} with only the placement and probe refitted:")
-            print(setups.validation_summary(ident.validate(model.robot, series[k])))
+            v = ident.validate(model.robot, series[k])
+            print(setups.validation_summary(v) + f"\n(per axis, the RMS of every x, y and z residual: "
+                                                  f"{v['rms_mm'] / np.sqrt(3):.3f} mm)")
 
     if args.joint:
         every = with_setups(series)

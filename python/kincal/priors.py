@@ -171,7 +171,8 @@ def summary_lines(fit: "_core.IdentifyResult", info: dict, worst: Sequence) -> l
     loss = info["loss"]
     if loss["scale_mm"]:
         how = ("set by --loss-scale" if loss["scale_from"] == "--loss-scale" else
-               f"2.80 x the residuals' robust spread {loss['noise_mm']:.4f} mm per coordinate")
+               f"{loss['scale_mm'] / loss['noise_mm']:.2f} x the residuals' robust spread {loss['noise_mm']:.4f} mm "
+               "per coordinate")
         lines.append(f"robust loss: {loss['name']} bending at {loss['scale_mm']:.4f} mm ({how})")
         if worst:
             lines.append("  most down-weighted points (pose, target, residual, weight): " +

@@ -120,7 +120,9 @@ def test_data_scaled_loss_on_clean_and_gross_errors(kr500):
     measured with the same noise (the held-out RMS a validation reports). Clean data: the default
     (Huber, scale from the data) within 1% of --loss none. With 3% gross errors of 3-6 mm: the
     default within 5% of its clean result, --loss none worse by more than 50%. The scale found is
-    2.80 x the estimated noise, which is within 10% of the true 0.02 mm."""
+    4.03 x the estimated noise (the 99.9% point of a 3-D Gaussian norm), which is within 10% of the
+    true 0.02 mm. Measured held-out RMS (seeds 1-3): clean 0.0350, 0.0346, 0.0350 mm with either loss;
+    with the gross errors the default 0.0350, 0.0348, 0.0352 and --loss none 0.137, 0.109, 0.109."""
     rng = np.random.default_rng(5)
     for s in range(1, 4):
         truth = ident.default_truth(kr500, seed=s)
@@ -134,7 +136,7 @@ def test_data_scaled_loss_on_clean_and_gross_errors(kr500):
         assert e["dirty", "huber"] < 1.05 * e["clean", "huber"], e
         assert e["dirty", "none"] > 1.5 * e["clean", "none"], e
         r = fits["clean", "huber"].fit
-        assert abs(r.noise_mm / 0.02 - 1) < 0.1 and r.loss_scale_mm == pytest.approx(np.sqrt(7.815) * r.noise_mm)
+        assert abs(r.noise_mm / 0.02 - 1) < 0.1 and r.loss_scale_mm == pytest.approx(np.sqrt(16.266) * r.noise_mm)
         # the summary names the scale and the rows it down-weighted most: the gross errors
         worst = fits["dirty", "huber"].worst
         assert worst and all(err > 2.5 for _, _, err, _ in worst[:3])
@@ -144,15 +146,15 @@ def test_data_scaled_loss_on_clean_and_gross_errors(kr500):
 @pytest.mark.skipif(not IPA.is_dir(), reason="needs ../shared/data/ipa-robot-accuracy")
 def test_ur10_series_b_default_loss_not_worse_than_none():
     """UR10 series B (1495 real points), grouped 5-fold cross-validation (whole configurations per
-    fold): the default loss (Huber at the data's scale) against --loss none. Measured 0.413240 against
-    0.413195 mm RMS: 0.011% worse, so the issue's "not worse" is NOT met strictly; the test holds
-    the difference under 0.05% (Huber at the old fixed 0.1 mm: 0.4148, 0.4% worse)."""
+    fold): the default loss (Huber at the data's scale) against --loss none. Measured 0.413181 against
+    0.413195 mm RMS (bending at the 95% point instead, 2.80 x the noise: 0.413240, 0.011% worse;
+    Huber at the old fixed 0.1 mm: 0.4148, 0.4% worse)."""
     robot = kincal.load_robot("ur10")
     data = datasets.read_ipa(IPA / "Series_B/measurements_joint_configurations.csv")
     default = ident.identify(robot, data).validation
     none = ident.identify(robot, data, loss="none").validation
     assert default["scheme"].startswith("5-fold, whole configurations")
-    assert default["after_rms_mm"] <= 1.0005 * none["after_rms_mm"], (default["after_rms_mm"], none["after_rms_mm"])
+    assert default["after_rms_mm"] <= none["after_rms_mm"], (default["after_rms_mm"], none["after_rms_mm"])
 
 
 SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",

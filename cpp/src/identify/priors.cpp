@@ -70,7 +70,7 @@ double robust_noise(std::vector<double> v, std::size_t p) {
   return std::max(1e-4, 1.4826 * median(v) * std::sqrt(n / dof));
 }
 
-double loss_threshold(double noise_mm, int row_size) { return noise_mm * std::sqrt(row_size == 6 ? 12.592 : 7.815); }
+double loss_threshold(double noise_mm, int row_size) { return noise_mm * std::sqrt(row_size == 6 ? 22.458 : 16.266); }
 
 /// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
 /// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r).

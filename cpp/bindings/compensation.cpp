@@ -99,8 +99,11 @@ void define_compensation(py::module_& m) {
          std::optional<std::string> format, const std::string& targets, const std::string& name,
          std::optional<double> speed, std::optional<double> zone, int max_per_file,
          const std::vector<double>& program_tool, const std::vector<double>& program_base, bool skip_unresolved,
-         std::optional<double> tolerance) {
+         std::optional<double> tolerance, const std::vector<std::string>& uframes,
+         const std::vector<std::string>& utools) {
         NativeOptions n;
+        for (const auto& u : uframes) add_numbered_frame(n.user_frames, u, "--uframe");
+        for (const auto& u : utools) add_numbered_frame(n.user_tools, u, "--utool");
         if (tolerance) n.tolerance_mm = *tolerance;
         for (const auto* v : {&program_tool, &program_base})
           if (!v->empty() && v->size() != 6) throw InputError("--program-tool / --program-base: X,Y,Z,A,B,C (6 numbers)");
@@ -138,11 +141,12 @@ void define_compensation(py::module_& m) {
       py::arg("targets") = "joints", py::arg("name") = "", py::arg("speed") = py::none(), py::arg("zone") = py::none(),
       py::arg("max_targets_per_file") = 0, py::arg("program_tool") = std::vector<double>{},
       py::arg("program_base") = std::vector<double>{}, py::arg("skip_unresolved") = false,
-      py::arg("tolerance") = py::none(),
+      py::arg("tolerance") = py::none(), py::arg("uframes") = std::vector<std::string>{},
+      py::arg("utools") = std::vector<std::string>{},
       "Compensates a pose program file into a program in a controller's language (format: krl, rapid, fanuc-ls, "
       "urscript, gcode, csv; None: by the output's extension), every file written or none; tolerance (mm): targets "
       "inserted where the path between two targets leaves the desired segment by more (path_before_mm, "
-      "path_after_mm, inserted)");
+      "path_after_mm, inserted); uframes, utools: FANUC LS user frames and tools, 'N=X,Y,Z,A,B,C' each");
   m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,

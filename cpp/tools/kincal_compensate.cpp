@@ -148,6 +148,7 @@ int main(int argc, char** argv) {
   std::optional<double> speed, zone;
   int max_per_file = 0;
   std::vector<double> program_tool, program_base;
+  std::vector<std::string> uframes, utools;
   bool skip_unresolved = false;
   std::optional<double> tolerance;
   std::string joint_convention;
@@ -170,6 +171,10 @@ int main(int argc, char** argv) {
       ->delimiter(',')->expected(6);
   app.add_option("--program-base", program_base, "a KRL/RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
       ->delimiter(',')->expected(6);
+  app.add_option("--uframe", uframes, "a FANUC LS program's user frame N in the robot's base frame: N=X,Y,Z,A,B,C "
+                                      "(repeat for each UF the positions use)");
+  app.add_option("--utool", utools, "a FANUC LS program's tool N in the model's tool frame: N=X,Y,Z,A,B,C (repeat "
+                                    "for each UT the positions use)");
   app.add_flag("--skip-unresolved", skip_unresolved, "pass targets computed at run time through with a warning");
   app.add_option("--tolerance", tolerance, "insert targets where the path between two targets leaves the desired "
                                            "segment by more than this (mm)");
@@ -240,6 +245,8 @@ int main(int argc, char** argv) {
     if (program_base.size() == 6)
       n.program_base = {kincal::Vec3(program_base[0], program_base[1], program_base[2]),
                         kincal::Vec3(program_base[3], program_base[4], program_base[5])};
+    for (const auto& u : uframes) kincal::add_numbered_frame(n.user_frames, u, "--uframe");
+    for (const auto& u : utools) kincal::add_numbered_frame(n.user_tools, u, "--utool");
     n.skip_unresolved = skip_unresolved;
     if (tolerance) n.tolerance_mm = *tolerance;
     const auto cr = kincal::compensate_to_controller(robot, program, out, opt, w, n);

@@ -27,6 +27,12 @@ def add_options(sp) -> None:
                     help="split KRL and LS programs with more targets into parts a main program calls (default 2000)")
     sp.add_argument("--program-tool", help="a KRL or RAPID program's TCP in the model's tool frame: X,Y,Z,A,B,C (mm, deg)")
     sp.add_argument("--program-base", help="a KRL or RAPID program's base in the robot's base frame: X,Y,Z,A,B,C")
+    sp.add_argument("--uframe", action="append", default=[], metavar="N=X,Y,Z,A,B,C",
+                    help="a FANUC LS program's user frame N in the robot's base frame (repeat for each UF its "
+                         "positions use; one UF alone may use --program-base)")
+    sp.add_argument("--utool", action="append", default=[], metavar="N=X,Y,Z,A,B,C",
+                    help="a FANUC LS program's tool N in the model's tool frame (repeat for each UT its positions "
+                         "use; one UT alone may use --program-tool)")
     sp.add_argument("--skip-unresolved", action="store_true",
                     help="pass targets computed at run time (RelTool, Offs, CRobT, geometric operators) through "
                          "unchanged with a warning (default: an error listing them)")
@@ -64,7 +70,8 @@ def compensate(robot, args, comp_kwargs: dict) -> dict:
                                           max_targets_per_file=args.max_targets_per_file,
                                           program_tool=_frame(args.program_tool, "--program-tool"),
                                           program_base=_frame(args.program_base, "--program-base"),
-                                          skip_unresolved=args.skip_unresolved, tolerance=args.tolerance)
+                                          skip_unresolved=args.skip_unresolved, tolerance=args.tolerance,
+                                          uframes=args.uframe, utools=args.utool)
 
 
 def summary(res: dict) -> list[str]:

@@ -134,3 +134,86 @@ def test_malformed_programs(tmp_path, model, name, edit, where, cause, tool):
     assert r.returncode == 1, r.stderr
     assert where + ":" in r.stderr and cause in r.stderr, r.stderr
     assert not out.exists()
+
+
+# P[n]: (UF, UT) in the several-frames program, and the frames given for them (X, Y, Z, A, B, C)
+LS_FRAMES = {2: (1, 1), 3: (2, 1), 4: (2, 2), 5: (1, 2)}
+UFRAMES = {1: [300.0, -200.0, 50.0, 10.0, 0.0, 0.0], 2: [-100.0, 80.0, 0.0, -15.0, 2.0, 0.0]}
+UTOOLS = {1: [0.0, 0.0, 40.0, 0.0, 0.0, 0.0], 2: [5.0, -3.0, 60.0, 20.0, 0.0, 5.0]}
+LS_ANY = (r"P\[(\d+)[^\]]*\]\{\s*GP1:\s*UF : (\d+), UT : (\d+),\s*CONFIG : '([^']*)',\s*X =\s*" + N + r"\s*mm,\s*Y =\s*" +
+          N + r"\s*mm,\s*Z =\s*" + N + r"\s*mm,\s*W =\s*" + N + r"\s*deg,\s*P =\s*" + N + r"\s*deg,\s*R =\s*" + N)
+
+
+def _iso(p) -> np.ndarray:
+    t = np.eye(4)
+    t[:3, :3] = Rotation.from_euler("ZYX", p[3:], degrees=True).as_matrix()
+    t[:3, 3] = p[:3]
+    return t
+
+
+def _xyzabc(t: np.ndarray) -> list:
+    return [*t[:3, 3], *Rotation.from_matrix(t[:3, :3]).as_euler("ZYX", degrees=True)]
+
+
+def _several_frames_program(tmp_path) -> Path:
+    """tape.ls with its Cartesian positions in two user frames and two tools (LS_FRAMES)."""
+    text = (DATA / "tape.ls").read_text()
+    for n, (uf, ut) in LS_FRAMES.items():
+        text = re.sub(r"(P\[" + str(n) + r"[^\]]*\]\{\s*GP1:\s*)UF : 0, UT : 1,", rf"\g<1>UF : {uf}, UT : {ut},", text)
+    path = tmp_path / "frames.ls"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_ls_several_user_frames_and_tools(tmp_path, model, calibrated, tool):
+    """An LS program whose positions use UF 1 and 2 and UT 1 and 2 (LS_FRAMES): each position is
+    compensated in its own frames (--uframe N=.., --utool N=..), and only X..R and CONFIG change. The
+    written values are read back here: the pose each describes, in the robot's base (user frame x pose x
+    tool^-1), selects by its CONFIG nominal joints at which the calibrated robot's tool is where the
+    program's pose puts it (within 5e-3 mm, 1e-3 deg)."""
+    program = _several_frames_program(tmp_path)
+    out = tmp_path / "out.ls"
+    args = ["compensate"] if tool == "kincal" else []
+    frames = [a for n, f in UFRAMES.items() for a in ("--uframe", f"{n}=" + ",".join(map(str, f)))]
+    frames += [a for n, f in UTOOLS.items() for a in ("--utool", f"{n}=" + ",".join(map(str, f)))]
+    r = run(tool, *args, "--model", str(model), "--program", str(program), "--out", str(out), "--targets", "filtered",
+            "--skip-unresolved", *frames)
+    assert r.returncode == 0, r.stderr
+    a, b = program.read_text(), out.read_text()
+    lines = a.split("\n")
+    assert all(lines[i - 1].lstrip().startswith(("X =", "W =", "UF : ")) for i in _changed(a, b))
+    desired = {int(m.group(1)): [float(m.group(k)) for k in (5, 6, 7, 10, 9, 8)] for m in re.finditer(LS_ANY, a)}
+    written = list(re.finditer(LS_ANY, b))
+    assert sorted(int(m.group(1)) for m in written) == [2, 3, 4, 5]
+    for m in written:
+        n, uf, ut = int(m.group(1)), int(m.group(2)), int(m.group(3))
+        assert (uf, ut) == LS_FRAMES[n]
+        base, tcp = _iso(UFRAMES[uf]), np.linalg.inv(_iso(UTOOLS[ut]))
+        pose = _xyzabc(base @ _iso([float(m.group(k)) for k in (5, 6, 7, 10, 9, 8)]) @ tcp)
+        q = _core.select_branch(calibrated, "fanuc-ls", {"pose": pose, "fanuc_config": m.group(4)})
+        assert not isinstance(q, str), q
+        assert _reaches(calibrated, q, np.array(_xyzabc(base @ _iso(desired[n]) @ tcp)), 5e-3), n
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_ls_several_frames_need_each_given(tmp_path, model, tool):
+    """Positions in several UF or UT without a frame for each: an error naming the position's file:line
+    and the option; --uframe on a KRL program and a malformed --uframe are errors too; no output file."""
+    program = _several_frames_program(tmp_path)
+    out = tmp_path / "out.ls"
+    args = ["compensate"] if tool == "kincal" else []
+    base = [*args, "--model", str(model), "--program", str(program), "--out", str(out), "--skip-unresolved"]
+    line_p3 = program.read_text().split("\n").index("P[3]{") + 1
+    cases = [([], f"frames.ls:{line_p3 + 2}: P[3] is in UF 2, P[2] in UF 1", "--uframe N=X,Y,Z,A,B,C"),
+             (["--uframe", "1=0,0,0,0,0,0", "--uframe", "2=0,0,0,0,0,0"], "P[4] is in UT 2, P[2] in UT 1", "--utool"),
+             (["--uframe", "1=0,0,0,0,0"], "--uframe 1=0,0,0,0,0: 5 numbers", "expected N=X,Y,Z,A,B,C"),
+             (["--uframe", "x=0,0,0,0,0,0"], "the number must be 0..99", "--uframe x=0,0,0,0,0,0")]
+    for extra, where, cause in cases:
+        r = run(tool, *base, *extra)
+        assert r.returncode == 1 and where in r.stderr and cause in r.stderr and not out.exists(), (extra, r.stderr)
+    for f in ("tape.src", "tape.dat"):
+        shutil.copy(DATA / f, tmp_path / f)
+    r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "tape.src"), "--out",
+            str(tmp_path / "o" / "tape.src"), "--uframe", "1=0,0,0,0,0,0")
+    assert r.returncode == 1 and "apply to FANUC LS programs" in r.stderr and not (tmp_path / "o").exists(), r.stderr

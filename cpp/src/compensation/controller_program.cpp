@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace kincal {
 
@@ -101,6 +102,35 @@ NativePath compensate_native_path(const Robot& robot, const NativeProgram& p, co
   return r;
 }
 
+// Per target, the program's base (with its own frame) in the robot's base and its TCP in the model's tool
+// frame: an LS position's UF n / UT n from --uframe / --utool, else --program-base / --program-tool, which
+// stand for one UF and one UT only.
+struct TargetFrames {
+  std::vector<Eigen::Isometry3d> base, tool;
+};
+TargetFrames target_frames(const NativeProgram& p, ControllerFormat format, const NativeOptions& n) {
+  if ((!n.user_frames.empty() || !n.user_tools.empty()) && format != ControllerFormat::FanucLs)
+    throw InputError(p.paths[0] + ": --uframe and --utool apply to FANUC LS programs (the others: --program-base, "
+                     "--program-tool)");
+  TargetFrames f;
+  const auto pick = [&](const std::map<int, Pose6>& given, int number, int first, const Pose6& one,
+                        const NativeTarget& t, const char* what, const char* option) {
+    const auto it = given.find(number);
+    if (it != given.end()) return pose_to_iso(it->second);
+    if (number != first)
+      throw InputError(where(p.paths[static_cast<size_t>(t.file)], t.line) + ": " + t.name + " is in " + what + " " +
+                       std::to_string(number) + ", " + p.targets[0].name + " in " + what + " " + std::to_string(first) +
+                       ": with several, give each with " + option + " N=X,Y,Z,A,B,C");
+    return pose_to_iso(one);
+  };
+  for (const NativeTarget& t : p.targets) {
+    f.base.push_back(pick(n.user_frames, t.uframe, p.targets[0].uframe, n.program_base, t, "UF", "--uframe") *
+                     t.frame);
+    f.tool.push_back(pick(n.user_tools, t.utool, p.targets[0].utool, n.program_tool, t, "UT", "--utool"));
+  }
+  return f;
+}
+
 // a native program (KRL, RAPID, LS, URScript) with its Cartesian targets compensated, as joints or filtered
 // poses, and --tolerance's targets inserted; every other byte unchanged
 ControllerProgramResult compensate_native(const Robot& robot, const std::string& in_path, ControllerFormat in_format,
@@ -121,17 +151,23 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
       r.result.warnings.push_back(u.where + ": target computed at run time, passed through unchanged: " + u.text);
   }
   if (p.targets.empty()) throw InputError(in_path + ": the program has no Cartesian targets to compensate");
-  const Eigen::Isometry3d base = pose_to_iso(n.program_base), tool = pose_to_iso(n.program_tool);
+  const TargetFrames frames = target_frames(p, in_format, n);
   std::vector<Pose6> poses;
   std::vector<std::string> where_of;
-  for (const NativeTarget& t : p.targets) {
-    poses.push_back(iso_to_pose(base * t.frame * pose_to_iso(t.pose) * tool.inverse()));
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    const NativeTarget& t = p.targets[k];
+    poses.push_back(iso_to_pose(frames.base[k] * pose_to_iso(t.pose) * frames.tool[k].inverse()));
     where_of.push_back(where(p.paths[static_cast<size_t>(t.file)], t.line));
   }
   const auto warnings = std::move(r.result.warnings);
   std::vector<Vec6> q_of;  // per target, its compensated joints
   std::vector<InsertedTarget> inserted;
   if (std::isfinite(n.tolerance_mm)) {
+    for (size_t k = 1; k < p.targets.size(); ++k)
+      if (p.targets[k].utool != p.targets[0].utool)
+        throw InputError(where_of[k] + ": --tolerance follows the path of one tool; " + p.targets[k].name + " is in UT " +
+                         std::to_string(p.targets[k].utool) + ", " + p.targets[0].name + " in UT " +
+                         std::to_string(p.targets[0].utool));
     NativePath path = compensate_native_path(robot, p, poses, opt, n.tolerance_mm);
     r.result = std::move(path.tol.result);
     r.path_before_mm = path.tol.before_mm, r.path_after_mm = path.tol.after_mm, r.inserted = path.tol.inserted;
@@ -142,9 +178,9 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
     for (const size_t m : path.inserted_before) where_ins.push_back(where(p.paths[0], p.motions[m].line));
     const auto ins = controller_targets(robot, path.q_inserted, TargetKind::Filtered, in_format, where_ins);
     for (size_t j = 0; j < ins.size(); ++j) {
-      const NativeTarget& t = p.targets[static_cast<size_t>(p.motions[path.inserted_before[j]].target)];
+      const size_t t = static_cast<size_t>(p.motions[path.inserted_before[j]].target);
       inserted.push_back({path.inserted_before[j],
-                          iso_to_pose((base * t.frame).inverse() * pose_to_iso(ins[j].pose) * tool), ins[j]});
+                          iso_to_pose(frames.base[t].inverse() * pose_to_iso(ins[j].pose) * frames.tool[t]), ins[j]});
     }
   } else {
     r.result = compensate_poses(robot, poses, where_of, opt);
@@ -166,7 +202,7 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
   for (size_t k = 0, f = 0; k < targets.size(); ++k) {
     if (joints[k]) continue;
     targets[k] = filtered[f++];
-    back[k] = iso_to_pose((base * p.targets[k].frame).inverse() * pose_to_iso(targets[k].pose) * tool);
+    back[k] = iso_to_pose(frames.base[k].inverse() * pose_to_iso(targets[k].pose) * frames.tool[k]);
   }
   const size_t n_joints = static_cast<size_t>(std::count(joints.begin(), joints.end(), true));
   r.targets_note = std::to_string(n_joints) + " target(s) written as joints, " +
@@ -202,6 +238,30 @@ void with_inserted_targets(PoseProgram& prog, const std::vector<int>& original) 
 }
 
 }  // namespace
+
+void add_numbered_frame(std::map<int, Pose6>& frames, const std::string& text, const std::string& option) {
+  const auto bad = [&](const std::string& cause) {
+    return InputError(option + " " + text + ": " + cause + " (expected N=X,Y,Z,A,B,C: the frame's number, mm and deg)");
+  };
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos) throw bad("no '='");
+  char* end = nullptr;
+  const long number = std::strtol(text.c_str(), &end, 10);
+  if (end != text.c_str() + eq || eq == 0 || number < 0 || number > 99) throw bad("the number must be 0..99");
+  std::vector<double> v;
+  for (size_t at = eq + 1;;) {
+    const size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(x)) throw bad("'" + item + "' is not a number");
+    v.push_back(x);
+    if (comma == text.size()) break;
+    at = comma + 1;
+  }
+  if (v.size() != 6) throw bad(std::to_string(v.size()) + " numbers");
+  if (!frames.emplace(static_cast<int>(number), Pose6{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])}).second)
+    throw bad("frame " + std::to_string(number) + " given twice");
+}
 
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
                                                  const std::string& out_path, const ProgramOptions& opt,

@@ -2,8 +2,8 @@
 // second point on the continuation line ": P[m] ...") and A to P[n]; the /POS entries P[n]{ GP1: UF, UT,
 // CONFIG, X Y Z W P R } (Cartesian: compensated) or J1..J6 (joints: kept). A motion to a position
 // register PR[i], an indirect P[R[i]], or with Offset / Tool_Offset / INC / VOFFSET is unresolved (known
-// at run time only). FANUC's W, P, R are KUKA's C, B, A. The Cartesian positions must all be in one user
-// frame (UF) and one tool (UT): --program-base and --program-tool give them when they are not the model's.
+// at run time only). FANUC's W, P, R are KUKA's C, B, A. Each target keeps its position's user frame (UF)
+// and tool (UT) numbers: compensate_native applies --uframe / --utool, or --program-base / --program-tool.
 #include "controller_writers.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/native.hpp"
@@ -171,7 +171,6 @@ NativeProgram read_ls_program(const std::string& path) {
   std::map<int, bool> done;
   std::map<int, int> motions, joint_motions;  // per position, the motions to it and how many are J
   for (const Use& u : uses) ++motions[u.n], joint_motions[u.n] += u.joint;
-  int uf = -1, ut = -1;
   for (const Use& u : uses) {
     const auto it = pos.find(u.n);
     if (it == pos.end())
@@ -179,12 +178,8 @@ NativeProgram read_ls_program(const std::string& path) {
     const LsPos& lp = it->second;
     if (!lp.cartesian || done[u.n]) continue;
     done[u.n] = true;
-    if ((uf >= 0 && lp.uf != uf) || (ut >= 0 && lp.ut != ut))
-      throw InputError(where(path, lp.first) + ": P[" + std::to_string(u.n) + "] is in UF " + std::to_string(lp.uf) +
-                       ", UT " + std::to_string(lp.ut) + ", another position in UF " + std::to_string(uf) + ", UT " +
-                       std::to_string(ut) + " (kincal applies one --program-base and --program-tool)");
-    uf = lp.uf, ut = lp.ut;
     NativeTarget t;
+    t.uframe = lp.uf, t.utool = lp.ut;
     t.line = lp.first;
     t.last_line = lp.last;
     t.begin = 0;

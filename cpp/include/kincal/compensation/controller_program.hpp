@@ -7,6 +7,7 @@
 #include "kincal/io/controllers.hpp"
 
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,11 +23,18 @@ std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::
 struct NativeOptions {
   Pose6 program_tool;  ///< the program's TCP in the model's tool frame (--program-tool)
   Pose6 program_base;  ///< the program's base in the robot's base frame (--program-base)
+  /// FANUC LS: user frame n in the robot's base frame (--uframe n=..) and tool n in the model's tool frame
+  /// (--utool n=..), for the positions in UF n / UT n. Needed when the positions use several; a program in
+  /// one UF and one UT may use program_base / program_tool instead.
+  std::map<int, Pose6> user_frames, user_tools;
   bool skip_unresolved = false;  ///< pass run-time targets through with a warning (else an error)
   /// --tolerance: targets inserted where the real robot's path between two targets leaves the desired
   /// segment by more (mm; kincal/compensation/tolerance.hpp); NaN: none inserted
   double tolerance_mm = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// Adds "N=X,Y,Z,A,B,C" (mm, deg) of `option` (--uframe, --utool) to `frames`, else InputError naming it.
+void add_numbered_frame(std::map<int, Pose6>& frames, const std::string& text, const std::string& option);
 
 /// Reads a pose program (CSV or G-code; a KRL or RAPID program: see NativeOptions), compensates it and writes it in w.format (every file, or
 /// none when anything fails). A G-code program written as G-code joints keeps its other lines.

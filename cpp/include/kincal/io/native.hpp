@@ -33,6 +33,7 @@ struct NativeTarget {
   Pose6 pose;                          ///< in the program's frame (mm, KUKA ABC deg)
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();  ///< the program's frame in the robot base
   std::string name;                    ///< declared name, or "" when inline
+  int uframe = -1, utool = -1;         ///< FANUC LS: the position's UF and UT numbers (-1: other languages)
   /// Whether it can be written as a joint target: every motion to it interpolates in joints (KRL PTP /
   /// SPTP, RAPID MoveJ, LS J, URScript movej) and nothing else in the program names it.
   bool joint_motion = false;

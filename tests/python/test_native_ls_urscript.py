@@ -199,16 +199,19 @@ def test_ls_several_user_frames_and_tools(tmp_path, model, calibrated, tool):
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
 def test_ls_several_frames_need_each_given(tmp_path, model, tool):
     """Positions in several UF or UT without a frame for each: an error naming the position's file:line
-    and the option; --uframe on a KRL program and a malformed --uframe are errors too; no output file."""
+    and the option; --uframe on a KRL program, a malformed --uframe and --tolerance across tools are
+    errors too; no output file."""
     program = _several_frames_program(tmp_path)
     out = tmp_path / "out.ls"
     args = ["compensate"] if tool == "kincal" else []
     base = [*args, "--model", str(model), "--program", str(program), "--out", str(out), "--skip-unresolved"]
     line_p3 = program.read_text().split("\n").index("P[3]{") + 1
+    every = [a for n in (1, 2) for a in ("--uframe", f"{n}=0,0,0,0,0,0", "--utool", f"{n}=0,0,0,0,0,0")]
     cases = [([], f"frames.ls:{line_p3 + 2}: P[3] is in UF 2, P[2] in UF 1", "--uframe N=X,Y,Z,A,B,C"),
              (["--uframe", "1=0,0,0,0,0,0", "--uframe", "2=0,0,0,0,0,0"], "P[4] is in UT 2, P[2] in UT 1", "--utool"),
              (["--uframe", "1=0,0,0,0,0"], "--uframe 1=0,0,0,0,0: 5 numbers", "expected N=X,Y,Z,A,B,C"),
-             (["--uframe", "x=0,0,0,0,0,0"], "the number must be 0..99", "--uframe x=0,0,0,0,0,0")]
+             (["--uframe", "x=0,0,0,0,0,0"], "the number must be 0..99", "--uframe x=0,0,0,0,0,0"),
+             (every + ["--tolerance", "0.05"], "--tolerance follows the path of one tool", "P[4] is in UT 2")]
     for extra, where, cause in cases:
         r = run(tool, *base, *extra)
         assert r.returncode == 1 and where in r.stderr and cause in r.stderr and not out.exists(), (extra, r.stderr)

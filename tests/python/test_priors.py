@@ -183,7 +183,7 @@ def test_priors_better_with_15_configurations_on_the_ur10():
     drawn at random; each model predicts every other row of its series. The default priors (nominal,
     1 mm / 0.1 deg) against none, median ratio of held-out RMS over the 5 seeds (the issue asks at
     most 0.85): A 0.735, B 0.815, C 0.817, D 0.644; pooled 0.795. A ratio of 0 is a draw the fit
-    without priors refuses (one of D's); on one of A's it predicts at 28 mm: a 15-pose fit without
+    without priors refuses (one of D's); on one of A's it predicts at 25 mm: a 15-pose fit without
     priors turns the robot's unmodelled 0.4 mm into geometry. On simulated campaigns whose only error
     is Gaussian noise (kr500, 15 configurations, one target, 0.05 or 0.2 mm) the gain is 3-5%: the
     data then determine the geometry far better than a 1 mm prior does, so the item is shown here."""

@@ -220,3 +220,7 @@ def test_ls_several_frames_need_each_given(tmp_path, model, tool):
     r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "tape.src"), "--out",
             str(tmp_path / "o" / "tape.src"), "--uframe", "1=0,0,0,0,0,0")
     assert r.returncode == 1 and "apply to FANUC LS programs" in r.stderr and not (tmp_path / "o").exists(), r.stderr
+    (tmp_path / "poses.csv").write_text("x,y,z,a,b,c\n2000,-720,600,180,0,180\n")
+    r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "poses.csv"), "--out",
+            str(tmp_path / "o.csv"), "--utool", "1=0,0,0,0,0,0")
+    assert r.returncode == 1 and "apply to FANUC LS programs" in r.stderr and not (tmp_path / "o.csv").exists(), r.stderr

@@ -269,6 +269,9 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
   const ControllerFormat in_format = controller_format_of_path(in_path);
   if (in_format != ControllerFormat::Csv && in_format != ControllerFormat::Gcode)
     return compensate_native(robot, in_path, in_format, out_path, opt, w, native);
+  if (!native.user_frames.empty() || !native.user_tools.empty())
+    throw InputError(in_path + ": --uframe and --utool apply to FANUC LS programs (a pose program is in the model's "
+                     "frames)");
   PoseProgram prog = read_pose_program(in_path);
   std::vector<std::string> where_of;
   where_of.reserve(prog.poses.size());

@@ -157,6 +157,7 @@ def _xyzabc(t: np.ndarray) -> list:
 
 def _several_frames_program(tmp_path) -> Path:
     """tape.ls with its Cartesian positions in two user frames and two tools (LS_FRAMES)."""
+    tmp_path.mkdir(exist_ok=True)
     text = (DATA / "tape.ls").read_text()
     for n, (uf, ut) in LS_FRAMES.items():
         text = re.sub(r"(P\[" + str(n) + r"[^\]]*\]\{\s*GP1:\s*)UF : 0, UT : 1,", rf"\g<1>UF : {uf}, UT : {ut},", text)
@@ -165,17 +166,15 @@ def _several_frames_program(tmp_path) -> Path:
     return path
 
 
-@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
-def test_ls_several_user_frames_and_tools(tmp_path, model, calibrated, tool):
-    """An LS program whose positions use UF 1 and 2 and UT 1 and 2 (LS_FRAMES): each position is
-    compensated in its own frames (--uframe N=.., --utool N=..), and only X..R and CONFIG change. The
-    written values are read back here: the pose each describes, in the robot's base (user frame x pose x
-    tool^-1), selects by its CONFIG nominal joints at which the calibrated robot's tool is where the
-    program's pose puts it (within 5e-3 mm, 1e-3 deg)."""
+def _reached_in_frames(tool, tmp_path, model, calibrated, uframes: dict) -> list:
+    """Compensates the several-frames program with ``uframes`` and UTOOLS given; per written position,
+    whether the pose it describes in the robot's base (UFRAMES x pose x UTOOLS^-1, the frames the
+    program means), run through the nominal IK branch its CONFIG selects, puts the calibrated robot's tool
+    where the program's pose is (within 5e-3 mm, 1e-3 deg). Checks that only X..R and CONFIG lines change."""
     program = _several_frames_program(tmp_path)
     out = tmp_path / "out.ls"
     args = ["compensate"] if tool == "kincal" else []
-    frames = [a for n, f in UFRAMES.items() for a in ("--uframe", f"{n}=" + ",".join(map(str, f)))]
+    frames = [a for n, f in uframes.items() for a in ("--uframe", f"{n}=" + ",".join(map(str, f)))]
     frames += [a for n, f in UTOOLS.items() for a in ("--utool", f"{n}=" + ",".join(map(str, f)))]
     r = run(tool, *args, "--model", str(model), "--program", str(program), "--out", str(out), "--targets", "filtered",
             "--skip-unresolved", *frames)
@@ -186,31 +185,52 @@ def test_ls_several_user_frames_and_tools(tmp_path, model, calibrated, tool):
     desired = {int(m.group(1)): [float(m.group(k)) for k in (5, 6, 7, 10, 9, 8)] for m in re.finditer(LS_ANY, a)}
     written = list(re.finditer(LS_ANY, b))
     assert sorted(int(m.group(1)) for m in written) == [2, 3, 4, 5]
+    reached = []
     for m in written:
         n, uf, ut = int(m.group(1)), int(m.group(2)), int(m.group(3))
         assert (uf, ut) == LS_FRAMES[n]
         base, tcp = _iso(UFRAMES[uf]), np.linalg.inv(_iso(UTOOLS[ut]))
         pose = _xyzabc(base @ _iso([float(m.group(k)) for k in (5, 6, 7, 10, 9, 8)]) @ tcp)
         q = _core.select_branch(calibrated, "fanuc-ls", {"pose": pose, "fanuc_config": m.group(4)})
-        assert not isinstance(q, str), q
-        assert _reaches(calibrated, q, np.array(_xyzabc(base @ _iso(desired[n]) @ tcp)), 5e-3), n
+        reached.append(not isinstance(q, str) and
+                       _reaches(calibrated, q, np.array(_xyzabc(base @ _iso(desired[n]) @ tcp)), 5e-3))
+    return reached
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_ls_several_user_frames_and_tools(tmp_path, model, calibrated, tool):
+    """An LS program whose positions use UF 1 and 2 and UT 1 and 2 (LS_FRAMES): each position is
+    compensated in its own frames (--uframe N=.., --utool N=..), and only X..R and CONFIG change; every
+    written position, read back here through its frames and CONFIG, puts the calibrated robot on the
+    program's pose. The control: with the two user frames given the wrong way round, the same check
+    fails for every position (so it sees the frames)."""
+    assert all(_reached_in_frames(tool, tmp_path / "right", model, calibrated, UFRAMES))
+    swapped = {1: UFRAMES[2], 2: UFRAMES[1]}
+    assert not any(_reached_in_frames(tool, tmp_path / "swapped", model, calibrated, swapped))
 
 
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
 def test_ls_several_frames_need_each_given(tmp_path, model, tool):
-    """Positions in several UF or UT without a frame for each: an error naming the position's file:line
-    and the option; --uframe on a KRL program, a malformed --uframe and --tolerance across tools are
-    errors too; no output file."""
+    """Positions in several UF or UT without a frame for each, or --uframe given for some of the UFs
+    used only, or for one no position uses, or beside --program-base: an error naming the position's
+    file:line (or the option) and the cause; --uframe on a KRL program or a pose program, a malformed
+    --uframe and --tolerance across tools are errors too; no output file."""
     program = _several_frames_program(tmp_path)
     out = tmp_path / "out.ls"
     args = ["compensate"] if tool == "kincal" else []
     base = [*args, "--model", str(model), "--program", str(program), "--out", str(out), "--skip-unresolved"]
     line_p3 = program.read_text().split("\n").index("P[3]{") + 1
+    line_p2 = program.read_text().split("\n").index('P[2:"approach"]{') + 1
     every = [a for n in (1, 2) for a in ("--uframe", f"{n}=0,0,0,0,0,0", "--utool", f"{n}=0,0,0,0,0,0")]
     cases = [([], f"frames.ls:{line_p3 + 2}: P[3] is in UF 2, P[2] in UF 1", "--uframe N=X,Y,Z,A,B,C"),
              (["--uframe", "1=0,0,0,0,0,0", "--uframe", "2=0,0,0,0,0,0"], "P[4] is in UT 2, P[2] in UT 1", "--utool"),
              (["--uframe", "1=0,0,0,0,0"], "--uframe 1=0,0,0,0,0: 5 numbers", "expected N=X,Y,Z,A,B,C"),
-             (["--uframe", "x=0,0,0,0,0,0"], "the number must be 0..99", "--uframe x=0,0,0,0,0,0"),
+             (["--uframe", "x=0,0,0,0,0,0"], "--uframe x=0,0,0,0,0,0: not N=..", "number 0..99"),
+             (["--uframe", "1=0x10,0,0,0,0,0"], "'0x10' is not a number", "--uframe"),
+             (["--uframe", "2=0,0,0,0,0,0", "--utool", "2=0,0,0,0,0,0"], "P[2] is in UF 1, which no --uframe gives",
+              f"frames.ls:{line_p2 + 2}"),
+             (every + ["--uframe", "7=0,0,0,0,0,0"], "--uframe 7: no position is in UF 7", "frames.ls"),
+             (every + ["--program-base", "1,0,0,0,0,0"], "--uframe and --program-base together", "--uframe"),
              (every + ["--tolerance", "0.05"], "--tolerance follows the path of one tool", "P[4] is in UT 2")]
     for extra, where, cause in cases:
         r = run(tool, *base, *extra)

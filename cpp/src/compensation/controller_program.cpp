@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <regex>
+#include <set>
 
 namespace kincal {
 
@@ -103,31 +105,44 @@ NativePath compensate_native_path(const Robot& robot, const NativeProgram& p, co
 }
 
 // Per target, the program's base (with its own frame) in the robot's base and its TCP in the model's tool
-// frame: an LS position's UF n / UT n from --uframe / --utool, else --program-base / --program-tool, which
-// stand for one UF and one UT only.
+// frame. FANUC LS: with --uframe (--utool) given, every UF (UT) the positions use is among them and every
+// one given is used; without, the positions share one UF (UT), in --program-base (--program-tool).
 struct TargetFrames {
   std::vector<Eigen::Isometry3d> base, tool;
 };
-TargetFrames target_frames(const NativeProgram& p, ControllerFormat format, const NativeOptions& n) {
-  if ((!n.user_frames.empty() || !n.user_tools.empty()) && format != ControllerFormat::FanucLs)
-    throw InputError(p.paths[0] + ": --uframe and --utool apply to FANUC LS programs (the others: --program-base, "
-                     "--program-tool)");
-  TargetFrames f;
-  const auto pick = [&](const std::map<int, Pose6>& given, int number, int first, const Pose6& one,
-                        const NativeTarget& t, const char* what, const char* option) {
-    const auto it = given.find(number);
-    if (it != given.end()) return pose_to_iso(it->second);
-    if (number != first)
-      throw InputError(where(p.paths[static_cast<size_t>(t.file)], t.line) + ": " + t.name + " is in " + what + " " +
-                       std::to_string(number) + ", " + p.targets[0].name + " in " + what + " " + std::to_string(first) +
-                       ": with several, give each with " + option + " N=X,Y,Z,A,B,C");
-    return pose_to_iso(one);
+TargetFrames target_frames(const NativeProgram& p, const NativeOptions& n) {
+  const auto frames = [&](const std::map<int, Pose6>& given, int NativeTarget::*number, const Pose6& one,
+                          const std::string& what, const std::string& option, const std::string& single) {
+    if (!given.empty() && !(one.xyz.isZero() && one.abc.isZero()))
+      throw InputError(option + " and " + single + " together: give the frame of each " + what + " with " + option);
+    std::vector<Eigen::Isometry3d> out;
+    std::set<int> used;
+    const NativeTarget& first = p.targets[0];
+    for (const NativeTarget& t : p.targets) {
+      used.insert(t.*number);
+      const auto it = given.find(t.*number);
+      if (it != given.end()) {
+        out.push_back(pose_to_iso(it->second));
+        continue;
+      }
+      const std::string at = where(p.paths[static_cast<size_t>(t.file)], t.line) + ": " + t.name + " is in " + what +
+                             " " + std::to_string(t.*number);
+      if (!given.empty()) throw InputError(at + ", which no " + option + " gives");
+      if (t.*number != first.*number)
+        throw InputError(at + ", " + first.name + " in " + what + " " + std::to_string(first.*number) +
+                         ": with several, give each with " + option + " N=X,Y,Z,A,B,C");
+      out.push_back(pose_to_iso(one));
+    }
+    for (const auto& g : given)
+      if (!used.count(g.first))
+        throw InputError(p.paths[0] + ": " + option + " " + std::to_string(g.first) + ": no position is in " + what +
+                         " " + std::to_string(g.first));
+    return out;
   };
-  for (const NativeTarget& t : p.targets) {
-    f.base.push_back(pick(n.user_frames, t.uframe, p.targets[0].uframe, n.program_base, t, "UF", "--uframe") *
-                     t.frame);
-    f.tool.push_back(pick(n.user_tools, t.utool, p.targets[0].utool, n.program_tool, t, "UT", "--utool"));
-  }
+  TargetFrames f;
+  f.base = frames(n.user_frames, &NativeTarget::uframe, n.program_base, "UF", "--uframe", "--program-base");
+  for (size_t k = 0; k < f.base.size(); ++k) f.base[k] = f.base[k] * p.targets[k].frame;
+  f.tool = frames(n.user_tools, &NativeTarget::utool, n.program_tool, "UT", "--utool", "--program-tool");
   return f;
 }
 
@@ -151,7 +166,7 @@ ControllerProgramResult compensate_native(const Robot& robot, const std::string&
       r.result.warnings.push_back(u.where + ": target computed at run time, passed through unchanged: " + u.text);
   }
   if (p.targets.empty()) throw InputError(in_path + ": the program has no Cartesian targets to compensate");
-  const TargetFrames frames = target_frames(p, in_format, n);
+  const TargetFrames frames = target_frames(p, n);
   std::vector<Pose6> poses;
   std::vector<std::string> where_of;
   for (size_t k = 0; k < p.targets.size(); ++k) {
@@ -240,38 +255,37 @@ void with_inserted_targets(PoseProgram& prog, const std::vector<int>& original) 
 }  // namespace
 
 void add_numbered_frame(std::map<int, Pose6>& frames, const std::string& text, const std::string& option) {
+  static const std::regex form(R"((\d{1,2})=(.*))"), number(R"([+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?)");
   const auto bad = [&](const std::string& cause) {
-    return InputError(option + " " + text + ": " + cause + " (expected N=X,Y,Z,A,B,C: the frame's number, mm and deg)");
+    return InputError(option + " " + text + ": " + cause + " (expected N=X,Y,Z,A,B,C: the frame's number 0..99, mm and deg)");
   };
-  const size_t eq = text.find('=');
-  if (eq == std::string::npos) throw bad("no '='");
-  char* end = nullptr;
-  const long number = std::strtol(text.c_str(), &end, 10);
-  if (end != text.c_str() + eq || eq == 0 || number < 0 || number > 99) throw bad("the number must be 0..99");
+  std::smatch m;
+  if (!std::regex_match(text, m, form)) throw bad("not N=..");
   std::vector<double> v;
-  for (size_t at = eq + 1;;) {
-    const size_t comma = std::min(text.find(',', at), text.size());
-    const std::string item = text.substr(at, comma - at);
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(x)) throw bad("'" + item + "' is not a number");
-    v.push_back(x);
-    if (comma == text.size()) break;
+  const std::string values = m[2];
+  for (size_t at = 0;;) {
+    const size_t comma = std::min(values.find(',', at), values.size());
+    const std::string item = values.substr(at, comma - at);
+    v.push_back(std::regex_match(item, number) ? std::strtod(item.c_str(), nullptr) : HUGE_VAL);
+    if (!std::isfinite(v.back())) throw bad("'" + item + "' is not a number");
+    if (comma == values.size()) break;
     at = comma + 1;
   }
   if (v.size() != 6) throw bad(std::to_string(v.size()) + " numbers");
-  if (!frames.emplace(static_cast<int>(number), Pose6{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])}).second)
-    throw bad("frame " + std::to_string(number) + " given twice");
+  const int n = std::stoi(m[1]);
+  if (!frames.emplace(n, Pose6{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])}).second)
+    throw bad("frame " + std::to_string(n) + " given twice");
 }
 
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
                                                  const std::string& out_path, const ProgramOptions& opt,
                                                  const WriterOptions& w, const NativeOptions& native) {
   const ControllerFormat in_format = controller_format_of_path(in_path);
+  if ((!native.user_frames.empty() || !native.user_tools.empty()) && in_format != ControllerFormat::FanucLs)
+    throw InputError(in_path + ": --uframe and --utool apply to FANUC LS programs (the others: --program-base, "
+                     "--program-tool)");
   if (in_format != ControllerFormat::Csv && in_format != ControllerFormat::Gcode)
     return compensate_native(robot, in_path, in_format, out_path, opt, w, native);
-  if (!native.user_frames.empty() || !native.user_tools.empty())
-    throw InputError(in_path + ": --uframe and --utool apply to FANUC LS programs (a pose program is in the model's "
-                     "frames)");
   PoseProgram prog = read_pose_program(in_path);
   std::vector<std::string> where_of;
   where_of.reserve(prog.poses.size());

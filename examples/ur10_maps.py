@@ -184,15 +184,20 @@ def main() -> None:
         edges = np.quantile(fit_data["q_deg"][:, j], np.linspace(0, 1, 6))
         blocked += [(fit_data["q_deg"][:, j] >= edges[b]) & (fit_data["q_deg"][:, j] <= edges[b + 1]) for b in range(5)]
     scores = {}
-    for lam in (1e0, 1e2, 1e4):
-        for mu in (1e1, 1e2, 1e3, 1e4, 1e5):
+    given = None
+    if args.penalty:
+        try:
+            lam, mu = (float(x) for x in args.penalty.split(","))
+        except ValueError:
+            p.error(f"--penalty {args.penalty}: expected LAMBDA,MU (two numbers)")
+        given = (lam, mu)
+    for lam in ((given[0],) if given else (1e0, 1e2, 1e4)):
+        for mu in ((given[1],) if given else (1e1, 1e2, 1e3, 1e4, 1e5)):
             pen = maps.penalty(lam, mu)
             scores[(lam, mu)] = (cv_rms(a, y, pen, folds), cv_rms(a, y, pen, blocked))
             print(f"lambda {lam:g}, mu {mu:g}: grouped 5-fold RMS {scores[(lam, mu)][0]:.4f} mm, blocked by angle "
                   f"{scores[(lam, mu)][1]:.4f} mm")
     lam, mu = min(scores, key=lambda k: scores[k][1])
-    if args.penalty:
-        lam, mu = (float(x) for x in args.penalty.split(","))
     pen = maps.penalty(lam, mu)
     print(f"{'given' if args.penalty else 'chosen by the blocked cross-validation on ' + args.fit}: lambda {lam:g}, "
           f"mu {mu:g}")

@@ -141,14 +141,16 @@ def test_data_scaled_loss_on_clean_and_gross_errors(kr500):
         worst = fits["dirty", "huber"].worst
         assert worst and all(err > 2.5 for _, _, err, _ in worst[:3])
         assert "robust loss: huber bending at" in fits["dirty", "huber"].summary()
+        assert "(4.03 x the residuals' robust spread" in fits["clean", "huber"].summary()
 
 
 @pytest.mark.skipif(not IPA.is_dir(), reason="needs ../shared/data/ipa-robot-accuracy")
 def test_ur10_series_b_default_loss_not_worse_than_none():
     """UR10 series B (1495 real points), grouped 5-fold cross-validation (whole configurations per
     fold): the default loss (Huber at the data's scale) against --loss none. Measured 0.413181 against
-    0.413195 mm RMS (bending at the 95% point instead, 2.80 x the noise: 0.413240, 0.011% worse;
-    Huber at the old fixed 0.1 mm: 0.4148, 0.4% worse)."""
+    0.413195 mm RMS: a margin of 3e-5 relative, at the resolution of this measure (bending at the 95%
+    point instead, 2.80 x the noise, the default until the bend was moved with this series in view:
+    0.413240, 0.011% worse; Huber at the old fixed 0.1 mm: 0.4148, 0.4% worse)."""
     robot = kincal.load_robot("ur10")
     data = datasets.read_ipa(IPA / "Series_B/measurements_joint_configurations.csv")
     default = ident.identify(robot, data).validation
@@ -184,12 +186,14 @@ def test_priors_better_with_15_configurations_on_the_ur10():
     1 mm / 0.1 deg) against none, median ratio of held-out RMS over the 5 seeds (the issue asks at
     most 0.85): A 0.735, B 0.815, C 0.817, D 0.644; pooled 0.795. A ratio of 0 is a draw the fit
     without priors refuses (one of D's); on one of A's it predicts at 25 mm: a 15-pose fit without
-    priors turns the robot's unmodelled 0.4 mm into geometry. On simulated campaigns whose only error
-    is Gaussian noise (kr500, 15 configurations, one target, 0.05 or 0.2 mm) the gain is 3-5%: the
-    data then determine the geometry far better than a 1 mm prior does, so the item is shown here."""
+    priors turns the robot's unmodelled 0.4 mm into geometry (without that draw D's median is 0.76).
+    On simulated campaigns whose only error is Gaussian noise (kr500, 15 configurations, one target,
+    0.05 or 0.2 mm; measured once in the ninth session with a scratch script, not kept) the gain was
+    3-5%: the data then determine the geometry far better than a 1 mm prior does, so the item is shown
+    on real data."""
     robot = kincal.load_robot("ur10")
-    ratios = {s: [_few_configurations_ratio(robot, datasets.read_ipa(IPA / f), seed) for seed in range(1, 6)]
-              for s, f in SERIES.items()}
+    series = {s: datasets.read_ipa(IPA / f) for s, f in SERIES.items()}
+    ratios = {s: [_few_configurations_ratio(robot, d, seed) for seed in range(1, 6)] for s, d in series.items()}
     for s in SERIES:
         assert np.median(ratios[s]) <= 0.85, (s, ratios)
 

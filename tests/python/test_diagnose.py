@@ -160,3 +160,26 @@ def test_fivebar_link_deflection_is_named(tmp_path):
     assert named == {("link_deflection", "b"), ("link_deflection", "c")}
     assert doc["final_rms_mm"] < 0.1 * doc["steps"][0]["rms_before_mm"]
     assert (tmp_path / "d" / "residual_map.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_step_figure_draws_the_effect_less_its_mean(kr500):
+    """The step figure's curve of a joint-angle effect is the identified change less its mean over the
+    points: the residuals it is drawn on never show a constant (the joint's offset carries it). Truth:
+    a transmission error on joint 2 of 0.10 deg sin q - 0.04 deg cos q + 0.02 deg sin 2q, seen over
+    -140..5 deg only, where its mean is far from zero."""
+    from types import SimpleNamespace
+
+    from kincal import _core
+    from kincal.diagnose import serial_report
+
+    effect = _core.Effect("transmission_error", 2)
+    robot = kr500.with_effects([(effect, [D(0.10), D(-0.04), D(0.02), 0.0])], 20.0)
+    var = np.linspace(-140.0, 5.0, 300)
+    xs, curve = serial_report._effect_curve(SimpleNamespace(robot=robot), {}, effect, var)
+
+    def truth(deg):
+        t = D(deg)
+        return 0.10 * np.sin(t) - 0.04 * np.cos(t) + 0.02 * np.sin(2 * t)
+
+    assert abs(np.mean(truth(var))) > 0.03  # a large offset over this range, so the check has teeth
+    assert np.allclose(curve, truth(xs) - np.mean(truth(var)), atol=1e-12)

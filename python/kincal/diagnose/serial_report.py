@@ -47,21 +47,26 @@ def _joint_error(res, data: dict, joint: int) -> np.ndarray:
 
 
 def _effect_curve(res, data: dict, effect, var: np.ndarray):
-    """The identified effect as a joint-angle change (deg) along its variable, sorted, or None
-    (thermal_expansion)."""
+    """The identified effect as a joint-angle change (deg) along its variable, sorted, less its mean
+    over the points (a constant change is the joint's offset, which the geometry carries, so the
+    residuals never show it), or None (thermal_expansion)."""
     if effect.name == "joint_compliance":
         c = [float(x) for p, x in zip(res.layout.parameters, res.x) if p.kind == "compliance" and p.joint == effect.joint]
         xs = np.sort(var)
-        return (xs, c[0] * xs) if c else None  # deg/kNm * kN m
+        return (xs, c[0] * (xs - np.mean(var))) if c else None  # deg/kNm * kN m
     vals = next((v for e, v in res.robot.effects if e == effect), None)
     if vals is None or effect.name == "thermal_expansion":
         return None
     if effect.name == "backlash":  # drawn at the two directions only
         return np.array([-1.0, 1.0]), np.degrees(vals[0]) * np.array([-1.0, 1.0])
+
+    def dq(deg: np.ndarray) -> np.ndarray:
+        t = np.radians(deg)
+        return np.degrees(sum(vals[2 * i] * np.sin(k * t) + vals[2 * i + 1] * np.cos(k * t)
+                              for i, k in enumerate(effect.harmonics)))
+
     xs = np.linspace(float(np.min(var)), float(np.max(var)), 400)
-    t = np.radians(xs)
-    dq = sum(vals[2 * i] * np.sin(k * t) + vals[2 * i + 1] * np.cos(k * t) for i, k in enumerate(effect.harmonics))
-    return xs, np.degrees(dq)
+    return xs, dq(xs) - float(np.mean(dq(np.asarray(var, dtype=float))))
 
 
 def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, after_fit, path: Path) -> None:
@@ -207,7 +212,7 @@ the repeats of one of the {diag['validation']['configurations']} configurations 
 <h2>Residuals against each named effect</h2>
 <p>Each step's residual against the variable of its effect, before and after the step (fitted on every point):
 for an effect on a joint angle, the angle error of that joint each point's residual implies, with the identified
-effect's curve.</p>{steps_img}
+effect's curve less its mean over the points (a constant is the joint's offset, which the geometry carries).</p>{steps_img}
 <h2>What remains, against every candidate variable</h2>
 <p>The final model's residual fitted, held out on the same folds, as a smooth function of each variable acting on
 the instrument's placement and on every joint angle: {report.esc(diag.get("residual_summary", ""))}.</p>

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -41,8 +42,7 @@ def tool_from_targets(result: Identification, known: np.ndarray) -> Identificati
     tool["xyz_mm"] = new_t.tolist()
     tool["abc_deg"] = _abc_of(new_r)
     robot = Robot.from_json(json.dumps(doc), "<identified>")
-    return Identification(robot=robot, targets=known.copy(), fit=result.fit, effects=result.effects,
-                          validation=result.validation, fit_info=result.fit_info, worst=result.worst)
+    return dataclasses.replace(result, robot=robot, targets=known.copy())
 
 
 def _abc_of(r: np.ndarray) -> list:

@@ -61,7 +61,7 @@ def main() -> None:
     for k in sorted(SERIES):
         if k != args.fit:
             print(f"\nseries {k}, the model of series {args.fit} with only the placement and probe refitted:")
-            v = ident.validate(model.robot, series[k], joint_ranges=model.joint_ranges)
+            v = ident.validate(model.robot, series[k])
             print(setups.validation_summary(v) + f"\n(per axis, the RMS of every x, y and z residual: "
                                                   f"{v['rms_mm'] / np.sqrt(3):.3f} mm)")
 

@@ -3,6 +3,7 @@
 #include "kincal/identify/simulate.hpp"
 #include "kincal/ik/ik.hpp"
 #include "kincal/io/model_json.hpp"
+#include "kincal/model/coverage.hpp"
 #include "kincal/model/model.hpp"
 #include "kincal/model/robots.hpp"
 
@@ -68,6 +69,17 @@ void define_model(py::module_& m) {
           py::arg("setups"),
           "The robot with its calibrated model seen from these placements: (name, xyz_mm, abc_deg) per\n"
           "setup, the first its base_in_instrument (one: no setups)")
+      .def_property_readonly("fitted_ranges_deg", [](const Robot& r) { return r.calibrated->spec().fitted_deg; },
+                             "per joint, the angles the identification saw ([lo, hi] deg); empty when unknown")
+      .def(
+          "with_fitted_ranges",
+          [](const Robot& r, const std::vector<JointRange>& ranges) {
+            ModelSpec s = r.calibrated->spec();
+            if (!ranges.empty()) check_joint_ranges(ranges, r.calibrated->dof(), "with_fitted_ranges");
+            s.fitted_deg = ranges;
+            return Robot{r.nominal, std::make_shared<Model>(s)};
+          },
+          py::arg("ranges"), "The robot whose calibrated model records the angles its fit saw (joint_ranges())")
       .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated->needs_dir(); },
                              "backlash: the direction of motion into each pose is needed")
       .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated->needs_temperature(); },
@@ -97,4 +109,39 @@ void define_model(py::module_& m) {
           py::arg("base_in_instrument") = py::none(),
           "A robot whose calibrated model has simulated manufacturing errors (for simulations and demos)");
   m.def("builtin_names", &builtin_names);
+
+  py::class_<Extrapolation>(m, "Extrapolation",
+                            "A joint whose periodic effects rows of joint angles ask for outside the angles they were "
+                            "fitted on (extrapolated())")
+      .def_readonly("joint", &Extrapolation::joint, "counted from 1")
+      .def_readonly("effects", &Extrapolation::effects, "the joint's periodic effects, e.g. 'joint_map(joint 1)'")
+      .def_readonly("fitted_deg", &Extrapolation::fitted, "the fitted range [lo, hi] (deg)")
+      .def_readonly("rows", &Extrapolation::rows, "rows outside it")
+      .def_readonly("first", &Extrapolation::first, "the first of them (0-based)")
+      .def("message", &extrapolation_message, py::arg("total"), py::arg("noun") = "rows",
+           "the warning in words: 'joint 1 is outside the -180..-45 deg its ...'");
+  m.def(
+      "joint_ranges", [](const RowMatrix& q_deg) { return joint_ranges(q_deg.data(), q_deg.rows(), q_deg.cols()); },
+      py::arg("q_deg"),
+      "Per joint, the range [lo, hi] (deg) of rows of joint angles: the shortest arc of the circle that holds\n"
+      "every angle (modulo 360 deg), lo in [-180, 180); [-180, 180] when no gap is wider than 10 deg");
+  m.def(
+      "outside_range",
+      [](const Eigen::VectorXd& q_deg, const JointRange& range) {
+        std::vector<bool> out(static_cast<size_t>(q_deg.size()));
+        for (Eigen::Index i = 0; i < q_deg.size(); ++i) out[static_cast<size_t>(i)] = outside_range(q_deg[i], range);
+        return out;
+      },
+      py::arg("q_deg"), py::arg("range"), "angles (deg, any turn) more than 1 deg outside a range [lo, hi]");
+  m.def(
+      "extrapolated",
+      [](const Robot& r, const RowMatrix& q_deg) {
+        if (q_deg.rows() > 0 && q_deg.cols() != r.calibrated->dof())
+          throw InputError("extrapolated: " + std::to_string(q_deg.cols()) + " joint columns for a robot of " +
+                           std::to_string(r.calibrated->dof()));
+        return extrapolated(r.calibrated->spec(), q_deg.data(), q_deg.rows(), r.calibrated->dof());
+      },
+      py::arg("robot"), py::arg("q_deg"),
+      "The joints whose periodic effects (transmission_error, joint_map) rows of joint angles (deg) take\n"
+      "outside the ranges the calibrated model was fitted on (none when it carries no ranges)");
 }

@@ -17,7 +17,7 @@ from . import cli_campaign as campaign
 from . import cli_programs as programs
 from . import diagnose as diagnosis
 from . import feed as feedmod
-from . import coverage, fivebar, priors
+from . import fivebar, priors
 from . import identify as ident
 from .csv_text import format_rows
 from .kinematics_files import fk_file, ik_file
@@ -156,8 +156,7 @@ def cmd_identify(args) -> None:
 def cmd_validate(args) -> None:
     robot = load_robot(args.model)
     data = ident.read_measurements(args.data, robot)
-    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale,
-                       joint_ranges=coverage.fitted_ranges(args.model))
+    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
     v["model"] = str(args.model)
     _core.write_file_atomic(args.out, json.dumps(v, indent=1, sort_keys=True) + "\n")
     print(ident.validation_summary(v))

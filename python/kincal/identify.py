@@ -15,7 +15,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core, coverage, gravity as _gravity, grouping, priors
+from . import _core, gravity as _gravity, grouping, priors
 from ._core import Robot
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, validate  # noqa: F401  (kincal.identify.validate, as before)
@@ -254,7 +254,6 @@ class Identification:
     validation: dict = field(default_factory=dict)
     fit_info: dict = field(default_factory=dict)  #: priors.report(): the priors and the loss
     worst: list = field(default_factory=list)  #: priors.down_weighted(): the most down-weighted rows
-    joint_ranges: list = field(default_factory=list)  #: coverage.joint_ranges() of the fitted rows (deg)
 
     def parameters(self) -> list:
         f = self.fit
@@ -281,7 +280,6 @@ class Identification:
             "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f.rms_mm, "max_mm": f.max_mm,
                     "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
-            "joint_ranges_deg": self.joint_ranges,
             **self.fit_info,
         }
         if f.layout.n_setups > 1:
@@ -477,9 +475,10 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     choice = (f"{fit.scales[0]:g} (chosen by grouped cross-validation)" if fit.scales else f"{opts.prior_scale:g}")
     info = priors.report(r, loss, loss_scale_mm, choice)
     info["priors"]["centred_on"] = "the prior model's calibrated geometry" if prior_model else "the starting model"
-    return Identification(robot=r.robot, targets=np.asarray(r.targets), fit=r, effects=list(effects),
-                          validation=val, fit_info=info, worst=priors.down_weighted(r, subset(data, fit_mask)),
-                          joint_ranges=coverage.joint_ranges(data["q_deg"][fit_mask]))
+    # the model records the angles its fit saw: where its periodic effects were measured
+    calibrated = r.robot.with_fitted_ranges(_core.joint_ranges(data["q_deg"][fit_mask]))
+    return Identification(robot=calibrated, targets=np.asarray(r.targets), fit=r, effects=list(effects),
+                          validation=val, fit_info=info, worst=priors.down_weighted(r, subset(data, fit_mask)))
 
 
 def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:

@@ -9,7 +9,7 @@ from typing import Optional
 
 import numpy as np
 
-from . import _core, coverage
+from . import _core
 from ._core import Robot
 
 
@@ -82,7 +82,7 @@ def validation_summary(v: dict) -> str:
             row(f"  setup {name}", f, "deg")
     lines.append("")
     lines.append(f"refitted: {v['refitted']}")
-    lines += coverage.summary_lines(v.get("extrapolated", []))
+    lines += [f"warning: {e['message']}" for e in v.get("extrapolated", [])]
     return "\n".join(lines)
 
 
@@ -167,8 +167,16 @@ def _refit_placements(robot: Robot, data: dict, loss: str = "huber", loss_scale_
     return ea, eb, oa, ob, cal
 
 
-def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1,
-             joint_ranges: Optional[list] = None) -> dict:
+def extrapolated(robot: Robot, q_deg: np.ndarray) -> list:
+    """Where rows of joint angles take the robot's periodic effects outside the angles they were
+    fitted on (_core.extrapolated), as the records of validate()'s ``extrapolated``."""
+    n = len(q_deg)
+    return [{"joint": e.joint, "effects": e.effects, "fitted_deg": list(e.fitted_deg), "rows_outside": e.rows,
+             "share_outside": e.rows / n, "message": e.message(n, "rows")}
+            for e in _core.extrapolated(robot, np.asarray(q_deg, dtype=float))]
+
+
+def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
     differently: only the placements and the target offsets are refitted, on the calibrated
@@ -177,9 +185,9 @@ def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float
     ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm``; with measured orientations ``rms_deg``,
     ``mean_deg``), ``before_mean_mm``, ``before_max_mm``, per setup the same under ``setups`` and
     the refitted ``placements``; ``rows``, ``after_rms_mm``, ``after_max_mm`` repeat them under the
-    names of earlier versions. With the model's ``joint_ranges`` (its JSON's
-    ``identification.joint_ranges_deg``), ``extrapolated`` lists the joints whose periodic effects
-    these rows ask for outside the angles they were fitted on (coverage.extrapolated)."""
+    names of earlier versions. ``extrapolated``: the joints whose periodic effects these rows ask for
+    outside the angles the model was fitted on (``robot.fitted_ranges_deg``), each ``{"joint",
+    "effects", "fitted_deg", "rows_outside", "share_outside", "message"}``."""
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
     ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm)
@@ -187,5 +195,5 @@ def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float
     v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
              refitted="the instrument placement of every setup and the target offsets; the model's geometry and "
                       "effects held (its drift left out)", placements=setup_frames(cal.setups),
-             extrapolated=coverage.extrapolated(robot, joint_ranges, data["q_deg"]))
+             extrapolated=extrapolated(robot, data["q_deg"]))
     return v

@@ -1,10 +1,12 @@
 """Where a model's periodic effects are extrapolated: the joint ranges a fit saw (model.json's
-identification.joint_ranges_deg) and `kincal validate`'s warning when new data leave them.
+calibrated.fitted_joint_ranges_deg), `kincal validate`'s warning when new data leave them, and the
+warning of `kincal compensate` and `kincal-compensate` when a program does.
 
 Truth of the end-to-end case: kr500 with 1 mm / 0.05 deg geometric errors and 0.003 deg/kN m joint
 compliance (seed 3), a transmission error on joint 2 (0.02 deg sin q2 + 0.01 deg cos 2 q2), 3
 reflectors, 0.02 mm noise per coordinate; the model is fitted on the rows with q2 below its median and
-validated on those above it, then on rows of its own range."""
+validated on those above it, then on rows of its own range; a program of 40 poses is compensated on
+it, joint 2 swept over both halves."""
 
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import coverage
+from kincal import _core
 from kincal import identify as ident
 
 from conftest import run
@@ -28,7 +30,7 @@ from conftest import run
     (np.array([30.0]), [30.0, 30.0]),
 ])
 def test_joint_ranges_are_the_circle_less_its_widest_gap(angles, expect):
-    assert np.allclose(coverage.joint_ranges(angles[:, None])[0], expect)
+    assert np.allclose(_core.joint_ranges(angles[:, None])[0], expect)
 
 
 def test_outside_counts_turns_and_the_margin():
@@ -36,23 +38,31 @@ def test_outside_counts_turns_and_the_margin():
     q = np.array([-180.5, -44.5, -43.0, -181.5, 180.0, 52.0, 315.0, -405.0, 0.0])
     # inside (within 1 deg), inside, outside, outside, inside (= -180), outside, inside (= -45),
     # inside (= -45), outside
-    assert coverage.outside(q, lo, hi).tolist() == [False, False, True, True, False, True, False, False, True]
-    assert not coverage.outside(q, -180.0, 180.0).any()
+    assert _core.outside_range(q, [lo, hi]) == [False, False, True, True, False, True, False, False, True]
+    assert not any(_core.outside_range(q, [-180.0, 180.0]))
 
 
-def test_validate_warns_where_a_periodic_effect_is_extrapolated(tmp_path):
+@pytest.fixture(scope="module")
+def half_fit(tmp_path_factory):
+    """The model fitted on the rows with q2 below its median (identify, geometry + the transmission
+    error of joint 2): (folder, the simulated rows, the fitted rows' mask)."""
+    tmp = tmp_path_factory.mktemp("coverage")
     robot = kincal.load_robot("kr500")
     truth = robot.with_calibrated(3, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
     hidden = [("transmission_error", 2, [np.radians(0.02), 0.0, 0.0, np.radians(0.01)])]
     data = ident.simulate(truth, 300, seed=5, targets=3, effects=hidden)
-    q2 = data["q_deg"][:, 1]
-    low = q2 < np.median(q2)
+    low = data["q_deg"][:, 1] < np.median(data["q_deg"][:, 1])
     for name, mask in (("fit", low), ("high", ~low)):
-        (tmp_path / f"{name}.csv").write_text(ident.measurements_csv(ident.subset(data, mask), 6))
-    r = run("kincal", "identify", "--robot", "kr500", "--data", str(tmp_path / "fit.csv"), "--out",
-            str(tmp_path / "model.json"), "--effects", "transmission_error:2", "--folds", "0")
+        (tmp / f"{name}.csv").write_text(ident.measurements_csv(ident.subset(data, mask), 6))
+    r = run("kincal", "identify", "--robot", "kr500", "--data", str(tmp / "fit.csv"), "--out",
+            str(tmp / "model.json"), "--effects", "transmission_error:2", "--folds", "0")
     assert r.returncode == 0, r.stderr
-    ranges = json.loads((tmp_path / "model.json").read_text())["identification"]["joint_ranges_deg"]
+    return tmp, data, low
+
+
+def test_validate_warns_where_a_periodic_effect_is_extrapolated(half_fit):
+    tmp_path, data, low = half_fit
+    ranges = json.loads((tmp_path / "model.json").read_text())["calibrated"]["fitted_joint_ranges_deg"]
     fit_q = data["q_deg"][low]
     assert len(ranges) == 6
     assert np.allclose(ranges[1], [fit_q[:, 1].min(), fit_q[:, 1].max()])
@@ -61,10 +71,10 @@ def test_validate_warns_where_a_periodic_effect_is_extrapolated(tmp_path):
             "--out", str(tmp_path / "v.json"))
     assert r.returncode == 0, r.stderr
     ext = json.loads((tmp_path / "v.json").read_text())["extrapolated"]
-    assert [e["joint"] for e in ext] == [2] and ext[0]["effects"] == ["transmission_error(joint 2)"]
+    assert [e["joint"] for e in ext] == [2] and ext[0]["effects"] == "transmission_error(joint 2)"
     n_high = int((~low).sum())  # rows (a pose per reflector); those within 1 deg of the median are inside
     assert ext[0]["rows_outside"] > 0.95 * n_high
-    assert "joint 2 outside" in r.stdout and "transmission_error(joint 2)" in r.stdout
+    assert "warning: joint 2 is outside" in r.stdout and "transmission_error(joint 2)" in r.stdout
     # rows of the fitted range: nothing to say
     r = run("kincal", "validate", "--model", str(tmp_path / "model.json"), "--data", str(tmp_path / "fit.csv"),
             "--out", str(tmp_path / "v2.json"))
@@ -75,3 +85,34 @@ def test_validate_warns_where_a_periodic_effect_is_extrapolated(tmp_path):
             str(tmp_path / "v3.json"))
     assert r.returncode == 0, r.stderr
     assert json.loads((tmp_path / "v3.json").read_text())["extrapolated"] == []
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_compensate_warns_where_a_program_leaves_the_fitted_range(half_fit, tool):
+    """40 poses (base frame) whose joint 2 sweeps from inside the fitted range to 20 deg beyond it:
+    the warning names joint 2, its effect, the line of the first pose outside and how many are; the
+    program's first half alone draws no warning."""
+    tmp_path, data, low = half_fit
+    model = kincal.load_robot(str(tmp_path / "model.json"))
+    lo, hi = model.fitted_ranges_deg[1]
+    q = np.tile(model.home_deg, (40, 1))  # the branch the first pose takes: the one nearest home
+    q[:, 1] = np.linspace(hi - 20.0, hi + 20.0, 40)
+    poses = kincal.fk(model, q)
+    header = "x,y,z,a,b,c\n"
+    rows = "".join(",".join(repr(float(v)) for v in p) + "\n" for p in poses)
+    (tmp_path / "sweep.csv").write_text(header + rows)
+    (tmp_path / "inside.csv").write_text(header + "".join(rows.splitlines(keepends=True)[:15]))
+    cmd = ["kincal", "compensate"] if tool == "kincal" else ["kincal-compensate"]
+    r = run(*cmd, "--model", str(tmp_path / "model.json"), "--program", str(tmp_path / "sweep.csv"),
+            "--out", str(tmp_path / f"{tool}.csv"))
+    assert r.returncode == 0, r.stderr
+    got = np.loadtxt(tmp_path / f"{tool}.csv", delimiter=",", skiprows=1)
+    out = np.asarray(_core.outside_range(got[:, 1], [lo, hi]))
+    assert 15 <= out.sum() <= 25  # the half beyond the range, within its 1 deg margin
+    first_line = int(np.argmax(out)) + 2  # the header is line 1
+    line = next(x for x in r.stderr.splitlines() if "is outside" in x)
+    assert f"sweep.csv:{first_line}: joint 2 is outside" in line and "transmission_error(joint 2)" in line
+    assert f"at {int(out.sum())} of 40 poses" in line
+    r = run(*cmd, "--model", str(tmp_path / "model.json"), "--program", str(tmp_path / "inside.csv"),
+            "--out", str(tmp_path / f"{tool}-inside.csv"))
+    assert r.returncode == 0 and "is outside" not in r.stderr, r.stderr

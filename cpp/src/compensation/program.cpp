@@ -3,6 +3,7 @@
 #include "kincal/io/file.hpp"
 #include "kincal/io/programs.hpp"
 #include "kincal/kinematics/kinematics.hpp"
+#include "kincal/model/coverage.hpp"
 #include "kincal/model/joint_convention.hpp"
 
 #include <algorithm>
@@ -275,11 +276,25 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
     }
     return res;
   };
-  if (!needs_dir) return run(Vec6::Ones());
-  if (!opt.initial_direction.empty()) return run(initial_directions(opt.initial_direction));
-  // the direction of the first motion: from a first pass that assumes +1, then the program again
-  const ProgramResult first = run(Vec6::Ones());
-  return run(motion_directions(first.q_deg, {})[0]);
+  ProgramResult res;
+  if (!needs_dir) {
+    res = run(Vec6::Ones());
+  } else if (!opt.initial_direction.empty()) {
+    res = run(initial_directions(opt.initial_direction));
+  } else {
+    // the direction of the first motion: from a first pass that assumes +1, then the program again
+    const ProgramResult first = run(Vec6::Ones());
+    res = run(motion_directions(first.q_deg, {})[0]);
+  }
+  // the poses that take a joint's periodic effects outside the angles they were fitted on
+  if (opt.compensate && !res.q_deg.empty()) {
+    std::vector<double> q;
+    q.reserve(res.q_deg.size() * 6);
+    for (const Vec6& v : res.q_deg) q.insert(q.end(), v.data(), v.data() + 6);
+    for (const Extrapolation& e : extrapolated(cal.spec(), q.data(), res.q_deg.size(), 6))
+      res.warnings.push_back(where_i(e.first) + ": " + extrapolation_message(e, res.q_deg.size(), "poses"));
+  }
+  return res;
 }
 
 ProgramResult compensate_program_file(const Robot& robot, const std::string& in_path, const std::string& out_path,

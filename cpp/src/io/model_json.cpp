@@ -1,4 +1,6 @@
 #include "kincal/io/model_json.hpp"
+
+#include "kincal/model/coverage.hpp"
 #include "kincal/model/joint_convention.hpp"
 
 #include "kincal/model/robots.hpp"
@@ -73,6 +75,11 @@ json spec_json(const ModelSpec& s) {
   }
   for (const EffectValue& ev : s.effects)
     if (ev.effect.name == "drift") o["t_mean_s"] = s.t_mean_s;
+  if (!s.fitted_deg.empty()) {
+    json r = json::array();
+    for (const JointRange& j : s.fitted_deg) r.push_back(json::array({j[0], j[1]}));
+    o["fitted_joint_ranges_deg"] = r;
+  }
   return o;
 }
 
@@ -154,6 +161,17 @@ struct Reader {
         if (!name.is_string()) fail(w + ".name", "not a string");
         s.setups.push_back(SetupFrame{name.get<std::string>(), pose(setups[i], "base_in_instrument", w)});
       }
+    }
+    if (o.contains("fitted_joint_ranges_deg")) {
+      const std::string w = where + ".fitted_joint_ranges_deg";
+      const json& r = o["fitted_joint_ranges_deg"];
+      if (!r.is_array()) fail(w, "needs a list of [lo, hi] per joint");
+      for (const json& j : r) {
+        if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
+          fail(w, "needs a list of [lo, hi] per joint");
+        s.fitted_deg.push_back({j[0].get<double>(), j[1].get<double>()});
+      }
+      check_joint_ranges(s.fitted_deg, static_cast<int>(s.joints.size()), source + ": " + w);
     }
     if (o.contains("effects")) {
       const json& effs = o["effects"];

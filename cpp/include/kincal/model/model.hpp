@@ -48,6 +48,9 @@ struct SetupFrame {
 };
 
 /// Everything that defines one robot geometry; plain data, checked when a Model is built from it.
+/// A joint's fitted range of angles (deg): [lo, hi], lo in [-180, 180), hi - lo its arc (coverage.hpp)
+using JointRange = std::array<double, 2>;
+
 struct ModelSpec {
   std::string name = "robot";
   std::vector<JointSpec> joints;
@@ -70,6 +73,9 @@ struct ModelSpec {
   /// How the controller numbers the joints (kincal/model/joint_convention.hpp): "" its own angles are
   /// the model's; "fanuc": the controller's J3 is the forearm's angle to the horizontal
   std::string joint_convention;
+  /// Per joint, the angles the identification saw (coverage.hpp); empty when unknown (a nominal model,
+  /// a model written before they were recorded)
+  std::vector<JointRange> fitted_deg;
 };
 
 class Model {

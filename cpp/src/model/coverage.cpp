@@ -1,0 +1,94 @@
+#include "kincal/model/coverage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace kincal {
+
+namespace {
+
+/// an angle (deg) in [-180, 180)
+double wrap180(double a) {
+  double r = std::fmod(a + 180.0, 360.0);
+  if (r < 0) r += 360.0;
+  return r - 180.0;
+}
+
+}  // namespace
+
+std::vector<JointRange> joint_ranges(const double* q_deg, size_t rows, int dof) {
+  std::vector<JointRange> out;
+  for (int j = 0; j < dof; ++j) {
+    std::vector<double> a(rows);
+    for (size_t i = 0; i < rows; ++i) a[i] = wrap180(q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(j)]);
+    if (a.empty()) {
+      out.push_back({-180.0, 180.0});
+      continue;
+    }
+    std::sort(a.begin(), a.end());
+    // the widest gap between neighbours on the circle (the last one wraps to the first)
+    size_t widest = a.size() - 1;
+    double gap = a.front() + 360.0 - a.back();
+    for (size_t i = 0; i + 1 < a.size(); ++i)
+      if (a[i + 1] - a[i] > gap) gap = a[i + 1] - a[i], widest = i;
+    if (gap <= kFullTurnGapDeg) {
+      out.push_back({-180.0, 180.0});
+      continue;
+    }
+    const double lo = a[(widest + 1) % a.size()];
+    out.push_back({lo, lo + 360.0 - gap});
+  }
+  return out;
+}
+
+bool outside_range(double q_deg, const JointRange& range) {
+  const double lo = range[0] - kRangeMarginDeg, len = range[1] - range[0] + 2 * kRangeMarginDeg;
+  if (len >= 360.0) return false;
+  double past = std::fmod(q_deg - lo, 360.0);  // 0 at the range's (widened) start
+  if (past < 0) past += 360.0;
+  return past > len;
+}
+
+void check_joint_ranges(const std::vector<JointRange>& ranges, int dof, const std::string& who) {
+  if (static_cast<int>(ranges.size()) != dof)
+    throw InputError(who + ": " + std::to_string(ranges.size()) + " ranges for " + std::to_string(dof) + " joints");
+  for (size_t j = 0; j < ranges.size(); ++j) {
+    const JointRange& r = ranges[j];
+    if (!(r[0] >= -180.0 && r[0] < 180.0) || !(r[1] >= r[0] && r[1] - r[0] <= 360.0))
+      throw InputError(who + ": joint " + std::to_string(j + 1) +
+                       ": a range needs [lo, hi] with lo in [-180, 180) and 0 <= hi - lo <= 360 (deg)");
+  }
+}
+
+std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const double* q_deg, size_t rows, int dof) {
+  std::vector<Extrapolation> out;
+  if (calibrated.fitted_deg.empty()) return out;
+  for (int j = 0; j < dof && j < static_cast<int>(calibrated.fitted_deg.size()); ++j) {
+    Extrapolation e;
+    for (const EffectValue& ev : calibrated.effects)
+      if (ev.effect.harmonic() && ev.effect.joint == j) e.effects += (e.effects.empty() ? "" : ", ") + ev.effect.label();
+    if (e.effects.empty()) continue;
+    e.joint = j + 1;
+    e.fitted = calibrated.fitted_deg[static_cast<size_t>(j)];
+    for (size_t i = 0; i < rows; ++i)
+      if (outside_range(q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(j)], e.fitted)) {
+        if (e.rows == 0) e.first = i;
+        ++e.rows;
+      }
+    if (e.rows > 0) out.push_back(e);
+  }
+  return out;
+}
+
+std::string extrapolation_message(const Extrapolation& e, size_t total, const std::string& noun) {
+  const double share = total ? 100.0 * static_cast<double>(e.rows) / static_cast<double>(total) : 0.0;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "joint %d is outside the %.0f..%.0f deg its ", e.joint, e.fitted[0], e.fitted[1]);
+  char tail[160];
+  std::snprintf(tail, sizeof tail, " at %zu of %zu %s (%.*f%%)", e.rows, total, noun.c_str(), share < 0.5 ? 1 : 0, share);
+  return buf + e.effects + " was fitted on (angles modulo 360 deg)" + tail +
+         ": the effect is extrapolated there, not measured";
+}
+
+}  // namespace kincal

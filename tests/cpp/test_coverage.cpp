@@ -40,6 +40,8 @@ TEST(Coverage, RangeIsTheCircleLessItsWidestGap) {
   EXPECT_NEAR(ranges_of(turn)[0][0], 54.0, 1e-12);
   EXPECT_NEAR(ranges_of(turn)[0][1], 54.0 + 360.0 - 27.0, 1e-12);
   EXPECT_EQ(ranges_of({30.0})[0], (JointRange{30.0, 30.0}));
+  EXPECT_EQ(ranges_of({30.0, std::nan(""), 40.0})[0], (JointRange{30.0, 40.0}));  // not finite: left out
+  EXPECT_EQ(ranges_of({})[0], (JointRange{-180.0, 180.0}));
 }
 
 TEST(Coverage, OutsideCountsTurnsAndTheMargin) {
@@ -53,6 +55,7 @@ TEST(Coverage, OutsideCountsTurnsAndTheMargin) {
   EXPECT_FALSE(outside_range(-405.0, r));  // = -45
   EXPECT_TRUE(outside_range(52.0, r));
   EXPECT_FALSE(outside_range(52.0, JointRange{-180.0, 180.0}));
+  EXPECT_FALSE(outside_range(std::nan(""), r));
 }
 
 TEST(Coverage, ModelJsonCarriesTheRangesAndRejectsBadOnes) {

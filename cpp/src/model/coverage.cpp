@@ -20,8 +20,12 @@ double wrap180(double a) {
 std::vector<JointRange> joint_ranges(const double* q_deg, size_t rows, int dof) {
   std::vector<JointRange> out;
   for (int j = 0; j < dof; ++j) {
-    std::vector<double> a(rows);
-    for (size_t i = 0; i < rows; ++i) a[i] = wrap180(q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(j)]);
+    std::vector<double> a;  // the finite angles (a measurement reader refuses others; a caller may not)
+    a.reserve(rows);
+    for (size_t i = 0; i < rows; ++i) {
+      const double q = q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(j)];
+      if (std::isfinite(q)) a.push_back(wrap180(q));
+    }
     if (a.empty()) {
       out.push_back({-180.0, 180.0});
       continue;

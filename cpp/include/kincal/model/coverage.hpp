@@ -22,10 +22,12 @@ constexpr double kFullTurnGapDeg = 10.0;
 /// an angle this close to a fitted range (deg) is inside it
 constexpr double kRangeMarginDeg = 1.0;
 
-/// Per joint, the fitted range of rows of joint angles (deg; row-major, rows x dof).
+/// Per joint, the fitted range of rows of joint angles (deg; row-major, rows x dof); angles that are
+/// not finite are left out, and a joint with none gets the whole turn.
 std::vector<JointRange> joint_ranges(const double* q_deg, size_t rows, int dof);
 
-/// True when an angle (deg, any turn) lies outside a range by more than kRangeMarginDeg.
+/// True when an angle (deg, any turn) lies outside a range by more than kRangeMarginDeg (never for an
+/// angle that is not finite).
 bool outside_range(double q_deg, const JointRange& range);
 
 /// Checks ranges read from a file: one per joint, lo in [-180, 180), 0 <= hi - lo <= 360.

@@ -6,7 +6,9 @@ measured from its own tracker placement), in the calls a user makes:
 1. the diagnosis on one series (default B): DIR/report.html, DIR/diagnosis.json and DIR/model.json
    (`kincal diagnose --robot ur10 --data B.csv --effects joint_compliance --out DIR`);
 2. that model checked on each other series, only the tracker placement and the probe offset
-   refitted (`kincal validate --model DIR/model.json --data A.csv --out VA.json`);
+   refitted (`kincal validate --model DIR/model.json --data A.csv --out VA.json`), with its warnings
+   where the series takes the model's periodic effects outside the angles they were fitted on and
+   the RMS of those rows against the others;
 3. with --joint, all four series identified jointly, one placement per series (a `setup` column),
    validated by grouped 5-fold cross-validation (whole configurations per fold) and by holding out
    each series whole (`kincal identify --data ABCD.csv --hold-out-setups`; per series: the other
@@ -64,6 +66,11 @@ def main() -> None:
             v = ident.validate(model.robot, series[k])
             print(setups.validation_summary(v) + f"\n(per axis, the RMS of every x, y and z residual: "
                                                   f"{v['rms_mm'] / np.sqrt(3):.3f} mm)")
+            if v["extrapolated"]:
+                io = setups.inside_and_outside(model.robot, series[k])
+                print("RMS after (before) of the rows inside every fitted range and of those outside one: " +
+                      ", ".join(f"{w} {io[w]['rows']} rows {io[w]['rms_mm']:.3f} ({io[w]['before_rms_mm']:.3f}) mm"
+                                for w in ("inside", "outside")))
 
     if args.joint:
         every = with_setups(series)

@@ -74,6 +74,7 @@ void define_model(py::module_& m) {
       .def(
           "with_fitted_ranges",
           [](const Robot& r, const std::vector<JointRange>& ranges) {
+            if (!r.identified()) throw InputError("with_fitted_ranges: a nominal robot was fitted on nothing");
             ModelSpec s = r.calibrated->spec();
             if (!ranges.empty()) check_joint_ranges(ranges, r.calibrated->dof(), "with_fitted_ranges");
             s.fitted_deg = ranges;

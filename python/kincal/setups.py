@@ -176,6 +176,23 @@ def extrapolated(robot: Robot, q_deg: np.ndarray) -> list:
             for e in _core.extrapolated(robot, np.asarray(q_deg, dtype=float))]
 
 
+def inside_and_outside(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
+    """validate()'s RMS (after, before) split between the rows that take none of the robot's periodic
+    effects outside their fitted ranges and the rows that take one: ``{"inside": {"rows",
+    "rms_mm", "before_rms_mm"}, "outside": {...}}`` (the placements refitted on every row)."""
+    ea, eb, _, _, _ = _refit_placements(robot, data, loss, loss_scale_mm)
+    q = np.asarray(data["q_deg"], dtype=float)
+    out = np.zeros(len(q), dtype=bool)
+    for e in _core.extrapolated(robot, q):
+        out |= np.asarray(_core.outside_range(q[:, e.joint - 1], e.fitted_deg))
+
+    def part(m: np.ndarray) -> dict:
+        rms = (lambda x: float(np.sqrt(np.mean(x ** 2))) if len(x) else float("nan"))
+        return {"rows": int(m.sum()), "rms_mm": rms(ea[m]), "before_rms_mm": rms(eb[m])}
+
+    return {"inside": part(~out), "outside": part(out)}
+
+
 def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit

@@ -41,7 +41,11 @@ TEST(Coverage, RangeIsTheCircleLessItsWidestGap) {
   EXPECT_NEAR(ranges_of(turn)[0][1], 54.0 + 360.0 - 27.0, 1e-12);
   EXPECT_EQ(ranges_of({30.0})[0], (JointRange{30.0, 30.0}));
   EXPECT_EQ(ranges_of({30.0, std::nan(""), 40.0})[0], (JointRange{30.0, 40.0}));  // not finite: left out
-  EXPECT_EQ(ranges_of({})[0], (JointRange{-180.0, 180.0}));
+  EXPECT_THROW(ranges_of({std::nan("")}), InputError);  // a joint with no angle at all
+  EXPECT_TRUE(ranges_of({}).empty());                   // no rows: unknown
+  // -180 less an ulp is -180 on the circle (fmod's -tiny + 360 rounds to 360)
+  const JointRange edge = ranges_of({std::nextafter(-180.0, -200.0), -100.0})[0];
+  EXPECT_EQ(edge, (JointRange{-180.0, -100.0}));
 }
 
 TEST(Coverage, OutsideCountsTurnsAndTheMargin) {
@@ -104,7 +108,12 @@ TEST(Coverage, ExtrapolatedNamesTheJointsOfPeriodicEffectsOnly) {
   EXPECT_EQ(e[0].effects, "transmission_error(joint 2)");
   EXPECT_EQ(e[0].rows, 20u);
   EXPECT_EQ(e[0].first, 0u);
-  EXPECT_EQ(extrapolation_message(e[0], 20, "poses"),
+  EXPECT_EQ(extrapolation_message(e[0], 20, "poses compensated"),
             "joint 2 is outside the -30..-3 deg its transmission_error(joint 2) was fitted on (angles modulo 360 deg) "
-            "at 20 of 20 poses (100%): the effect is extrapolated there, not measured");
+            "at 20 of 20 poses compensated (100%): the effect is extrapolated there, not measured");
+  Extrapolation most = e[0];
+  most.rows = 1999;  // 99.95%: not "100%"
+  EXPECT_NE(extrapolation_message(most, 2000, "rows").find("at 1999 of 2000 rows (99.9%)"), std::string::npos);
+  most.rows = 1;  // 0.05%: not "0%"
+  EXPECT_NE(extrapolation_message(most, 2000, "rows").find("at 1 of 2000 rows (0.1%)"), std::string::npos);
 }

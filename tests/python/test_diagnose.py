@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import kincal
+from kincal import _core
 from kincal import diagnose as dg
 from kincal import identify as ident
 from kincal.urdf import spec_urdf
@@ -129,6 +130,9 @@ def test_cli_writes_diagnosis_report_and_model(tmp_path):
     assert model["format"] == "kincal-model"
     assert "backlash(joint 3)" in model["identification"]["effects"]
     assert np.allclose(model["identification"]["targets_mm"], ident.DEFAULT_TARGETS[:3])
+    # the final model (TCP placed from --tool-targets) records the angles it was fitted on: every row
+    data = ident.read_measurements(str(tmp_path / "m.csv"), robot)
+    assert np.allclose(model["calibrated"]["fitted_joint_ranges_deg"], _core.joint_ranges(data["q_deg"]))
     page = (tmp_path / "d" / "report.html").read_text()
     assert "gap.png" in page and "residual_map.png" in page
     assert "model.json was written" in page
@@ -183,3 +187,21 @@ def test_step_figure_draws_the_effect_less_its_mean(kr500):
 
     assert abs(np.mean(truth(var))) > 0.03  # a large offset over this range, so the check has teeth
     assert np.allclose(curve, truth(xs) - np.mean(truth(var)), atol=1e-12)
+
+
+def test_step_figure_draws_backlash_less_its_mean(kr500):
+    """Backlash b dir draws one level per direction, less b times the mean direction over the points
+    (what the joint's offset absorbs when the directions are unbalanced). Truth: b = 0.015 deg on
+    joint 3; 70 of 100 points approach upwards (+1), the signs jittered by up to 0.15 as plotted."""
+    from types import SimpleNamespace
+
+    from kincal import _core
+    from kincal.diagnose import serial_report
+
+    effect = _core.Effect("backlash", 3)
+    robot = kr500.with_effects([(effect, [D(0.015)])], 20.0)
+    signs = np.r_[np.ones(70), -np.ones(30)]
+    var = signs + np.random.default_rng(1).uniform(-0.15, 0.15, 100)
+    xs, levels = serial_report._effect_curve(SimpleNamespace(robot=robot), {}, effect, var)
+    assert xs.tolist() == [-1.0, 1.0]
+    assert np.allclose(levels, 0.015 * (np.array([-1.0, 1.0]) - 0.4))

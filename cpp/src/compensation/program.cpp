@@ -292,7 +292,7 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
     q.reserve(res.q_deg.size() * 6);
     for (const Vec6& v : res.q_deg) q.insert(q.end(), v.data(), v.data() + 6);
     for (const Extrapolation& e : extrapolated(cal.spec(), q.data(), res.q_deg.size(), 6))
-      res.warnings.push_back(where_i(e.first) + ": " + extrapolation_message(e, res.q_deg.size(), "poses"));
+      res.warnings.push_back(where_i(e.first) + ": " + extrapolation_message(e, res.q_deg.size(), "poses compensated"));
   }
   return res;
 }

@@ -166,9 +166,10 @@ struct Reader {
       const std::string w = where + ".fitted_joint_ranges_deg";
       const json& r = o["fitted_joint_ranges_deg"];
       if (!r.is_array()) fail(w, "needs a list of [lo, hi] per joint");
-      for (const json& j : r) {
+      for (size_t i = 0; i < r.size(); ++i) {
+        const json& j = r[i];
         if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
-          fail(w, "needs a list of [lo, hi] per joint");
+          fail(w + "[" + std::to_string(i) + "]", "needs [lo, hi] (deg)");
         s.fitted_deg.push_back({j[0].get<double>(), j[1].get<double>()});
       }
       check_joint_ranges(s.fitted_deg, static_cast<int>(s.joints.size()), source + ": " + w);

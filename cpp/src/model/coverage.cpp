@@ -12,6 +12,7 @@ namespace {
 double wrap180(double a) {
   double r = std::fmod(a + 180.0, 360.0);
   if (r < 0) r += 360.0;
+  if (r >= 360.0) r -= 360.0;  // -180 less an ulp: fmod gives -tiny, and -tiny + 360 rounds to 360
   return r - 180.0;
 }
 
@@ -19,6 +20,7 @@ double wrap180(double a) {
 
 std::vector<JointRange> joint_ranges(const double* q_deg, size_t rows, int dof) {
   std::vector<JointRange> out;
+  if (rows == 0) return out;  // nothing fitted: unknown
   for (int j = 0; j < dof; ++j) {
     std::vector<double> a;  // the finite angles (a measurement reader refuses others; a caller may not)
     a.reserve(rows);
@@ -26,10 +28,7 @@ std::vector<JointRange> joint_ranges(const double* q_deg, size_t rows, int dof) 
       const double q = q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(j)];
       if (std::isfinite(q)) a.push_back(wrap180(q));
     }
-    if (a.empty()) {
-      out.push_back({-180.0, 180.0});
-      continue;
-    }
+    if (a.empty()) throw InputError("joint ranges: joint " + std::to_string(j + 1) + " has no finite angle");
     std::sort(a.begin(), a.end());
     // the widest gap between neighbours on the circle (the last one wraps to the first)
     size_t widest = a.size() - 1;
@@ -90,7 +89,12 @@ std::string extrapolation_message(const Extrapolation& e, size_t total, const st
   char buf[160];
   std::snprintf(buf, sizeof buf, "joint %d is outside the %.0f..%.0f deg its ", e.joint, e.fitted[0], e.fitted[1]);
   char tail[160];
-  std::snprintf(tail, sizeof tail, " at %zu of %zu %s (%.*f%%)", e.rows, total, noun.c_str(), share < 0.5 ? 1 : 0, share);
+  // a share that would round to 0% or 100% without being it keeps a decimal
+  // (rounded away from it: 99.95% is 99.9%, 0.05% is 0.1%)
+  const bool low = share < 0.5 && e.rows > 0, high = share >= 99.5 && e.rows < total;
+  const double shown = low ? std::ceil(share * 10) / 10 : high ? std::floor(share * 10) / 10 : share;
+  std::snprintf(tail, sizeof tail, " at %zu of %zu %s (%.*f%%)", e.rows, total, noun.c_str(), low || high ? 1 : 0,
+                shown);
   return buf + e.effects + " was fitted on (angles modulo 360 deg)" + tail +
          ": the effect is extrapolated there, not measured";
 }

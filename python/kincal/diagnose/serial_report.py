@@ -57,8 +57,8 @@ def _effect_curve(res, data: dict, effect, var: np.ndarray):
     vals = next((v for e, v in res.robot.effects if e == effect), None)
     if vals is None or effect.name == "thermal_expansion":
         return None
-    if effect.name == "backlash":  # drawn at the two directions only
-        return np.array([-1.0, 1.0]), np.degrees(vals[0]) * np.array([-1.0, 1.0])
+    if effect.name == "backlash":  # drawn at the two directions only (var: the jittered signs)
+        return np.array([-1.0, 1.0]), np.degrees(vals[0]) * (np.array([-1.0, 1.0]) - np.mean(np.sign(var)))
 
     def dq(deg: np.ndarray) -> np.ndarray:
         t = np.radians(deg)

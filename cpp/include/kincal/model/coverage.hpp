@@ -23,7 +23,8 @@ constexpr double kFullTurnGapDeg = 10.0;
 constexpr double kRangeMarginDeg = 1.0;
 
 /// Per joint, the fitted range of rows of joint angles (deg; row-major, rows x dof); angles that are
-/// not finite are left out, and a joint with none gets the whole turn.
+/// not finite are left out (InputError when a joint has none); no rows: none (unknown). The angles
+/// are the model's (ModelSpec), not a controller's numbers (joint_convention.hpp).
 std::vector<JointRange> joint_ranges(const double* q_deg, size_t rows, int dof);
 
 /// True when an angle (deg, any turn) lies outside a range by more than kRangeMarginDeg (never for an

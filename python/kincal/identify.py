@@ -319,6 +319,11 @@ class Identification:
             rates = ", ".join("{} {:+.4g} {}".format(x["name"], x["value"], x["unit"]) for x in drift["parameters"])
             lines.append(f"instrument drift about t = {drift['t_mean_s']:.0f} s (removed from the fit, never "
                          f"compensated): {rates}")
+        ranges = self.robot.fitted_ranges_deg
+        periodic = sorted({e.joint for e, _ in self.robot.effects if e.name in ("transmission_error", "joint_map")})
+        if ranges and periodic:
+            lines.append("periodic effects known over the fitted angles (validate and compensate warn beyond them): " +
+                         ", ".join(f"joint {j} {ranges[j - 1][0]:.0f}..{ranges[j - 1][1]:.0f} deg" for j in periodic))
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}"
                      " (what the data determine)")
         if self.fit_info:

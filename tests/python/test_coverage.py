@@ -57,6 +57,9 @@ def half_fit(tmp_path_factory):
     r = run("kincal", "identify", "--robot", "kr500", "--data", str(tmp / "fit.csv"), "--out",
             str(tmp / "model.json"), "--effects", "transmission_error:2", "--folds", "0")
     assert r.returncode == 0, r.stderr
+    q2 = data["q_deg"][low, 1]  # the summary says where the transmission error was fitted
+    assert f"known over the fitted angles (validate and compensate warn beyond them): joint 2 " \
+           f"{q2.min():.0f}..{q2.max():.0f} deg" in r.stdout, r.stdout
     return tmp, data, low
 
 

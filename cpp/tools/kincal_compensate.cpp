@@ -226,7 +226,10 @@ int main(int argc, char** argv) {
         outbuf[n] = '\n';
         std::fwrite(outbuf, 1, n + 1, stdout);
         std::fflush(stdout);
-        if (!sc.warning().empty()) std::fprintf(stderr, "kincal-compensate: warning: %s\n", sc.warning().c_str());
+        for (size_t a = 0, b = 0; a < sc.warning().size(); a = b + 1) {  // one warning per line
+          b = std::min(sc.warning().find('\n', a), sc.warning().size());
+          std::fprintf(stderr, "kincal-compensate: warning: %.*s\n", static_cast<int>(b - a), sc.warning().data() + a);
+        }
       }
       return 0;
     }

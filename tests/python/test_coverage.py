@@ -6,7 +6,7 @@ Truth of the end-to-end case: kr500 with 1 mm / 0.05 deg geometric errors and 0.
 compliance (seed 3), a transmission error on joint 2 (0.02 deg sin q2 + 0.01 deg cos 2 q2), 3
 reflectors, 0.02 mm noise per coordinate; the model is fitted on the rows with q2 below its median and
 validated on those above it, then on rows of its own range; a program of 40 poses is compensated on
-it, joint 2 swept over both halves."""
+it, joint 2 swept over both halves, and streamed out and back again."""
 
 from __future__ import annotations
 
@@ -119,3 +119,27 @@ def test_compensate_warns_where_a_program_leaves_the_fitted_range(half_fit, tool
     r = run(*cmd, "--model", str(tmp_path / "model.json"), "--program", str(tmp_path / "inside.csv"),
             "--out", str(tmp_path / f"{tool}-inside.csv"))
     assert r.returncode == 0 and "is outside" not in r.stderr, r.stderr
+
+
+def test_stream_warns_each_time_a_joint_leaves_the_fitted_range(half_fit):
+    """kincal-compensate --stream: the 40-pose sweep beyond the range, then back, then beyond again
+    (120 lines after the header): a warning on the line where joint 2 leaves the range, each time it
+    leaves (twice), and none while it stays out or comes back."""
+    tmp_path, data, low = half_fit
+    model = kincal.load_robot(str(tmp_path / "model.json"))
+    lo, hi = model.fitted_ranges_deg[1]
+    q = np.tile(model.home_deg, (120, 1))
+    sweep = np.linspace(hi - 20.0, hi + 20.0, 40)
+    q[:, 1] = np.r_[sweep, sweep[::-1], sweep]
+    poses = kincal.fk(model, q)
+    lines = "x,y,z,a,b,c\n" + "".join(",".join(repr(float(v)) for v in p) + "\n" for p in poses)
+    r = run("kincal-compensate", "--model", str(tmp_path / "model.json"), "--stream", stdin=lines)
+    assert r.returncode == 0, r.stderr
+    got = np.loadtxt(r.stdout.splitlines()[1:], delimiter=",")
+    out = got[:, 1] > hi + 1.0  # outside: above the range by more than the margin
+    leaves = [i + 2 for i in range(120) if out[i] and (i == 0 or not out[i - 1])]  # input lines (header: 1)
+    assert len(leaves) == 2
+    warned = [w for w in r.stderr.splitlines() if "is outside" in w]
+    assert [w.split(":")[3] for w in warned] == [str(n) for n in leaves], r.stderr  # "...: stdin:N: ..."
+    assert all(w.startswith("kincal-compensate: warning: stdin:") and "transmission_error(joint 2)" in w
+               and "extrapolated from here" in w for w in warned)

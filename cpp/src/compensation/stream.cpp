@@ -44,6 +44,7 @@ Field next_field(const char*& f, const char* e) {
 StreamCompensator::StreamCompensator(Robot robot, ProgramOptions opt)
     : robot_(std::move(robot)), opt_(std::move(opt)), cursor_(robot_, opt_, stream_directions(robot_, opt_)) {
   warning_.reserve(512);
+  if (opt_.compensate) periodic_ = periodic_joints(robot_.calibrated->spec());
 }
 
 Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
@@ -55,6 +56,14 @@ Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
   if (s.branch_changed()) {
     if (opt_.keep_branch) fail_at("stdin", line_no_, branch_change_message(s.error));
     warning_ = "stdin:" + std::to_string(line_no_) + ": " + branch_change_message(s.error);
+  }
+  for (const Extrapolation& e : periodic_) {  // a joint leaving its fitted range: said once per excursion
+    const size_t j = static_cast<size_t>(e.joint - 1);
+    const bool out = j < 6 && outside_range(s.q_deg[static_cast<Eigen::Index>(j)], e.fitted);
+    if (out && !outside_[j])
+      warning_ += (warning_.empty() ? "" : "\n") + std::string("stdin:") + std::to_string(line_no_) + ": " +
+                  leaving_message(e) + ": the effect is extrapolated from here, not measured";
+    if (j < 6) outside_[j] = out;
   }
   Vec6 q = s.q_deg;  // the cursor keeps the model's angles; the line carries the controller's numbers
   joints_to_controller(robot_.nominal->spec(), q.data(), 6);

@@ -64,18 +64,27 @@ void check_joint_ranges(const std::vector<JointRange>& ranges, int dof, const st
   }
 }
 
-std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const double* q_deg, size_t rows, int dof) {
+std::vector<Extrapolation> periodic_joints(const ModelSpec& calibrated) {
   std::vector<Extrapolation> out;
-  if (calibrated.fitted_deg.empty()) return out;
-  for (int j = 0; j < dof && j < static_cast<int>(calibrated.fitted_deg.size()); ++j) {
+  for (size_t j = 0; j < calibrated.fitted_deg.size(); ++j) {
     Extrapolation e;
     for (const EffectValue& ev : calibrated.effects)
-      if (ev.effect.harmonic() && ev.effect.joint == j) e.effects += (e.effects.empty() ? "" : ", ") + ev.effect.label();
+      if (ev.effect.harmonic() && ev.effect.joint == static_cast<int>(j))
+        e.effects += (e.effects.empty() ? "" : ", ") + ev.effect.label();
     if (e.effects.empty()) continue;
-    e.joint = j + 1;
-    e.fitted = calibrated.fitted_deg[static_cast<size_t>(j)];
+    e.joint = static_cast<int>(j) + 1;
+    e.fitted = calibrated.fitted_deg[j];
+    out.push_back(e);
+  }
+  return out;
+}
+
+std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const double* q_deg, size_t rows, int dof) {
+  std::vector<Extrapolation> out;
+  for (Extrapolation e : periodic_joints(calibrated)) {
+    if (e.joint > dof) continue;
     for (size_t i = 0; i < rows; ++i)
-      if (outside_range(q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(j)], e.fitted)) {
+      if (outside_range(q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(e.joint - 1)], e.fitted)) {
         if (e.rows == 0) e.first = i;
         ++e.rows;
       }
@@ -84,10 +93,14 @@ std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const doubl
   return out;
 }
 
+std::string leaving_message(const Extrapolation& e) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "joint %d is outside the %.0f..%.0f deg its ", e.joint, e.fitted[0], e.fitted[1]);
+  return buf + e.effects + " was fitted on (angles modulo 360 deg)";
+}
+
 std::string extrapolation_message(const Extrapolation& e, size_t total, const std::string& noun) {
   const double share = total ? 100.0 * static_cast<double>(e.rows) / static_cast<double>(total) : 0.0;
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "joint %d is outside the %.0f..%.0f deg its ", e.joint, e.fitted[0], e.fitted[1]);
   char tail[160];
   // a share that would round to 0% or 100% without being it keeps a decimal
   // (rounded away from it: 99.95% is 99.9%, 0.05% is 0.1%)
@@ -95,8 +108,7 @@ std::string extrapolation_message(const Extrapolation& e, size_t total, const st
   const double shown = low ? std::ceil(share * 10) / 10 : high ? std::floor(share * 10) / 10 : share;
   std::snprintf(tail, sizeof tail, " at %zu of %zu %s (%.*f%%)", e.rows, total, noun.c_str(), low || high ? 1 : 0,
                 shown);
-  return buf + e.effects + " was fitted on (angles modulo 360 deg)" + tail +
-         ": the effect is extrapolated there, not measured";
+  return leaving_message(e) + tail + ": the effect is extrapolated there, not measured";
 }
 
 }  // namespace kincal

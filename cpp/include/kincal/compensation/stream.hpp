@@ -4,8 +4,11 @@
 #pragma once
 
 #include "kincal/compensation/program.hpp"
+#include "kincal/model/coverage.hpp"
 
+#include <array>
 #include <string>
+#include <vector>
 
 namespace kincal {
 
@@ -16,7 +19,8 @@ class StreamCompensator {
   /// Processes one input line (without its newline); writes the output line (without newline) to
   /// out and returns its length. Throws InputError "stdin:N: cause" on bad input.
   size_t process(const char* line, size_t len, char* out, size_t cap);
-  /// A warning about the last line processed (a branch change), or empty.
+  /// A warning about the last line processed (a branch change; a joint leaving the angles its periodic
+  /// effects were fitted on, once each time it leaves them), or empty.
   const std::string& warning() const { return warning_; }
 
  private:
@@ -25,6 +29,8 @@ class StreamCompensator {
   int line_no_ = 0;
   ProgramCursor cursor_;
   std::string warning_;
+  std::vector<Extrapolation> periodic_;  ///< joints whose periodic effects have a fitted range
+  std::array<bool, 6> outside_{};        ///< each one's last pose was outside its range
   // CSV state
   bool csv_header_seen_ = false;
   int csv_cols_[6] = {0, 1, 2, 3, 4, 5};

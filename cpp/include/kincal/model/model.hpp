@@ -47,10 +47,10 @@ struct SetupFrame {
   Pose6 base_in_instrument;
 };
 
-/// Everything that defines one robot geometry; plain data, checked when a Model is built from it.
 /// A joint's fitted range of angles (deg): [lo, hi], lo in [-180, 180), hi - lo its arc (coverage.hpp)
 using JointRange = std::array<double, 2>;
 
+/// Everything that defines one robot geometry; plain data, checked when a Model is built from it.
 struct ModelSpec {
   std::string name = "robot";
   std::vector<JointSpec> joints;

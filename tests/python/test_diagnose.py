@@ -205,3 +205,29 @@ def test_step_figure_draws_backlash_less_its_mean(kr500):
     xs, levels = serial_report._effect_curve(SimpleNamespace(robot=robot), {}, effect, var)
     assert xs.tolist() == [-1.0, 1.0]
     assert np.allclose(levels, 0.015 * (np.array([-1.0, 1.0]) - 0.4))
+
+
+def test_linearisation_copies_the_fit_by_name_when_the_model_gains_a_parameter(kr500):
+    """The diagnosis linearises the calibrated model at the fit. When the fit identified a tilt of
+    joint 1 (as on UR10 series A), joint 1 carries a gravity torque in the calibrated model, which
+    then has a joint1.compliance the fit's layout had not, inserted before the others; the fit's values
+    must still reach their own parameters. Truth: kr500 with 1 mm / 0.05 deg errors and compliance
+    (seed 3), 150 poses x 3 reflectors, 0.02 mm noise; the fitted robot's joint 1 axis tilted by 0.01
+    deg. The residual must be that robot's own point errors (they were off by the reflector offsets)."""
+    from types import SimpleNamespace
+
+    from kincal import _core
+    from kincal.diagnose.serial import evaluate
+
+    data = ident.simulate(_truth(kr500, 0.003), 150, seed=4, targets=3)
+    f = ident.identify(kr500, data, k_folds=0).fit
+    doc = json.loads(f.robot.to_json())
+    t = D(0.01)
+    doc["calibrated"]["joints"][0]["axis"] = [np.sin(t), 0.0, np.cos(t)]
+    tilted = _core.Robot.from_json(json.dumps(doc))
+    res = SimpleNamespace(layout=f.layout, robot=tilted, targets=f.targets, t_ref=f.t_ref, x=f.x, fixed=f.fixed)
+    grown = _core.PointModel(tilted, len(f.targets), list(f.layout.effect_list), f.t_ref, True).layout.parameters
+    assert len(grown) == len(f.layout.parameters) + 1  # the case under test: one parameter more
+    r = evaluate(res, data, [])[0]
+    e = np.linalg.norm(np.asarray(r).reshape(-1, 3), axis=1)
+    assert np.allclose(e, _core.point_errors(tilted, f.targets, data), atol=1e-6), np.max(e)

@@ -108,23 +108,33 @@ def _key(p) -> tuple:
 def evaluate(res, data: dict, extra: Sequence) -> tuple:
     """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
     parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
-    parameter index by key)."""
+    parameter index of each of them that is the fit's, by index)."""
     layout = res.layout
     pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True)
     new = pm.layout.parameters
     old = {_key(p): p.index for p in layout.parameters}
+    # the fit's parameters by name, not by place: the calibrated model may carry one the fit's did not
+    # (a joint 1 whose identified tilt puts it under gravity gains a compliance, inserted before the
+    # targets); an extra effect may repeat one of the fit's (its names come again, after the fit's)
+    fit_of: dict = {}
+    taken: set = set()
+    for p in new:
+        k = old.get(_key(p))
+        if k is not None and k not in taken:
+            fit_of[p.index] = k
+            taken.add(k)
     x = np.zeros(len(new))
     fit_x = np.asarray(res.x)
-    for p in new[:len(layout.parameters)]:
+    for p in new:
         # geometry, tool and base are corrections to the calibrated model (zero); compliances,
         # targets and effect values are absolute
-        if p.kind not in ("joint_geometry", "tool", "base") and _key(p) in old:
-            x[p.index] = fit_x[old[_key(p)]]
+        if p.kind not in ("joint_geometry", "tool", "base") and p.index in fit_of:
+            x[p.index] = fit_x[fit_of[p.index]]
     r, J = pm.residuals(list(x), data, True)
     J = np.asarray(J)
     fixed = np.asarray(res.fixed)
-    cur = J[:, [p.index for p in new[:len(layout.parameters)] if _key(p) in old and not fixed[old[_key(p)]]]]
-    return np.asarray(r), cur, J, new, old
+    cur = J[:, [i for i, k in fit_of.items() if not fixed[k]]]
+    return np.asarray(r), cur, J, new, fit_of
 
 
 class _Linearised:
@@ -140,18 +150,17 @@ class _Linearised:
 
     def __call__(self, cand) -> tuple:
         if self.cols is None:
-            self.r, self.cur, self.J, self.new, self.old = evaluate(self.res, self.data, self.extra)
+            self.r, self.cur, self.J, self.new, self.fit_of = evaluate(self.res, self.data, self.extra)
             self.cols = {}
         key = (cand.name, cand.joint, tuple(cand.harmonics))
         if key not in self.cols:
             if cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
-                r, cur, J, new, old = evaluate(self.res, self.data, [cand])  # not among the round's candidates
+                r, cur, J, new, fit_of = evaluate(self.res, self.data, [cand])  # not among the round's candidates
             else:
-                r, cur, J, new, old = self.r, self.cur, self.J, self.new, self.old
+                r, cur, J, new, fit_of = self.r, self.cur, self.J, self.new, self.fit_of
             kind = "compliance" if cand.name == "joint_compliance" else cand.name
-            n_fit = len(self.res.layout.parameters)
             idx = [p.index for p in new if p.kind == kind and p.joint == cand.joint
-                   and (kind == "compliance" or (p.index >= n_fit and p.effect == cand))]
+                   and (kind == "compliance" or (p.index not in fit_of and p.effect == cand))]
             self.cols[key] = (r, cur, J[:, idx])
         return self.cols[key]
 

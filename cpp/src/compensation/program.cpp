@@ -287,7 +287,7 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
     res = run(motion_directions(first.q_deg, {})[0]);
   }
   // the poses that take a joint's periodic effects outside the angles they were fitted on
-  if (opt.compensate && !res.q_deg.empty()) {
+  if (opt.compensate && !res.q_deg.empty() && !cal.spec().fitted_deg.empty()) {
     std::vector<double> q;
     q.reserve(res.q_deg.size() * 6);
     for (const Vec6& v : res.q_deg) q.insert(q.end(), v.data(), v.data() + 6);

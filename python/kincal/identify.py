@@ -18,7 +18,7 @@ import numpy as np
 from . import _core, gravity as _gravity, grouping, priors
 from ._core import Robot
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
-from .setups import _refit_placements, validate  # noqa: F401  (kincal.identify.validate, as before)
+from .setups import _refit_placements, _rms, validate  # noqa: F401  (kincal.identify.validate, as before)
 
 #: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
 DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
@@ -237,10 +237,6 @@ def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
 def _figures(e: np.ndarray, when: str, unit: str) -> dict:
     """RMS, mean (the Samak paper's figure) and max of errors: {when}_rms_{unit}, ..."""
     return {f"{when}_rms_{unit}": _rms(e), f"{when}_mean_{unit}": float(np.mean(e)), f"{when}_max_{unit}": float(np.max(e))}
-
-
-def _rms(e: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(e ** 2))) if len(e) else float("nan")
 
 
 @dataclass

@@ -187,8 +187,7 @@ def inside_and_outside(robot: Robot, data: dict, loss: str = "huber", loss_scale
         out |= np.asarray(_core.outside_range(q[:, e.joint - 1], e.fitted_deg))
 
     def part(m: np.ndarray) -> dict:
-        rms = (lambda x: float(np.sqrt(np.mean(x ** 2))) if len(x) else float("nan"))
-        return {"rows": int(m.sum()), "rms_mm": rms(ea[m]), "before_rms_mm": rms(eb[m])}
+        return {"rows": int(m.sum()), "rms_mm": _rms(ea[m]), "before_rms_mm": _rms(eb[m])}
 
     return {"inside": part(~out), "outside": part(out)}
 

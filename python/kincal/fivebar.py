@@ -151,22 +151,23 @@ def position_errors(points: dict) -> np.ndarray:
 
 
 def error_map_figure(maps: list, path: str, title: str = "five-bar positioning error") -> None:
-    """One panel per (label, points) pair: the error (um) at each desired position, same colour scale."""
+    """One panel per (label, points) pair: the error (um) at each desired position, one colour scale
+    (logarithmic: report.error_norm)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    vmax = max(float(position_errors(p).max()) for _, p in maps) * 1000
+    norm = report.error_norm(np.concatenate([position_errors(p) for _, p in maps]) * 1000)
     fig, axes = plt.subplots(1, len(maps), figsize=(4.2 * len(maps), 4.6), constrained_layout=True)
     axes = np.atleast_1d(axes)
     for ax, (label, p) in zip(axes, maps):
         e = position_errors(p) * 1000
-        sc = ax.scatter(p["desired"][:, 0], p["desired"][:, 1], c=e, s=18, cmap="viridis", vmin=0, vmax=vmax)
+        sc = ax.scatter(p["desired"][:, 0], p["desired"][:, 1], c=e, s=18, cmap="viridis", norm=norm)
         ax.set_title(f"{label}\nmax {e.max():.0f} um, RMS {np.sqrt(np.mean(e ** 2)):.0f} um", fontsize=10)
         ax.set_xlabel("x (mm)")
         ax.set_aspect("equal")
     axes[0].set_ylabel("y (mm)")
-    fig.colorbar(sc, ax=list(axes), label="position error (um)")
+    fig.colorbar(sc, ax=list(axes), label="position error (um, log scale)")
     fig.suptitle(title)
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -348,13 +349,16 @@ def write_diagnosis(pts: dict, diag: dict, out: Union[str, Path], title: str) ->
     named = effects_of(diag)
     before = dict(pts, desired=predict(pts, fit_with_effects(pts, []), []))
     after = dict(pts, desired=predict(pts, fit_with_effects(pts, named), named))
-    error_map_figure([("four lengths", before), ("with the named effects", after)], str(folder / "residual_map.png"),
-                     title="five-bar: model minus measured position")
+    error_map_figure([("four lengths", before)] + ([("with the named effects", after)] if named else []),
+                     str(folder / "residual_map.png"), title="five-bar: model minus measured position")
     rows = [[k + 1, s["effect"], s.get("link") or s["joint"], f"{s['evidence']['F']:.3g}",
              f"{s['rms_before_mm'] * 1000:.1f}", f"{s['rms_after_mm'] * 1000:.1f}"] for k, s in enumerate(diag["steps"])]
+    steps = (report.table(["step", "effect", "link / actuator", "F", "CV RMS before (um)", "after (um)"], rows,
+                          numeric=True, text=[1, 2]) if rows else
+             "<p>No effect was named: no candidate passed the test.</p>")
     body = f"""<h1>{report.esc(title)}</h1>
-{report.table(["step", "effect", "link / actuator", "F", "CV RMS before (um)", "after (um)"], rows)}
-<p>{report.esc(diag['verdict'])}: cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um.</p>
+{steps}
+<p>{report.esc(diag['verdict'])}: cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um; {report.esc(engine.noise_phrase(diag))}.</p>
 {report.figure("residual_map.png", "residual map")}"""
     report.write(folder / "report.html", title, body)
     _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
@@ -364,7 +368,8 @@ def diagnosis_summary(diag: dict) -> str:
     """`kincal diagnose --robot fivebar`'s summary: each named effect and the final verdict."""
     lines = [f"{st['effect']} {st.get('link') or st['joint']}: cross-validated RMS "
              f"{st['rms_before_mm'] * 1000:.1f} -> {st['rms_after_mm'] * 1000:.1f} um" for st in diag["steps"]]
-    return "\n".join(lines + [f"final {diag['final_rms_mm'] * 1000:.1f} um: {diag['verdict']}"])
+    return "\n".join(lines + [f"final {diag['final_rms_mm'] * 1000:.1f} um ({engine.noise_phrase(diag)}): "
+                              f"{diag['verdict']}"])
 
 
 def points_csv(pts: dict) -> str:

@@ -39,13 +39,29 @@ def page(title: str, body: str) -> str:
 """
 
 
-def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = False, labelled: bool = False) -> str:
+def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = False, labelled: bool = False,
+          text: Sequence[int] = ()) -> str:
     """A table of escaped cells; ``numeric``: the cells right-aligned (columns of numbers);
-    ``labelled``: with ``numeric``, the first column (the rows' names) left-aligned."""
-    h = "".join(f"<th>{esc(x)}</th>" for x in header)
-    b = "".join("<tr>" + "".join(f"<td>{esc(x)}</td>" for x in r) + "</tr>" for r in rows)
+    ``labelled``: with ``numeric``, the first column (the rows' names) left-aligned; ``text``: with
+    ``numeric``, these columns (0-based) left-aligned too (names among numbers)."""
+    left = ' style="text-align:left"'
+    h = "".join(f"<th{left if k in text else ''}>{esc(x)}</th>" for k, x in enumerate(header))
+    b = "".join("<tr>" + "".join(f"<td{left if k in text else ''}>{esc(x)}</td>" for k, x in enumerate(r)) + "</tr>"
+                for r in rows)
     cls = (' class="num lab"' if labelled else ' class="num"') if numeric else ""
     return f"<table{cls}><tr>{h}</tr>{b}</table>"
+
+
+def error_norm(values: Any):
+    """The colour scale of error maps drawn side by side (before and after a calibration or a
+    diagnosis): logarithmic and shared, so a map of microns beside one of millimetres is neither
+    one colour nor misread as the same size; from the largest value down to a thousandth of it."""
+    from matplotlib.colors import LogNorm
+    import numpy as np
+    v = np.asarray(values, dtype=float)
+    hi = float(np.max(v)) if v.size and np.max(v) > 0 else 1.0
+    pos = v[v > 0]
+    return LogNorm(vmin=max(float(np.min(pos)) if pos.size else hi, hi * 1e-3), vmax=hi)
 
 
 def figure(src: str, alt: str) -> str:

@@ -66,9 +66,18 @@ def test_two_effects_named_in_order_of_size(kr500):
 
 
 def test_nothing_hidden_nothing_named(kr500):
-    out = dg.diagnose(kr500, ident.simulate(_truth(kr500), 250, seed=8, targets=3))
+    """Truth: kr500 geometry, Gaussian noise 0.02 mm per coordinate. Without --noise the verdict
+    cannot say "at the noise level" (the final fit's scatter only bounds the noise); given the
+    instrument's noise, it can."""
+    data = ident.simulate(_truth(kr500), 250, seed=8, targets=3)
+    out = dg.diagnose(kr500, data)
     assert out["steps"] == []
-    assert "noise level" in out["verdict"]
+    assert out["verdict"].startswith("no structure left that the library finds") and not out["noise_known"]
+    assert "noise level" not in out["verdict"]
+    known = dg.diagnose(kr500, data, noise_mm=0.02)
+    assert known["steps"] == [] and known["noise_known"]
+    assert known["verdict"] == "what remains is at the noise level"
+    assert known["noise_rms_mm"] == pytest.approx(NOISE)
 
 
 @pytest.mark.parametrize("hidden,expect", [
@@ -136,6 +145,8 @@ def test_cli_writes_diagnosis_report_and_model(tmp_path):
     page = (tmp_path / "d" / "report.html").read_text()
     assert "gap.png" in page and "residual_map.png" in page
     assert "model.json was written" in page
+    # the noise was not given: the page never calls the fit's scatter a noise estimate
+    assert "noise not known (the final fit" in page and "noise estimate" not in page
     for f in ("gap.png", "residual_map.png", "step1.png"):
         assert (tmp_path / "d" / f).read_bytes()[:4] == b"\x89PNG"
 
@@ -231,3 +242,38 @@ def test_linearisation_copies_the_fit_by_name_when_the_model_gains_a_parameter(k
     r = evaluate(res, data, [])[0]
     e = np.linalg.norm(np.asarray(r).reshape(-1, 3), axis=1)
     assert np.allclose(e, _core.point_errors(tilted, f.targets, data), atol=1e-6), np.max(e)
+
+
+def test_report_helpers_name_what_they_show():
+    """The report's labels: the starting model with each effect's joints gathered; a held-out share
+    at or below zero read as none; a p-value that underflows is not printed as 0; the error maps'
+    shared colour scale tells 5 um from 1000 um (logarithmic, down to a thousandth of the largest)."""
+    from kincal import report
+    from kincal.diagnose import serial_report as sr
+
+    assert sr._compact("geometry + joint_compliance(joint 2) + joint_compliance(joint 3) + backlash(joint 2)") == \
+        "geometry + joint_compliance(2, 3) + backlash(2)"
+    assert sr._compact("geometry") == "geometry"
+    assert sr._share(0.123) == "12.3%" and sr._share(-0.017) == "none (-1.7%)" and sr._share(0.0) == "none (0.0%)"
+    assert sr._p(0.0) == "< 1e-300" and sr._p(4.2e-63) == "4.2e-63"
+    norm = report.error_norm(np.r_[np.linspace(200.0, 1000.0, 50), np.linspace(3.0, 8.0, 50)])
+    assert norm.vmax == 1000.0 and norm.vmin == 3.0
+    assert norm(5.0) < 0.35 < 0.65 < norm(200.0)  # the after map's microns and the before map's apart
+    assert report.error_norm(np.r_[0.0, 0.001, 1000.0]).vmin == 1.0  # a thousandth of the largest at least
+
+
+def test_fivebar_report_without_a_named_effect_says_so(tmp_path):
+    """Truth: the Kiper paper's Table I points (data/fivebar-table1.csv): few points, nothing named.
+    The report says that no effect was named, shows no "with the named effects" map and does not
+    call what remains the noise (no --noise given)."""
+    from conftest import SHARED
+
+    table = SHARED / "data" / "fivebar-table1.csv"
+    if not table.exists():
+        pytest.skip(f"{table} is not present")
+    r = run("kincal", "diagnose", "--robot", "fivebar", "--data", str(table), "--out", str(tmp_path / "d"))
+    assert r.returncode == 0, r.stderr
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    assert doc["steps"] == [] and not doc["noise_known"]
+    page = (tmp_path / "d" / "report.html").read_text()
+    assert "No effect was named" in page and "noise level" not in page and "noise not known" in page

@@ -262,8 +262,9 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
     (``errors``, ``n_params`` free parameters). noise_rms_mm: with ``noise_mm`` (the instrument's
     noise per coordinate, if known) its RMS per point; otherwise the final fit's own scatter, an
     upper bound of the noise. "At the noise level" when the cross-validated RMS is within 1.3 times
-    the known noise, or, with the noise unknown, when no candidate of the last round (of the LISTED
-    best) is even significant."""
+    the known noise; with the noise unknown, "no structure left that the library finds" when no
+    candidate of the last round (of the LISTED best) is even significant (not "at the noise level":
+    with few points nothing is significant, whatever remains)."""
     dims = problem.dims
     scatter = math.sqrt(float(np.sum(errors ** 2)) / max(1, dims * len(errors) - n_params)) * math.sqrt(dims)
     left = [s for s in found.last_scores if s["p_value"] < alpha]
@@ -274,14 +275,26 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
         noise = scatter
         at_noise = not left
     if at_noise:
-        verdict = "what remains is at the noise level"
+        verdict = ("what remains is at the noise level" if noise_mm is not None else
+                   "no structure left that the library finds: what remains looks like noise (its level is not "
+                   "known)")
     else:
         gains = ", ".join(f"{problem.label(s['_cand'])} {s['cv_gain']:.1%}" for s in left[:3])
         verdict = ("what remains is structured but not explained by the library"
                    + (f" (significant candidates gain too little: {gains})" if left else ""))
-    say(f"{len(found.steps)} effect(s) named; cross-validated RMS {found.cv_rms_mm * 1000:.1f} um, noise estimate "
-        f"{noise * 1000:.1f} um: {verdict}")
-    return {"noise_rms_mm": noise, "noise_known": noise_mm is not None, "fit_scatter_mm": scatter, "verdict": verdict}
+    out = {"noise_rms_mm": noise, "noise_known": noise_mm is not None, "fit_scatter_mm": scatter, "verdict": verdict}
+    say(f"{len(found.steps)} effect(s) named; cross-validated RMS {found.cv_rms_mm * 1000:.1f} um, {noise_phrase(out)}: "
+        f"{verdict}")
+    return out
+
+
+def noise_phrase(diag: dict) -> str:
+    """How a summary or report names the noise a verdict compares with: the instrument's, when given,
+    or else the final fit's own scatter, which only bounds it (it also holds what no model explains)."""
+    if diag["noise_known"]:
+        return f"the instrument's noise {diag['noise_rms_mm'] * 1000:.1f} um"
+    return (f"noise not known (the final fit's own scatter, {diag['noise_rms_mm'] * 1000:.1f} um, only bounds it; "
+            f"--noise gives it)")
 
 
 def contract_json(diag: dict) -> dict:

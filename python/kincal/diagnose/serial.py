@@ -339,8 +339,8 @@ def summary(diag: dict, model: "ident.Identification", out: Union[str, Path], se
         o = f" order {st['order']}" if st.get("order") else ""
         lines.append(f"{st['effect']}{j}{o}: cross-validated RMS {st['rms_before_mm'] * 1000:.1f} -> "
                      f"{st['rms_after_mm'] * 1000:.1f} um (F = {st['evidence']['F']:.3g})")
-    lines.append(f"final cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um, noise estimate "
-                 f"{diag['noise_rms_mm'] * 1000:.1f} um: {diag['verdict']} ({seconds:.1f} s); "
+    lines.append(f"final cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um, {engine.noise_phrase(diag)}: "
+                 f"{diag['verdict']} ({seconds:.1f} s); "
                  f"report: {folder / 'report.html'}; model ({' + '.join(['geometry'] + model.effect_labels())}): "
                  f"{folder / 'model.json'}")
     if diag.get("residual_summary"):

@@ -12,6 +12,7 @@ from .. import _core
 from .. import report
 from .._core import Robot
 from . import residual_vars
+from .engine import noise_phrase
 from .serial import Spec, step_effect
 
 
@@ -36,14 +37,22 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
     return tau, f"gravity torque on joint {joint} (kN m)"
 
 
-def _joint_error(res, data: dict, joint: int) -> np.ndarray:
+#: a row whose point the joint moves less than this share of the median row's (|J_j|) implies no
+#: readable angle error of that joint: a residual of microns reads as degrees there
+LEVER = 0.25
+
+
+def _joint_error(res, data: dict, joint: int) -> tuple:
     """The angle error of ``joint`` (deg) each row's residual implies: the least-squares joint-angle
-    change that would close it (-J_j . r / J_j . J_j, J_j the joint's column at the fit)."""
+    change that would close it (-J_j . r / J_j . J_j, J_j the joint's column at the fit); and which
+    rows the joint moves enough (|J_j| at least LEVER times the median row's) to read it."""
     r, C = residual_vars.carriers(res, data)
     n = len(data["pose"])
     Jj = C[:, 6 + joint - 1].reshape(n, -1)
     rr = r.reshape(n, -1)
-    return -np.degrees(np.sum(Jj * rr, axis=1) / np.maximum(np.sum(Jj * Jj, axis=1), 1e-300))
+    lever = np.sqrt(np.sum(Jj * Jj, axis=1))
+    err = -np.degrees(np.sum(Jj * rr, axis=1) / np.maximum(lever ** 2, 1e-300))
+    return err, lever >= LEVER * np.median(lever)
 
 
 def _effect_curve(res, data: dict, effect, var: np.ndarray):
@@ -75,10 +84,17 @@ def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, af
     curve), as the point error otherwise."""
     effect = step_effect(st)
     var, lab = _variable(robot, data, st["effect"], st["joint"])
-    fig, ax = plt.subplots(figsize=(6.5, 3.4), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(7.5, 3.4), constrained_layout=True)
+    notes = []
     if effect.joint > 0:
-        b, a = _joint_error(before_fit, data, effect.joint), _joint_error(after_fit, data, effect.joint)
+        (b, seen), (a, _) = _joint_error(before_fit, data, effect.joint), _joint_error(after_fit, data, effect.joint)
+        if not seen.all():
+            notes.append(f"{int(np.sum(~seen))} points the joint barely moves left out")
+        var, b, a = var[seen], b[seen], a[seen]
         lim = float(np.percentile(np.abs(b), 99.5)) * 1.3 or 1.0
+        clipped = int(np.sum((np.abs(b) > lim) | (np.abs(a) > lim)))
+        if clipped:
+            notes.append(f"{clipped} beyond +-{lim * 1000:.0f} mdeg drawn on the frame")
         ax.scatter(var, np.clip(b, -lim, lim) * 1000, s=6, alpha=0.5, label="before")
         ax.scatter(var, np.clip(a, -lim, lim) * 1000, s=6, alpha=0.5, label="after")
         curve = _effect_curve(after_fit, data, effect, var)
@@ -92,10 +108,30 @@ def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, af
         ax.scatter(var, _point_errors(after_fit, data) * 1000, s=6, alpha=0.6, label="after")
         ax.set_ylabel("point error (um)")
     ax.set_xlabel(lab)
-    ax.set_title(f"step {k + 1}: {_label(st)}", fontsize=10)
-    ax.legend(fontsize=8, loc="best")
+    ax.set_title(f"step {k + 1}: {_label(st)}" + (f"\n({'; '.join(notes)})" if notes else ""), fontsize=10)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)  # beside the data, never on it
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def _compact(model: str) -> str:
+    """A model's label with the joints of each effect gathered: "geometry + joint_compliance(2, 3)"
+    for "geometry + joint_compliance(joint 2) + joint_compliance(joint 3)"."""
+    joints: dict = {}
+    for part in model.split(" + "):
+        name, _, rest = part.partition("(")
+        joints.setdefault(name, []).extend([rest.rstrip(")").replace("joint ", "")] if rest else [])
+    return " + ".join(f"{n}({', '.join(j)})" if j else n for n, j in joints.items())
+
+
+def _p(p: float) -> str:
+    """A p-value for the table (one that underflows to 0 is below what a double holds, not 0)."""
+    return f"{p:.2g}" if p > 0 else "< 1e-300"
+
+
+def _share(share: float) -> str:
+    """A held-out share for the table: below zero the variable explains nothing (its fit only adds noise)."""
+    return f"{share:.1%}" if share > 0 else f"none ({share:.1%})"
 
 
 def _point_errors(res, data: dict) -> np.ndarray:
@@ -140,14 +176,14 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     # one horizontal bar per step, labelled by the effect that step added (the model is cumulative):
     # long labels never overlap
     fig, ax = plt.subplots(figsize=(8, 1.2 + 0.45 * len(hist)), constrained_layout=True)
-    labels = [h["model"].split(" + ")[-1] if k else "geometry" for k, h in enumerate(hist)]
-    labels = [lab if k == 0 else "+ " + lab for k, lab in enumerate(labels)]
+    labels = [_compact(h["model"]) if k == 0 else "+ " + h["model"].split(" + ")[-1] for k, h in enumerate(hist)]
     y = np.arange(len(hist))[::-1]
     vals = [h["cv_rms_mm"] * 1000 for h in hist]
     ax.barh(y, vals, color="tab:blue")
     for yy, v in zip(y, vals):
         ax.text(v, yy, f" {v:.1f}", va="center", fontsize=8)
-    ax.axvline(diag["noise_rms_mm"] * 1000, color="k", ls="--", label="noise estimate")
+    ax.axvline(diag["noise_rms_mm"] * 1000, color="k", ls="--",
+               label="the instrument's noise" if diag["noise_known"] else "the final fit's scatter\n(noise not known:\nit only bounds it)")
     ax.set_yticks(y, labels, fontsize=8)
     ax.set_xlabel("cross-validated RMS (um), each step adds one effect to the model above it")
     ax.set_xlim(0, max(vals) * 1.15)
@@ -160,14 +196,14 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     e0 = start.errors(start.fit(robot, data), data)
     e1 = diag["_spec"].errors(diag["_final_fit"], data)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
-    vmax = float(np.max(e0)) * 1000
+    norm = report.error_norm(np.concatenate([e0, e1]) * 1000)
     for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
-        sc = ax.scatter(data["xyz"][:, 0], data["xyz"][:, 1], c=e * 1000, s=8, cmap="viridis", vmin=0, vmax=vmax)
+        sc = ax.scatter(data["xyz"][:, 0], data["xyz"][:, 1], c=e * 1000, s=8, cmap="viridis", norm=norm)
         ax.set_title(f"{lab}: RMS {np.sqrt(np.mean(e ** 2)) * 1000:.1f} um (fitted points)", fontsize=10)
         ax.set_xlabel("x (mm, instrument)")
         ax.set_aspect("equal")
     axes[0].set_ylabel("y (mm, instrument)")
-    fig.colorbar(sc, ax=list(axes), label="point error (um)")
+    fig.colorbar(sc, ax=list(axes), label="point error (um, log scale)")
     fig.savefig(out / "residual_map.png", dpi=100)
     plt.close(fig)
     files.append("residual_map.png")
@@ -184,10 +220,10 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
         before = after
     # 4. what remains against every candidate variable
     scores = diag.get("residual_variables", [])
-    if scores:
+    if scores and max(sc_["share"] for sc_ in scores) > 0:  # no chart of bars that all say "nothing"
         _variables_figure(plt, scores, out / "residual_variables.png")
         files.append("residual_variables.png")
-    rows = [[k + 1, _label(s), f"{s['evidence']['F']:.3g}", f"{s['evidence']['p_value']:.2g}",
+    rows = [[k + 1, _label(s), f"{s['evidence']['F']:.3g}", _p(s['evidence']['p_value']),
              f"{s['evidence']['cv_gain_linear']:.1%}", f"{s['rms_before_mm'] * 1000:.1f}",
              f"{s['rms_after_mm'] * 1000:.1f}"] for k, s in enumerate(diag["steps"])]
     notes = "".join(f"<li>{report.esc(n)}</li>" for n in diag["notes"])
@@ -202,10 +238,11 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
 residual of the current model (projected off what the model can already absorb), adds the best significant one,
 refits everything and checks that the cross-validated RMS falls ({diag['folds']} folds of whole configurations:
 the repeats of one of the {diag['validation']['configurations']} configurations never sit on both sides).</p>
-{report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True)
+{report.table(["step", "effect", "F", "p", "linear CV gain", "CV RMS before (um)", "after (um)"], rows, numeric=True,
+              text=[1])
  if rows else "<p>No effect was named: no candidate of the library passed the test.</p>"}
-<p><b>Result:</b> cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um against a noise estimate of
-{diag['noise_rms_mm'] * 1000:.1f} um: {report.esc(diag['verdict'])}.</p>
+<p><b>Result:</b> cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um; {report.esc(noise_phrase(diag))}:
+{report.esc(diag['verdict'])}.</p>
 <ul>{notes}</ul>
 <h2>The gap, step by step</h2>{report.figure("gap.png", "gap")}
 <h2>Where the model and the measurements disagree</h2>{report.figure("residual_map.png", "residual map")}
@@ -217,9 +254,9 @@ effect's curve less its mean over the points (a constant is the joint's offset, 
 <p>The final model's residual fitted, held out on the same folds, as a smooth function of each variable acting on
 the instrument's placement and on every joint angle: {report.esc(diag.get("residual_summary", ""))}.</p>
 {report.table(["variable", "what", "share held out", "RMS explained (um)"],
-              [[s["variable"], s["label"], f"{s['share']:.1%}", f"{s['rms_explained_mm'] * 1000:.1f}"]
+              [[s["variable"], s["label"], _share(s["share"]), f"{s['rms_explained_mm'] * 1000:.1f}"]
                for s in scores], numeric=False)}
-{report.figure("residual_variables.png", "residual variables") if scores else ""}
+{report.figure("residual_variables.png", "residual variables") if "residual_variables.png" in files else ""}
 {model_note}
 <p>Files: diagnosis.json (the contract's summary), {", ".join(([model_file] if model_file else []) + files)}.</p>"""
     report.write(out / "report.html", title, body)

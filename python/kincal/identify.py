@@ -292,7 +292,7 @@ class Identification:
                  _gravity.summary_line(f), ""]
         lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
                      f"{'mean after':>12}{'max before':>12}{'max after':>12}")
-        lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}{'':>24}"
+        lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}{'-':>12}{'-':>12}"
                      f"{f.nominal_max_mm:>12.4f}{f.max_mm:>12.4f}")
         for unit, label in (("mm", "held-out poses"), ("deg", "orientation (deg), held out")):
             if f"after_rms_{unit}" in v:
@@ -333,11 +333,13 @@ class Identification:
             lines.append("strong correlations:")
             for a, b, r in f.correlations[:20]:
                 lines.append(f"  {a:<22} {b:<22} {r:+.3f}")
-        lines.append("parameters (value +- standard deviation):")
+        lines.append("parameters (value +- standard deviation; angles in deg, as in the model file):")
         for p in self.parameters():
             if not p["fixed"]:
-                sd = "" if p["stddev"] is None else f" +- {p['stddev']:.3g}"
-                lines.append(f"  {p['name']:<22} {p['value']:+.6g}{sd} {p['unit']}")
+                k, unit = (math.degrees(1.0), p["unit"].replace("rad", "deg")) if p["unit"].startswith("rad") else \
+                    (1.0, p["unit"])
+                sd = "" if p["stddev"] is None else f" +- {p['stddev'] * k:.3g}"
+                lines.append(f"  {p['name']:<22} {p['value'] * k:+.6g}{sd} {unit}")
         return "\n".join(lines)
 
 

@@ -107,13 +107,15 @@ def cmd_simulate(args) -> None:
             raise ValueError(f"{args.truth}: {truth.dof} joints but {args.robot} has {robot.dof}")
     else:
         truth = ident.default_truth(robot, seed=args.seed)
-        if args.truth_out:
-            _core.write_file_atomic(args.truth_out, truth.to_json())
     pool = args.poses * (10 if args.select == "observability" else 1)
+    hidden = [ident.parse_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide]
     data = ident.simulate(truth, pool, seed=args.seed, noise_mm=args.noise, targets=args.targets,
-                          outlier_fraction=args.outliers, outlier_mm=args.outlier_mm,
-                          effects=[ident.parse_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide],
+                          outlier_fraction=args.outliers, outlier_mm=args.outlier_mm, effects=hidden,
                           orientation_noise_deg=args.orientation_noise, duration_h=args.duration)
+    if args.truth_out and not args.truth:  # the truth as measured: its hidden effects too (not the
+        # instrument's drift, a property of the measurement that no robot model carries)
+        acting = [e for e in hidden if e[0].name != "drift"]
+        _core.write_file_atomic(args.truth_out, (truth.with_effects(acting, 20.0) if acting else truth).to_json())
     if args.select == "observability":
         from . import plan
         data = plan.select_observable(robot, data, args.poses)

@@ -252,10 +252,17 @@ class Identification:
     worst: list = field(default_factory=list)  #: priors.down_weighted(): the most down-weighted rows
 
     def parameters(self) -> list:
+        """Every parameter of the fit in the model file's units (angles in degrees: the core's radians
+        converted), with its standard deviation, prior and why it was held, if it was."""
         f = self.fit
-        return [{"name": p.name, "kind": p.kind, "joint": p.joint or None, "unit": p.unit, "value": float(v),
-                 "stddev": (None if math.isnan(s) else float(s)), "fixed": bool(fx), "reason": r,
-                 "at_prior": bool(ap), "prior_sd": (float(ps) if math.isfinite(ps) else None)}
+
+        def scale(unit: str) -> tuple:
+            return (math.degrees(1.0), unit.replace("rad", "deg")) if unit.startswith("rad") else (1.0, unit)
+
+        return [{"name": p.name, "kind": p.kind, "joint": p.joint or None, "unit": scale(p.unit)[1],
+                 "value": float(v) * scale(p.unit)[0],
+                 "stddev": (None if math.isnan(s) else float(s) * scale(p.unit)[0]), "fixed": bool(fx), "reason": r,
+                 "at_prior": bool(ap), "prior_sd": (float(ps) * scale(p.unit)[0] if math.isfinite(ps) else None)}
                 for p, v, s, fx, r, ap, ps in zip(f.layout.parameters, f.x, f.stddev, f.fixed, f.fixed_reason,
                                                   f.at_prior, f.prior_sd)]
 
@@ -333,13 +340,11 @@ class Identification:
             lines.append("strong correlations:")
             for a, b, r in f.correlations[:20]:
                 lines.append(f"  {a:<22} {b:<22} {r:+.3f}")
-        lines.append("parameters (value +- standard deviation; angles in deg, as in the model file):")
+        lines.append("parameters (value +- standard deviation):")
         for p in self.parameters():
             if not p["fixed"]:
-                k, unit = (math.degrees(1.0), p["unit"].replace("rad", "deg")) if p["unit"].startswith("rad") else \
-                    (1.0, p["unit"])
-                sd = "" if p["stddev"] is None else f" +- {p['stddev'] * k:.3g}"
-                lines.append(f"  {p['name']:<22} {p['value'] * k:+.6g}{sd} {unit}")
+                sd = "" if p["stddev"] is None else f" +- {p['stddev']:.3g}"
+                lines.append(f"  {p['name']:<22} {p['value']:+.6g}{sd} {p['unit']}")
         return "\n".join(lines)
 
 

@@ -234,5 +234,5 @@ def test_cli_prior_options(tmp_path):
     assert r.returncode == 0, r.stderr
     doc = json.loads(out.read_text())["identification"]
     tilt = next(p for p in doc["parameters"] if p["name"] == "joint3.tilt_u")
-    assert tilt["prior_sd"] == pytest.approx(np.radians(0.05))
+    assert tilt["prior_sd"] == pytest.approx(0.05) and tilt["unit"] == "deg"  # the file's unit
     assert doc["loss"]["scale_from"] == "the residuals' robust spread" and "robust loss: huber" in r.stdout

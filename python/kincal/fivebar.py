@@ -344,8 +344,11 @@ def effects_of(diag: dict) -> list:
 def write_diagnosis(pts: dict, diag: dict, out: Union[str, Path], title: str) -> None:
     """In the folder ``out``: residual_map.png (the four lengths against the model with the named
     effects), report.html and diagnosis.json."""
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
+    with report.staged_folder(out) as folder:  # the whole folder or nothing
+        _write_diagnosis(pts, diag, folder, title)
+
+
+def _write_diagnosis(pts: dict, diag: dict, folder: Path, title: str) -> None:
     named = effects_of(diag)
     before = dict(pts, desired=predict(pts, fit_with_effects(pts, []), []))
     after = dict(pts, desired=predict(pts, fit_with_effects(pts, named), named))

@@ -5,9 +5,13 @@ loaded it, so a headless browser can check that every figure shows."""
 
 from __future__ import annotations
 
+import contextlib
 import html
+import os
+import shutil
+import tempfile
 from pathlib import Path
-from typing import Any, Iterable, Sequence, Union
+from typing import Any, Iterable, Iterator, Sequence, Union
 
 from . import _core
 
@@ -72,3 +76,25 @@ def figure(src: str, alt: str) -> str:
 def write(path: Union[str, Path], title: str, body: str) -> None:
     """The page written atomically to ``path``."""
     _core.write_file_atomic(str(path), page(title, body))
+
+
+@contextlib.contextmanager
+def staged_folder(out: Union[str, Path]) -> Iterator[Path]:
+    """A folder of outputs written whole or not at all: the files go into a hidden folder beside
+    ``out``, and only once every one is written (and none of their names is taken by a folder in
+    ``out``) are they moved into ``out`` (created). On any error ``out`` is left as it was."""
+    folder = Path(out)
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
+    try:
+        yield stage
+        names = sorted(p.name for p in stage.iterdir())
+        taken = [n for n in names if (folder / n).is_dir()]
+        if taken:
+            raise ValueError(f"{folder / taken[0]} is a folder: it is in the way of the file of that name "
+                             "(nothing was written)")
+        folder.mkdir(parents=True, exist_ok=True)
+        for n in names:
+            os.replace(stage / n, folder / n)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)

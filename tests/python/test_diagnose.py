@@ -277,3 +277,16 @@ def test_fivebar_report_without_a_named_effect_says_so(tmp_path):
     assert doc["steps"] == [] and not doc["noise_known"]
     page = (tmp_path / "d" / "report.html").read_text()
     assert "No effect was named" in page and "noise level" not in page and "noise not known" in page
+
+
+def test_a_failed_diagnosis_leaves_its_folder_as_it_was(tmp_path):
+    """Truth: kr500 (kincal simulate's default, seed 1), 40 poses. A folder named model.json stands
+    where the diagnosis writes its model: the command fails naming it, and the output folder holds
+    nothing but that folder (no report, no diagnosis.json, no figures, no staging folder)."""
+    r = run("kincal", "simulate", "--robot", "kr500", "--poses", "40", "--out", str(tmp_path / "m.csv"))
+    assert r.returncode == 0, r.stderr
+    (tmp_path / "d" / "model.json").mkdir(parents=True)
+    r = run("kincal", "diagnose", "--robot", "kr500", "--data", str(tmp_path / "m.csv"), "--out", str(tmp_path / "d"))
+    assert r.returncode != 0 and "model.json is a folder" in r.stderr, r.stderr
+    assert [p.name for p in (tmp_path / "d").iterdir()] == ["model.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "m.csv"]

@@ -15,7 +15,7 @@ from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 
-from .. import _core, grouping
+from .. import _core, grouping, report
 from .. import identify as ident
 from .._core import Robot
 from . import engine, residual_vars
@@ -321,11 +321,10 @@ def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_tar
         {"effect": e.name, "joint": e.joint or None, "label": e.label,
          "values": [v * sc for v, sc in zip(vals, e.file_scale)], "units": e.file_units}
         for e, vals in model.robot.effects]
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    write_report(robot, data, diag, folder, title=title, model_file="model.json")
-    _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
-    _core.write_file_atomic(str(folder / "model.json"), model.model_json())
+    with report.staged_folder(out) as folder:  # the whole folder or nothing
+        write_report(robot, data, diag, folder, title=title, model_file="model.json")
+        _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
+        _core.write_file_atomic(str(folder / "model.json"), model.model_json())
     return diag, model
 
 

@@ -290,3 +290,24 @@ def test_a_failed_diagnosis_leaves_its_folder_as_it_was(tmp_path):
     assert r.returncode != 0 and "model.json is a folder" in r.stderr, r.stderr
     assert [p.name for p in (tmp_path / "d").iterdir()] == ["model.json"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "m.csv"]
+
+
+def test_a_model_without_masses_says_why_compliance_is_no_candidate(tmp_path, kr500):
+    """A URDF robot without <inertial> blocks (the kr500 geometry): no joint carries a known gravity
+    torque, so joint_compliance is no candidate, and the notes say so and how to start from it."""
+    import re
+
+    spec = json.loads(kr500.to_json())["nominal"]
+    text = re.sub(r"<inertial>.*?</inertial>", "", spec_urdf(spec, "urdf_robot"), flags=re.S)
+    assert "<inertial" not in text
+    (tmp_path / "r.urdf").write_text(text)
+    robot = kincal.load_robot(str(tmp_path / "r.urdf"))
+    cands, notes = dg.serial.candidates(robot, ident.simulate(_truth(robot), 20, seed=5))
+    assert "joint_compliance" not in {c.name for c in cands}
+    assert any(n.startswith("joint_compliance skipped: the model has no link masses") and
+               "--effects joint_compliance" in n for n in notes), notes
+    # the massed URDF keeps the candidate (the note is about the masses, not the URDF)
+    (tmp_path / "m.urdf").write_text(spec_urdf(spec, "urdf_robot"))
+    massed = kincal.load_robot(str(tmp_path / "m.urdf"))
+    assert "joint_compliance" in {c.name for c in dg.serial.candidates(massed, ident.simulate(_truth(massed), 20,
+                                                                                             seed=5))[0]}

@@ -43,6 +43,9 @@ def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, li
     from) are no candidates."""
     out, notes = [], []
     have = {(e.name, e.joint) for e in start}
+    # identify's --gravity auto: the torques come from the link masses when any link has one (the core's
+    # gravity_fitted)
+    masses = any(j["mass_kg"] > 0 for j in json.loads(robot.to_json())["nominal"]["joints"])
     for kind in _core.effect_kinds():
         if kind.domain != "serial":
             continue
@@ -60,6 +63,11 @@ def candidates(robot: Robot, data: dict, start: Sequence = ()) -> tuple[list, li
             notes.append(f"{kind.name} skipped: the data have no {col} column")
             continue
         joints = ident.applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
+        if kind.gravity_loaded_only and not masses:  # its columns would be 0: no torque to scale
+            notes.append(f"{kind.name} skipped: the model has no link masses, so no joint carries a known gravity "
+                         f"torque (--effects {kind.name} starts the diagnosis from it, the torques' mass moments "
+                         "identified as `kincal identify --gravity fit` does)")
+            continue
         if kind.name == "joint_map":  # the highest order: the engine chooses among its variants
             out += [_core.Effect(kind.name, j, order=MAX_MAP_ORDER) for j in joints if (kind.name, j) not in have]
         else:

@@ -173,9 +173,9 @@ def cmd_hr_fit(args) -> None:
 
 
 def cmd_hr_matrix(args) -> None:
-    fivebar.load_fit(args.fit)  # a readable FIT.json (the matrix belongs to the model that commanded the grid)
-    pts = fivebar.read_table(args.data)
-    m = _core.ErrorMatrix.from_points(pts, args.data)
+    model, pts = fivebar.load_fit(args.fit), fivebar.read_table(args.data)
+    m = _core.ErrorMatrix.from_points(pts, args.data)  # a regular grid first, then commanded by the fit
+    fivebar.check_commanded_by(model, pts, args.fit, args.data)
     _core.write_file_atomic(args.out, m.to_json())
     e = fivebar.position_errors(pts)
     print(f"error matrix {m.nx} x {m.ny} nodes, {m.dx:g} x {m.dy:g} mm, from ({m.x0:g}, {m.y0:g}); "

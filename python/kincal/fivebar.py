@@ -145,6 +145,29 @@ def command(model: FiveBar, xy: np.ndarray, matrix: Optional[ErrorMatrix] = None
     return _core.fivebar_command(model, matrix, np.asarray(xy, dtype=float).reshape(-1, 2))
 
 
+#: how far (deg) a grid's angles may be from its model's commands: the rounding of a controller's
+#: numbers, far below what a different fit changes (hundredths to tenths of a degree)
+COMMAND_TOLERANCE_DEG = 0.005
+
+
+def check_commanded_by(model: FiveBar, pts: dict, fit_file: str, grid_file: str) -> dict:
+    """``pts`` when its angles are the commands ``model`` gives for its desired points: an error
+    matrix corrects the model that commanded the grid, and only that one. Otherwise a ValueError
+    naming the grid's line, the angles and the model's."""
+    q = command(model, pts["desired"])
+    diff = np.max(np.abs(q - np.c_[pts["theta1_deg"], pts["theta2_deg"]]), axis=1)
+    k = int(np.argmax(diff))
+    if diff[k] > COMMAND_TOLERANCE_DEG:
+        raise ValueError(f"{grid_file}:{int(pts['line'][k])}: the grid was not commanded by {fit_file}: point "
+                         f"{int(pts['id'][k])} has theta1, theta2 = {pts['theta1_deg'][k]:.4f}, "
+                         f"{pts['theta2_deg'][k]:.4f} deg where that model commands {q[k, 0]:.4f}, {q[k, 1]:.4f} "
+                         f"({int(np.sum(diff > COMMAND_TOLERANCE_DEG))} of {len(diff)} points differ by more than "
+                         f"{COMMAND_TOLERANCE_DEG} deg). The matrix corrects the model that commanded the grid: "
+                         "measure a grid commanded by this fit (kincal hidden-robot command), or give the fit "
+                         "that commanded it")
+    return pts
+
+
 def position_errors(points: dict) -> np.ndarray:
     """Distance (mm) between desired and measured position of every point."""
     return np.linalg.norm(points["measured"] - points["desired"], axis=1)

@@ -145,3 +145,25 @@ def test_hidden_robot_bad_input(tmp_path, case):
     assert r.returncode == 1
     assert msg in r.stderr, r.stderr
     assert not out.exists()
+
+
+def test_matrix_refuses_a_grid_another_model_commanded(tmp_path):
+    """Truth: the simulated 6-bar of `hidden-robot simulate`; a minimax fit on Table I's 9 positions
+    (20 um noise) commands the 5 mm grid. A matrix for a different fit (every length 0.2 mm longer)
+    would correct the wrong model: refused, naming the grid's line and the fit, nothing written;
+    with the fit that commanded the grid it is written."""
+    fit, other = tmp_path / "fit.json", tmp_path / "other.json"
+    _xy(tmp_path / "table.csv", TABLE_XY)
+    for s in (("simulate", "--noise", "0.02", "--targets", str(tmp_path / "table.csv"), "--out", str(tmp_path / "t.csv")),
+              ("fit", "--data", str(tmp_path / "t.csv"), "--method", "minimax", "--out", str(fit)),
+              ("simulate", "--fit", str(fit), "--out", str(tmp_path / "grid.csv"))):
+        r = run("kincal", "hidden-robot", *s)
+        assert r.returncode == 0, (s, r.stderr)
+    doc = json.loads(fit.read_text())
+    other.write_text(json.dumps({**doc, **{k: doc[k] + 0.2 for k in "abcd"}}))
+    out = tmp_path / "m.json"
+    r = run("kincal", "hidden-robot", "matrix", "--fit", str(other), "--data", str(tmp_path / "grid.csv"), "--out", str(out))
+    assert r.returncode == 1 and "grid.csv:" in r.stderr and f"not commanded by {other}" in r.stderr, r.stderr
+    assert not out.exists()
+    r = run("kincal", "hidden-robot", "matrix", "--fit", str(fit), "--data", str(tmp_path / "grid.csv"), "--out", str(out))
+    assert r.returncode == 0 and out.exists(), r.stderr

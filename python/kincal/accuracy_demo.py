@@ -77,7 +77,7 @@ def iso9283_runs(robot, nominal_fitted, models: dict, truth, out: Path, seed: in
         table = [[names[i], cycles[i], *taught[i], *att[i]] for i in measured]
         _core.write_file_atomic(str(folder / "runs.csv"), format_rows(RUNS_HEAD, table))
         res = accrep.run_iso9283(str(folder / "runs.csv"), str(folder), distance="P2,P4",
-                                 frame_label="the tracker's (the demo's simulated campaign)")
+                                 frame_label="the tracker's (the demo's simulated campaign)", label=f"kr500, {label}")
         reports[key] = {"label": label, "report": res}
     return {"plan": plan, "programs": reports}
 
@@ -111,7 +111,8 @@ def fivebar_axes(sixbar, model, matrix, out: Path, seed: int) -> dict:
             folder = out / "fivebar" / f"axis_{mech}_{name}"
             folder.mkdir(parents=True, exist_ok=True)
             _axis_csv(folder / "axis.csv", sixbar, m, mx, line, coord, seed + 100 * len(res))
-            res[(mech, name)] = accrep.run_axis(str(folder / "axis.csv"), str(folder))
+            res[(mech, name)] = accrep.run_axis(str(folder / "axis.csv"), str(folder),
+                                                label=f"five-bar, {mech} mechanism, along {name}")
     return res
 
 

@@ -54,7 +54,11 @@ def write_folder(out: Union[str, Path], files: dict) -> None:
 
 
 def _f(v: Optional[float], digits: int = 4) -> str:
-    return "" if v is None else f"{v:.{digits}f}"
+    """``v`` to ``digits`` decimals; a value that rounds to zero without its sign ("-0.000" is "0.000")."""
+    if v is None:
+        return ""
+    text = f"{v:.{digits}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
 # Precision rule, for every table, figure and line of text of these reports: a measured value is
@@ -76,7 +80,7 @@ def rounded(value: float, digits: int, factor: float = 1.0) -> str:
     """``value`` times ``factor`` (a change of unit) to the step 10^-digits of the original unit."""
     step = 10.0 ** -digits * factor
     shown = max(0, -math.floor(math.log10(step) + 1e-9))
-    return f"{round(value * factor / step) * step:.{shown}f}"
+    return _f(round(value * factor / step) * step, shown)
 
 
 def _length_unit(extent_mm: float) -> tuple:
@@ -186,7 +190,8 @@ def _deviation_figure(runs: dict, res: dict, layout: dict) -> bytes:
             axes[2 * (k // ncol) + row, k % ncol].set_visible(False)
     # the legend names exactly what the panels draw
     handles = [Line2D([], [], ls="none", marker="o", ms=4, color=COLOURS[c % len(COLOURS)],
-                      label="attained" if lab is None else f"attained, direction {lab}") for c, lab in enumerate(labels)]
+                      label="attained" if lab is None else f"attained, direction {lab}")
+               for c, lab in enumerate(labels)]
     handles += [Line2D([], [], ls="--", lw=0.8, color="k", label="RP_l around the barycentre"),
                 Line2D([], [], ls="none", marker="x", ms=7, mew=1.5, color="r", label="barycentre (the origin)")]
     if any(q["commanded_inside"] for q in layout["panels"]):
@@ -231,8 +236,8 @@ def iso9283_html(runs: dict, res: dict, title: str, layout: Optional[dict] = Non
     src = f" read from <code>{esc(data_name)}</code>" if data_name else ""
     body = [f"<h1>{esc(title)}</h1>",
             f"<p>{len(runs['point'])} measured poses of {len(pts)} point{'s' if len(pts) > 1 else ''}{src}, frame: "
-            f"{esc(res['frame'])}. Formulas of ISO 9283:1998 (7.2 pose accuracy and repeatability, 7.3 multi-directional "
-            "variation, 7.4 distance accuracy and repeatability); standard deviations with n - 1. Values are given to "
+            f"{esc(res['frame'])}. Formulas of ISO 9283:1998 (7.2 pose accuracy and repeatability, 7.3 "
+            "multi-directional variation, 7.4 distance accuracy and repeatability); standard deviations with n - 1. Values are given to "
             "the largest power of ten below a tenth of the smallest repeatability (RP_l, RP_a,b,c).</p>",
             "<h2>Position (mm)</h2>", report.table(head, rows, numeric=True)]
     if res["orientation"]:
@@ -309,7 +314,7 @@ def iso9283_summary(res: dict, out: str) -> str:
         v = f"{p['vAP_P_mm']:>{w}.{dp}f}" if "vAP_P_mm" in p else ""
         lines.append(f"{p['point']:<8}{p['n']:>5}{p['AP_P_mm']:>{w}.{dp}f}{p['RP_l_mm']:>{w}.{dp}f}{v}")
     if "AD_mm" in res:
-        lines.append(f"distance {'-'.join(res['distance']['points'])}: AD {res['AD_mm']:.{dp}f} mm, "
+        lines.append(f"distance {'-'.join(res['distance']['points'])}: AD {_f(res['AD_mm'], dp)} mm, "
                      f"RD +-{res['RD_mm']:.{dp}f} mm")
     lines.append(f"report: {Path(out) / 'report.html'}")
     return "\n".join(lines)

@@ -77,7 +77,7 @@ def iso9283_runs(robot, nominal_fitted, models: dict, truth, out: Path, seed: in
         table = [[names[i], cycles[i], *taught[i], *att[i]] for i in measured]
         _core.write_file_atomic(str(folder / "runs.csv"), format_rows(RUNS_HEAD, table))
         res = accrep.run_iso9283(str(folder / "runs.csv"), str(folder), distance="P2,P4",
-                                 frame_label="the tracker's (the demo's simulated campaign)")
+                                 frame_label="the tracker's (the demo's simulated campaign)", label=f"kr500, {label}")
         reports[key] = {"label": label, "report": res}
     return {"plan": plan, "programs": reports}
 
@@ -111,19 +111,23 @@ def fivebar_axes(sixbar, model, matrix, out: Path, seed: int) -> dict:
             folder = out / "fivebar" / f"axis_{mech}_{name}"
             folder.mkdir(parents=True, exist_ok=True)
             _axis_csv(folder / "axis.csv", sixbar, m, mx, line, coord, seed + 100 * len(res))
-            res[(mech, name)] = accrep.run_axis(str(folder / "axis.csv"), str(folder))
+            res[(mech, name)] = accrep.run_axis(str(folder / "axis.csv"), str(folder),
+                                                label=f"five-bar, {mech} mechanism, along {name}")
     return res
 
 
 # --- the report's sections ------------------------------------------------------------------------
 
 def _f(v: Optional[float], digits: int = 3) -> str:
-    return "" if v is None else f"{v:.{digits}f}"
+    return accrep._f(v, digits)
 
 
 def iso9283_section(iso: dict, sigma_note: str) -> str:
     plan = iso["plan"]
     c = plan["centre_mm"]
+    # the precision rule of accuracy_report.py (the finest any program's repeatability asks for)
+    dp = max(accrep.iso9283_decimals(p["report"])[0] for p in iso["programs"].values())
+    da = max(accrep.iso9283_decimals(p["report"])[1] for p in iso["programs"].values())
     rows = []
     for key, p in iso["programs"].items():
         r = p["report"]
@@ -131,10 +135,11 @@ def iso9283_section(iso: dict, sigma_note: str) -> str:
         ap = [x["AP_P_mm"] for x in pts]
         rp = [x["RP_l_mm"] for x in pts]
         ang = max(max(abs(x[f"AP_{n}_deg"]) for n in "abc") for x in pts)
-        rows.append([p["label"], _f(min(ap)), _f(max(ap)), _f(max(rp)), f"{ang:.4f}", _f(r["AD_mm"]), _f(r["RD_mm"])])
+        rows.append([p["label"], _f(min(ap), dp), _f(max(ap), dp), _f(max(rp), dp), _f(ang, da), _f(r["AD_mm"], dp),
+                     _f(r["RD_mm"], dp)])
     detail = []
     for key, p in iso["programs"].items():
-        detail.append([p["label"]] + [_f(x["AP_P_mm"]) for x in p["report"]["points"]])
+        detail.append([p["label"]] + [_f(x["AP_P_mm"], dp) for x in p["report"]["points"]])
     names = [x["point"] for x in next(iter(iso["programs"].values()))["report"]["points"]]
     links = ", ".join(f'<a href="iso9283/{k}/report.html">{report.esc(k)}</a>' for k in iso["programs"])
     return f"""<h3>ISO 9283 pose accuracy and repeatability of the kr500</h3>
@@ -157,9 +162,10 @@ def axis_section(axes: dict) -> str:
     rows = []
     for (mech, name), r in axes.items():
         v, i = r["vdi3441"], r["iso230_2"]
-        rows.append([f"{mech}, along {name}", f"{v['travel']:.0f}", f"{v['P'] * 1000:.1f}",
-                     f"{v.get('P_per_m', float('nan')) * 1000:.0f}", f"{v['Pa'] * 1000:.1f}", f"{v['Ps'] * 1000:.1f}",
-                     f"{v['U'] * 1000:.1f}", f"{i['A'] * 1000:.1f}", f"{i['R'] * 1000:.1f}"])
+        d, dm = accrep.axis_decimals(r)  # the precision rule of accuracy_report.py, here in um
+        um = [accrep.rounded(x, d, 1000.0) for x in (v["P"], v["Pa"], v["Ps"], v["U"], i["A"], i["R"])]
+        per_m = accrep.rounded(v["P_per_m"], dm + 3, 1000.0) if "P_per_m" in v else ""
+        rows.append([f"{mech}, along {name}", f"{v['travel']:.0f}", um[0], per_m, *um[1:]])
     links = ", ".join(f'<a href="fivebar/axis_{m}_{n}/report.html">{m} {n}</a>' for m, n in axes)
     return f"""<h3>VDI/DGQ 3441 and ISO 230-2 of the five-bar along x and y</h3>
 <p>{AXIS_TARGETS} targets along x (y = 0) and along y (x at the workspace's middle), each visited upwards then

@@ -202,16 +202,22 @@ SCATTER_ORDER = 6
 
 def point_scatter(q_rad: np.ndarray, order: int = SCATTER_ORDER) -> np.ndarray:
     """Per axis, the scatter (standard deviation, rad) of a program's points about a smooth path, such
-    as the rounding of coordinates written before the inverse kinematics: the median absolute
-    ``order``-th difference of the points scaled to the standard deviation of independent normal
-    scatter (/0.6745 / sqrt(C(2 order, order))). The smooth path adds its own differences (h^order
+    as the rounding of coordinates written before the inverse kinematics, as it shows in q(s): across
+    the path (a component along it moves a point along the path and the chord-length s follows it).
+    The ``order``-th differences of the points, each without its component along the chord of its
+    window, are median-scaled to the standard deviation of independent normal scatter
+    (|median| / 0.6745 / sqrt(C(2 order, order))). The smooth path adds its own differences (h^order
     times its order-th derivative), so where it bends within a few points this is an upper estimate.
     NaN with fewer than 3 order points."""
     q = np.asarray(q_rad, dtype=float)
     if len(q) < 3 * order:
         return np.full(q.shape[1], np.nan)
-    d = np.abs(np.diff(q, order, axis=0))
-    return np.median(d, axis=0) / 0.6744897501960817 / math.sqrt(math.comb(2 * order, order))
+    d = np.diff(q, order, axis=0)
+    chord = q[order:] - q[:-order]
+    norm = np.linalg.norm(chord, axis=1, keepdims=True)
+    t = np.divide(chord, norm, out=np.zeros_like(chord), where=norm > 0)
+    across = d - t * np.sum(d * t, axis=1, keepdims=True)
+    return np.median(np.abs(across), axis=0) / 0.6744897501960817 / math.sqrt(math.comb(2 * order, order))
 
 
 @functools.lru_cache(maxsize=8)
@@ -233,8 +239,10 @@ def _unit_scatter_gain(k: int, derivative: int) -> tuple[float, float]:
 def scatter_derivative(sigma, spacing: float, derivative: int, k: int = 5) -> tuple:
     """What a scatter ``sigma`` (rad) of points ``spacing`` apart in s (rad) alone gives the
     ``derivative``-th derivative of the interpolating spline of degree k (rad/rad^derivative): its
-    standard deviation in the middle of the path and the largest one (at the ends). The spline is
-    linear in the points, so this is sigma times the spline's gain, which scales as spacing^-derivative."""
+    standard deviation in the middle of the path and the largest one (at the ends), for independent
+    scatter. The spline is linear in the points, so this is sigma times the spline's gain, which
+    scales as spacing^-derivative. The scatter's component along the path moves the points along it
+    and the chord-length s follows them: only the rest shows in q(s)."""
     rms, top = _unit_scatter_gain(k, derivative)
     scale = np.asarray(sigma, dtype=float) / spacing ** derivative
     return scale * rms, scale * top
@@ -325,11 +333,13 @@ _STYLE = {"compare": {"color": "tab:blue", "lw": 3.0, "alpha": 0.45, "zorder": 2
 
 
 def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str,
-           window: Optional[tuple] = None, zoom: Optional[tuple] = None) -> None:
+           window: Optional[tuple] = None, zoom: Optional[tuple] = None) -> dict:
     """Fig. 1 of the paper for one axis: the coordinate and its three derivatives in s, the programs
     compared, with the constraint lines +- limit / feed^k (velocity green, acceleration magenta, jerk
     cyan), over a window and a zoomed one. Every panel scales to its own data (panel_range); limit
-    lines that would flatten the data are named with their values above the panel instead."""
+    lines that would flatten the data are named with their values above the panel instead. Returns
+    per panel (row 0-3: theta and its derivatives; column 0 the window, 1 the zoom) its y range, the
+    limit lines drawn and off scale, and the note above it."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -361,7 +371,7 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
                  (j / feed, "jerk", "jerk (eq. 23)")],
             [(a / feed ** 2, "acceleration", "acceleration"), (j / feed ** 2, "jerk", "jerk (eq. 25)")],
             [(j / feed ** 3, "jerk", "jerk")]]
-    kinds_drawn = set()
+    kinds_drawn, panels = set(), {}
     for col, (lo, hi) in enumerate((window, zoom)):
         for row, key in enumerate(("q", "d1", "d2", "d3")):
             ax = axes[row, col]
@@ -383,6 +393,7 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
             note = off_scale_note(bounds, off, data)
             if note:
                 ax.set_title(note, fontsize=8, loc="right")
+            panels[row, col] = {"ylim": (ylo, yhi), "drawn": drawn, "off": off, "note": note}
         axes[3, col].set_xlabel("s (rad)")
         axes[0, col].set_title(f"s in [{lo:.4g}, {hi:.4g}] rad" + (" (zoom)" if col else ""), fontsize=10)
     handles = [Line2D([], [], **{k: x for k, x in _STYLE.get(n, {"lw": 1}).items() if k != "zorder"},
@@ -397,6 +408,7 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
     note.set_in_layout(False)  # the row below the panels holds it; a long line must not squeeze them
     fig.savefig(path, dpi=100)
     plt.close(fig)
+    return panels
 
 
 def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_path: Optional[str] = None,

@@ -25,7 +25,7 @@ import json
 import math
 import textwrap
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -310,25 +310,26 @@ def _scatter_note(results: dict, axis: int) -> str:
         return ("linear interpolation (the paper's): the second and third derivatives are spikes at the program's "
                 "points and their differences, not the motion's derivatives")
     i = axis - 1
-    sig, parts, spacing, k = 0.0, [], None, 5
+    sig, parts, spacing, k = -1.0, [], 1.0, 5
     for key, r in results.items():
         arr = r["arrays"]
         if "scatter" not in arr or not np.isfinite(arr["scatter"][i]):
             return ""
-        sig = max(sig, float(arr["scatter"][i]))
         parts.append(f"{arr['scatter'][i]:.2g} rad ({r.get('label', key)})")
-        spacing, k = float(arr["spacing"]), int(arr["degree"])
-    (r2, _), (r3, t3) = scatter_derivative(sig, spacing, 2, k), scatter_derivative(sig, spacing, 3, k)
+        if arr["scatter"][i] > sig:  # the largest scatter, with its program's spacing
+            sig, spacing, k = float(arr["scatter"][i]), float(arr["spacing"]), int(arr["degree"])
+    (r2, _), (r3, _) = scatter_derivative(sig, spacing, 2, k), scatter_derivative(sig, spacing, 3, k)
+    gain_mid, gain_end = _unit_scatter_gain(k, 3)
     return (f"The spline passes through every program point, so its derivatives also carry the points' scatter about "
             f"a smooth path (e.g. coordinates rounded before the inverse kinematics): on A{axis} about "
             f"{', '.join(parts)} by median {SCATTER_ORDER}th differences, points {spacing:.2g} rad apart in s. "
             f"That alone gives $\\theta_{{ss}}$ \u00b1{2 * r2:.2g} 1/rad and $\\theta_{{sss}}$ \u00b1{2 * r3:.2g} "
-            f"1/rad$^2$ (2 standard deviations of independent scatter, {t3 / r3:.0f} times more at the ends): "
+            f"1/rad$^2$ (2 standard deviations of independent scatter, {gain_end / gain_mid:.0f} times more at the ends): "
             f"a ripple of that size is the program's own, not the smooth path's.")
 
 
 #: drawing order and style: the compared program wide and light underneath, the program on top
-_STYLE = {"compare": {"color": "tab:blue", "lw": 3.0, "alpha": 0.45, "zorder": 2},
+_STYLE: dict[str, dict[str, Any]] = {"compare": {"color": "tab:blue", "lw": 3.0, "alpha": 0.45, "zorder": 2},
           "program": {"color": "tab:red", "lw": 1.1, "zorder": 3}}
 
 
@@ -403,9 +404,9 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
     fig.suptitle(f"axis A{axis}: the joint coordinate and its derivatives in s (total axis displacement, rad); "
                  f"constraint lines at feed {feed:g} rad/s")
     top.legend(handles=handles, loc="center", ncol=len(handles), fontsize=9, frameon=False)
-    note = bottom.text(0.0, 1.0, textwrap.fill(_scatter_note(results, axis), 185), fontsize=8, va="top", ha="left",
+    caption = bottom.text(0.0, 1.0, textwrap.fill(_scatter_note(results, axis), 185), fontsize=8, va="top", ha="left",
                        transform=bottom.transAxes)
-    note.set_in_layout(False)  # the row below the panels holds it; a long line must not squeeze them
+    caption.set_in_layout(False)  # the row below the panels holds it; a long line must not squeeze them
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return panels

@@ -173,3 +173,133 @@ def test_paper_use_case_reports_no_violations(tmp_path):
             "--out", str(tmp_path / "feed_linear"))
     lin = json.loads((tmp_path / "feed_linear" / "feed.json").read_text())["programs"]["program"]
     assert any(v["limit"] == "jerk" for v in lin["violations"])
+
+
+# The figures (kincal feed, kincal demo): the panels' y ranges and limit lines, without pixels.
+
+def test_panel_range_comes_from_the_data_and_names_far_limit_lines():
+    """The audit's theta_s panel: data in [-0.2, 0.2], lines at +-5.24 (velocity), +-10.5 (eq. 22)
+    and +-105 (eq. 23): the range is the data's widened by 8% of their height on each side and every
+    line is off scale. With lines at +-0.09 (within the data), +-0.4 and +-0.7: the range may grow to
+    3 times the data's (1.392 here), so +-0.09 and +-0.4 are drawn ([-0.432, 0.432]), then +0.7
+    ([-0.432, 0.732], 1.164) and not -0.7 (1.464). Flat data at 0 get a height of 1 and the margin:
+    +-0.58."""
+    data = [np.linspace(-0.2, 0.2, 50), np.linspace(-0.1, 0.1, 50)]
+    far = [5.24, -5.24, 10.5, -10.5, 105.0, -105.0]
+    (lo, hi), drawn, off = feed.panel_range(data, far)
+    assert lo == pytest.approx(-0.232) and hi == pytest.approx(0.232)
+    assert drawn == [] and sorted(off) == sorted(far)
+    (lo, hi), drawn, off = feed.panel_range(data, [0.4, -0.4, 0.09, -0.09, 0.7, -0.7, 5.0, -5.0])
+    assert sorted(drawn) == [-0.4, -0.09, 0.09, 0.4, 0.7] and sorted(off) == [-5.0, -0.7, 5.0]
+    assert lo == pytest.approx(-0.432) and hi == pytest.approx(0.732)
+    assert (hi - lo) <= 3 * 0.464 + 1e-12
+    assert feed.panel_range([np.zeros(10)], [])[0] == pytest.approx((-0.58, 0.58))
+    # a line the data pass is always drawn, however far the data go
+    (lo, hi), drawn, off = feed.panel_range([np.array([0.0, 1000.0])], [1.0, -1.0])
+    assert drawn == [1.0, -1.0] and off == [] and lo < -1.0 and hi > 1000.0
+
+
+def test_off_scale_note_gives_the_values_and_says_when_the_data_pass_a_line():
+    bounds = [(5.236, "velocity", "velocity"), (104.7, "jerk", "jerk (eq. 23)"), (1676.0, "jerk", "jerk")]
+    assert feed.off_scale_note(bounds, []) == ""
+    note = feed.off_scale_note(bounds, [104.7, -104.7, 1676.0], [np.array([-0.2, 0.2])])
+    assert note == "off scale: jerk (eq. 23) \u00b1105, jerk +1676"
+    note = feed.off_scale_note([(0.175, "acceleration", "acceleration")], [0.175, -0.175],
+                               [np.array([0.43, 0.47])])
+    assert note == "off scale: acceleration \u00b10.175 (exceeded)"
+
+
+def test_figure_panels_scale_to_their_own_window(tmp_path):
+    """The helix above, two programs (the second 1e-3 rad off on every axis): each panel's y range
+    holds its own window's data, which fill at least a third of it; the zoom's theta_s range of axis
+    1 is the zoom's (under 1/50 of the full window's); no drawn line lies outside its panel and every
+    off-scale line lies outside it and is named above it."""
+    prog = np.degrees(helix(np.linspace(0, S, 297))[0])
+    res = {"program": feed.analyse(prog, LIM_V, LIM_A, LIM_J, feed=1.0, optimal=False),
+           "compare": feed.analyse(prog + np.degrees(1e-3), LIM_V, LIM_A, LIM_J, feed=1.0, optimal=False)}
+    zoom = (0.99, 1.01)
+    panels = feed.figure(res, LIM_V, LIM_A, LIM_J, 1.0, 1, str(tmp_path / "a1.png"), zoom=zoom)
+    assert (tmp_path / "a1.png").read_bytes()[:4] == b"\x89PNG"
+    for (row, col), p in panels.items():
+        lo_s, hi_s = (0.0, S) if col == 0 else zoom
+        vals = np.concatenate([r["arrays"][("q", "d1", "d2", "d3")[row]][:, 0][
+            (r["arrays"]["s"] >= lo_s) & (r["arrays"]["s"] <= hi_s)] for r in res.values()])
+        ylo, yhi = p["ylim"]
+        assert ylo < vals.min() and vals.max() < yhi
+        assert (vals.max() - vals.min()) * 1.16 >= (yhi - ylo) / 3 - 1e-12
+        assert all(ylo <= v <= yhi for v in p["drawn"]) and all(not ylo <= v <= yhi for v in p["off"])
+        assert bool(p["off"]) == p["note"].startswith("off scale")
+    full, zoomed = panels[1, 0]["ylim"], panels[1, 1]["ylim"]
+    assert zoomed[1] - zoomed[0] < (full[1] - full[0]) / 50
+    # axis 1's theta_s (-R k sin(k s), in [-0.85, 0]) at feed 1: the velocity line (1.05) is drawn,
+    # acceleration (eq. 22, 2.09) and jerk (eq. 23, 20.9) are off scale
+    assert sorted(panels[1, 0]["drawn"]) == pytest.approx([-np.radians(60), np.radians(60)])
+    assert "acceleration (eq. 22) \u00b12.09" in panels[1, 0]["note"] and "jerk (eq. 23) \u00b120.9" in panels[1, 0]["note"]
+
+
+def test_point_scatter_recovers_a_stated_scatter():
+    """A line along axis 4 (297 points, 1.1 rad; axes 1-3 still) with independent uniform scatter
+    +-5e-8 rad (standard deviation 5e-8/sqrt(3)) on every axis, 10 seeds: on axes 1-3 the estimate is
+    within 30% of it (measured 0.88-1.26: the median of 291 overlapping sixth differences), 10% on
+    the mean of the 30; on axis 4 the scatter runs along the path, which s absorbs: below 1e-12 rad.
+    Without scatter, on the helix, below 1e-13 rad."""
+    assert np.all(feed.point_scatter(helix(np.linspace(0, S, 297))[0]) < 1e-13)
+    line = np.zeros((297, 4))
+    line[:, 3], line[:, :3] = np.linspace(0, 1.1, 297), [0.3, -0.8, 1.6]
+    ratios = []
+    for seed in range(10):
+        est = feed.point_scatter(line + np.random.default_rng(seed).uniform(-5e-8, 5e-8, line.shape))
+        ratios += list(est[:3] / (5e-8 / np.sqrt(3)))
+        assert est[3] < 1e-12
+    assert np.all(np.abs(np.array(ratios) - 1) < 0.3) and abs(np.mean(ratios) - 1) < 0.1
+
+
+def test_scatter_derivative_predicts_the_spline_response_to_independent_scatter():
+    """A straight line in 6 axes (direction (1,..,1)/sqrt(6), 297 points 3.7e-3 rad apart) with
+    independent normal scatter 2e-8 rad, 3 seeds: the rms of the spline's second and third
+    derivatives over the middle half is scatter_derivative's, for the scatter across the path (the
+    component along it moves the points along the line and the chord-length s follows them):
+    2e-8 * sqrt(1 - 1/6). Within 20% per axis and seed (about 280 points' worth of samples: 6%
+    sampling error), within 5% on the mean of the 18."""
+    n, h, sig = 297, 3.7e-3, 2e-8
+    line = np.outer(np.arange(n) * h, np.ones(6) / np.sqrt(6))
+    ratios = {2: [], 3: []}
+    for seed in range(3):
+        prog = line + np.random.default_rng(seed).normal(0.0, sig, line.shape)
+        arr = feed.analyse(np.degrees(prog), [100.0] * 6, [100.0] * 6, [100.0] * 6, optimal=False)["arrays"]
+        mid = (arr["s"] > 0.25 * arr["s"][-1]) & (arr["s"] < 0.75 * arr["s"][-1])
+        assert arr["spacing"] == pytest.approx(h, rel=1e-4)
+        for k in (2, 3):
+            pred = feed.scatter_derivative(sig * np.sqrt(1 - 1 / 6), arr["spacing"], k)[0]
+            ratios[k] += list(np.sqrt(np.mean(arr[f"d{k}"][mid] ** 2, axis=0)) / pred)
+    for k in (2, 3):
+        assert np.all(np.abs(np.array(ratios[k]) - 1) < 0.2)
+        assert abs(np.mean(ratios[k]) - 1) < 0.05
+
+
+def test_rounded_coordinates_dominate_the_third_derivative_of_a_line(kr500):
+    """Why theta_sss of kincal demo's line ripples: the kr500 straight line of 297 poses 5 mm apart
+    (start (2000.123456789, -740.987654321, 500.314159265) mm, direction (0.1, 1, -0.05), tool
+    down), inverse kinematics of its exact coordinates and of the same coordinates rounded to 4
+    decimals as the demo's line.gcode writes them (+-5e-5 mm). Exact: |theta_sss| <= 2 1/rad^2 on
+    every axis and no scatter (< 1e-13 rad). Rounded: axes 2, 3 and 5 reach |theta_sss| above 5 times
+    the exact one's peak (measured 13-43 against 0.5-1.5). The figure's estimate of what the points'
+    scatter alone gives (point_scatter through scatter_derivative, for independent scatter) is within
+    a factor 2.5 of the rms of the difference over the middle half (measured 0.46-1.48: rounding of
+    evenly spaced coordinates is not independent scatter)."""
+    import kincal
+
+    poses = kincal.line_program(start=(2000.123456789, -740.987654321, 500.314159265), direction=(0.1, 1.0, -0.05))
+    rounded = poses.copy()
+    rounded[:, :3] = np.round(rounded[:, :3], 4)
+    lim = feed.robot_limits(kr500)
+    exact, rnd = (feed.analyse(np.asarray(kincal.compensate(kr500, p, compensate=False)["q_deg"]), *lim,
+                               optimal=False)["arrays"] for p in (poses, rounded))
+    assert np.all(np.abs(exact["d3"]).max(axis=0) <= 2.0) and np.all(exact["scatter"] < 1e-13)
+    peak_e, peak_r = np.abs(exact["d3"]).max(axis=0), np.abs(rnd["d3"]).max(axis=0)
+    assert np.all(peak_r[[1, 2, 4]] > 5 * peak_e[[1, 2, 4]])
+    mid = (exact["s"] > 0.25 * exact["s"][-1]) & (exact["s"] < 0.75 * exact["s"][-1])
+    ripple = np.sqrt(np.mean((rnd["d3"] - exact["d3"])[mid] ** 2, axis=0))
+    moving = [0, 1, 2, 4, 5]  # axis 4 stays at 0 on this line
+    ratio = feed.scatter_derivative(rnd["scatter"], rnd["spacing"], 3)[0][moving] / ripple[moving]
+    assert np.all(ratio > 1 / 2.5) and np.all(ratio < 2.5)

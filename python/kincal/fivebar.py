@@ -32,8 +32,13 @@ def read_table(path: str) -> dict:
     return _core.read_fivebar_table(str(path))
 
 
-def _max_error(model: FiveBar, pts: dict, desired: bool) -> float:
+def largest_error(model: FiveBar, pts: dict, desired: bool) -> float:
+    """The largest distance (mm) between the model's position at the commanded angles and the
+    desired (``desired``) or the measured position of every point: a fit's score."""
     return float(_core.fivebar_max_error(model, pts, desired))
+
+
+_max_error = largest_error
 
 
 def minimax_fit(pts: dict, start: FiveBar, desired: bool = False, sides: int = 64, max_iter: int = 200) -> FiveBar:
@@ -186,7 +191,7 @@ def error_map_figure(maps: list, path: str, title: str = "five-bar positioning e
     for ax, (label, p) in zip(axes, maps):
         e = position_errors(p) * 1000
         sc = ax.scatter(p["desired"][:, 0], p["desired"][:, 1], c=e, s=18, cmap="viridis", norm=norm)
-        ax.set_title(f"{label}\nmax {e.max():.0f} um, RMS {np.sqrt(np.mean(e ** 2)):.0f} um", fontsize=10)
+        ax.set_title(f"{label}\nmax {e.max():.1f} um, RMS {np.sqrt(np.mean(e ** 2)):.1f} um", fontsize=10)
         ax.set_xlabel("x (mm)")
         ax.set_aspect("equal")
     axes[0].set_ylabel("y (mm)")

@@ -114,6 +114,22 @@ def test_bad_programs(tmp_path, tool, name, text, message):
 
 
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+@pytest.mark.parametrize("name,option", [("p.csv", "--program-base"), ("p.gcode", "--program-tool")])
+def test_frame_options_are_refused_on_pose_programs(tmp_path, tool, name, option):
+    """A CSV or G-code program's poses are in the robot's base frame for the model's tool: a
+    program frame would be ignored, so it is an error naming the file and the options, no output."""
+    (tmp_path / name).write_text("x,y,z,a,b,c\n2000,0,500,180,0,180\n" if name.endswith(".csv") else
+                                 "G1 X2000 Y0 Z500 A180 B0 C180\n")
+    args = ["compensate"] if tool == "kincal" else []
+    out = tmp_path / ("o" + Path(name).suffix)
+    r = run(tool, *args, "--model", "kr500", "--program", str(tmp_path / name), "--out", str(out),
+            option, "100,0,0,0,0,0")
+    assert r.returncode != 0 and f"{name}: --program-base and --program-tool give a native program" in r.stderr, \
+        r.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
 def test_unknown_robot_and_missing_file(tmp_path, tool):
     args = ["compensate"] if tool == "kincal" else []
     (tmp_path / "p.csv").write_text("x,y,z,a,b,c\n2000,0,500,180,0,180\n")

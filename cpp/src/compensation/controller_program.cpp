@@ -286,6 +286,13 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
                      "--program-tool)");
   if (in_format != ControllerFormat::Csv && in_format != ControllerFormat::Gcode)
     return compensate_native(robot, in_path, in_format, out_path, opt, w, native);
+  // a pose program's poses are in the robot's base frame and for the model's tool (or the
+  // instrument's frame: --frame instrument); a frame option would be silently ignored
+  const auto given = [](const Pose6& p) { return !p.xyz.isZero(0.0) || !p.abc.isZero(0.0); };
+  if (given(native.program_base) || given(native.program_tool))
+    throw InputError(in_path + ": --program-base and --program-tool give a native program's frames (KRL, RAPID, LS, "
+                     "URScript); a CSV or G-code program's poses are in the robot's base frame (or the instrument's, "
+                     "--frame instrument) for the model's tool");
   PoseProgram prog = read_pose_program(in_path);
   std::vector<std::string> where_of;
   where_of.reserve(prog.poses.size());

@@ -124,6 +124,19 @@ def cmd_simulate(args) -> None:
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
 
+def _tool_targets(path: Optional[str], data: dict, data_path: str) -> Optional[np.ndarray]:
+    """--tool-targets: x,y,z of each target of the measurements in the tool frame, one row each
+    (checked before any fit: an error names the file and both counts)."""
+    if not path:
+        return None
+    known = _core.read_csv_columns(path, ["x", "y", "z"])
+    n = int(np.max(data["target"])) + 1
+    if len(known) != n:
+        raise ValueError(f"{path}: {len(known)} rows, but {data_path} measures {n} target(s) (one row of x,y,z per "
+                         "target in the tool frame, in target order)")
+    return known
+
+
 def cmd_identify(args) -> None:
     robot = _robot(args)
     effects = ident.parse_effects(args.effects, robot, args.harmonics)
@@ -131,6 +144,7 @@ def cmd_identify(args) -> None:
     ident.check_data_for(effects, dict(data, source=args.data), robot)
     if args.holdout is not None and args.folds is not None:
         raise ValueError("--holdout and --folds: give one (a split, or cross-validation)")
+    known = _tool_targets(args.tool_targets, data, args.data)
     prior_model = load_robot(args.prior_model) if args.prior_model else None
     res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
                          prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
@@ -141,8 +155,8 @@ def cmd_identify(args) -> None:
                          gravity=args.gravity)
     if sys.stderr.isatty():
         print(file=sys.stderr)
-    if args.tool_targets:
-        res = ident.tool_from_targets(res, _core.read_csv_columns(args.tool_targets, ["x", "y", "z"]))
+    if known is not None:
+        res = ident.tool_from_targets(res, known)
     text = res.model_json()
     if args.urdf:
         cal = json.loads(text)["calibrated"]
@@ -203,7 +217,7 @@ def cmd_diagnose(args) -> None:
     start = ident.parse_effects(args.effects, robot, args.harmonics)
     data = ident.read_measurements(args.data, robot)
     ident.check_data_for(start, dict(data, source=args.data), robot)
-    known = _core.read_csv_columns(args.tool_targets, ["x", "y", "z"]) if args.tool_targets else None
+    known = _tool_targets(args.tool_targets, data, args.data)
     t0 = time.perf_counter()
     diag, model = diagnosis.run(robot, data, args.out, title=f"kincal diagnose: {Path(args.data).name}",
                                 tool_targets=known, progress=_say, folds=args.folds, seed=args.seed,

@@ -228,3 +228,18 @@ def test_bench_prints_one_json_object():
     doc = json.loads(r.stdout)
     assert {"fk_ns", "kdl_fk_ns", "feed_297_poses_ms", "feed_100000_poses_ms", "bench_seconds"} <= set(doc)
     assert "identify_ms" not in doc and "diagnose_500_poses_s" not in doc
+
+
+@pytest.mark.parametrize("command", ["identify", "diagnose"])
+def test_tool_targets_of_the_wrong_count_name_the_file(tmp_path, command):
+    """A campaign of 3 reflectors (kincal simulate --targets 3) with a --tool-targets file of 2 rows:
+    refused before any fit, naming the file and both counts; nothing written."""
+    r = run("kincal", "simulate", "--robot", "kr500", "--poses", "20", "--targets", "3", "--out", str(tmp_path / "m.csv"))
+    assert r.returncode == 0, r.stderr
+    (tmp_path / "tt.csv").write_text("x,y,z\n0,0,100\n0,50,100\n")
+    out = tmp_path / ("o.json" if command == "identify" else "d")
+    r = run("kincal", command, "--robot", "kr500", "--data", str(tmp_path / "m.csv"), "--out", str(out),
+            "--tool-targets", str(tmp_path / "tt.csv"))
+    assert r.returncode == 1 and f"{tmp_path / 'tt.csv'}: 2 rows, but" in r.stderr and "measures 3 target" in r.stderr, \
+        r.stderr
+    assert not out.exists()

@@ -72,10 +72,11 @@ def cmd_compensate(args) -> None:
     for w in res["warnings"]:
         print(f"kincal compensate: warning: {w}", file=sys.stderr)
     it = np.asarray(res["iterations"])
-    print(f"{args.out}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
+    written = ", ".join(res.get("files") or [str(args.out)])  # a KRL program is its .src and .dat
+    print(f"{written}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
     for line in programs.summary(res):
-        print(f"{args.out}: {line}", file=sys.stderr)
+        print(f"{written}: {line}", file=sys.stderr)
 
 
 def _progress(label: str):

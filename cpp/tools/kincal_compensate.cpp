@@ -138,7 +138,7 @@ std::vector<double> parse_directions(const std::string& text) {
 int main(int argc, char** argv) {
   CLI::App app{"kincal-compensate: Newton compensation of pose programs into joint programs"};
   std::string model, program, out, frame = "base";
-  bool stream = false, fd = false, nominal = false, keep_branch = false;
+  bool stream = false, fd = false, nominal = false, keep_branch = false, paper_start = false;
   double eps = 1e-15, delta = 1e-8;
   std::optional<double> temperature;
   std::string initial_direction, residual = "rotation_vector";
@@ -187,6 +187,7 @@ int main(int argc, char** argv) {
   app.add_flag("--stream", stream, "read pose lines on stdin, write joint lines on stdout, flushed");
   app.add_flag("--finite-difference", fd, "the paper's finite-difference Jacobian (eq. 7)");
   app.add_flag("--nominal", nominal, "nominal IK only (the uncompensated program)");
+  app.add_flag("--paper-start", paper_start, "start Newton from the nominal IK (no correction), as the paper");
   app.add_option("--epsilon", eps, "stop when |F|^2 < epsilon (eq. 9)");
   app.add_option("--delta", delta, "finite-difference step, degrees (eq. 7)");
   app.add_option("--max-iterations", max_iter, "Newton iteration limit");
@@ -206,6 +207,7 @@ int main(int argc, char** argv) {
     opt.instrument_frame = frame == "instrument";
     opt.compensate = !nominal;
     opt.comp.finite_difference = fd;
+    opt.corrected_start = !paper_start;
     opt.comp.epsilon = eps;
     opt.comp.delta = delta;
     opt.comp.max_iterations = max_iter;

@@ -51,13 +51,15 @@ def test_python_and_standalone_compensation_agree(tmp_path, calibrated):
     poses = kincal.line_program(count=60)
     _write_poses_gcode(tmp_path / "line.gcode", poses)
     _write_csv(tmp_path / "line.csv", ["x", "y", "z", "a", "b", "c"], poses)
-    for ext in ("gcode", "csv"):
-        a, b = tmp_path / f"py.{ext}", tmp_path / f"cpp.{ext}"
-        r1 = run("kincal", "compensate", "--model", str(model), "--program", str(tmp_path / f"line.{ext}"), "--out", str(a))
-        r2 = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / f"line.{ext}"), "--out", str(b))
+    for ext, opts in (("gcode", []), ("csv", []), ("csv", ["--paper-start"])):  # the paper's start too
+        a, b = tmp_path / f"py{len(opts)}.{ext}", tmp_path / f"cpp{len(opts)}.{ext}"
+        r1 = run("kincal", "compensate", "--model", str(model), "--program", str(tmp_path / f"line.{ext}"), "--out", str(a),
+                 *opts)
+        r2 = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / f"line.{ext}"), "--out", str(b),
+                 *opts)
         assert r1.returncode == 0 and r2.returncode == 0, r1.stderr + r2.stderr
         assert a.read_text() == b.read_text()  # identical text: well within 1e-9 deg
-    q = kincal._core.read_joint_program(str(tmp_path / "py.gcode"), 6)[0]
+    q = kincal._core.read_joint_program(str(tmp_path / "py0.gcode"), 6)[0]
     reached = kincal.fk(calibrated, q)
     assert np.abs(reached[:, :3] - poses[:, :3]).max() < 1e-6  # the calibrated robot lands on the path
     assert np.abs(kincal.fk(calibrated, kincal.compensate(calibrated, poses, compensate=False)["q_deg"])[:, :3]

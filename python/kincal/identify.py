@@ -385,7 +385,12 @@ def _cross_validated_errors(fit: priors.Fitter, data: dict, opts, held_masks,
     for i, held in enumerate(held_masks):
         if progress:
             progress(i, len(held_masks))
-        parts.append(_errors(fit(subset(data, ~held), opts), subset(data, held)))
+        try:
+            model = fit(subset(data, ~held), opts)
+        except ValueError as e:  # the core names the data's source and the fold's rows: say they are a fold's
+            raise ValueError(f"cross-validation fold {i + 1} of {len(held_masks)} (the model fitted without "
+                             f"{int(np.sum(held))} held-out rows): {e}") from None
+        parts.append(_errors(model, subset(data, held)))
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 

@@ -111,3 +111,21 @@ def test_identify_command_states_the_scheme(tmp_path, repeated):
     assert f"25% held out, whole configurations ({CONFIGS} configurations: rows with equal joint angles" in r.stdout
     v = json.loads((tmp_path / "model.json").read_text())["identification"]["validation"]
     assert v["configurations"] == CONFIGS and v["held_rows"] == 9 * REPEATS
+
+
+def test_a_failed_fold_says_it_is_a_fold():
+    """A fold whose fit the core refuses (too few rows) is named as a fold in the error: the core's
+    count of rows is the fold's, not the file's."""
+    import numpy as np
+    import pytest
+
+    from kincal import identify as ident
+
+    def refuses(data, opts):
+        raise ValueError(f"m.csv: the {len(data['pose'])} measured points of ...: too few or too similar poses")
+
+    data = {"pose": np.arange(10), "q_deg": np.zeros((10, 6)), "xyz": np.zeros((10, 3)), "target": np.zeros(10, int)}
+    held = [np.arange(10) < 2, np.arange(10) >= 2]
+    with pytest.raises(ValueError, match=r"cross-validation fold 1 of 2 \(the model fitted without 2 held-out rows\): "
+                                         r"m.csv: the 8 measured points"):
+        ident._cross_validated_errors(refuses, data, None, held, None)

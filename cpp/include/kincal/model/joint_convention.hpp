@@ -18,8 +18,10 @@ namespace kincal {
 /// "" (none) or "fanuc"; InputError "joint convention 'x': ..." otherwise.
 void check_joint_convention(const std::string& name);
 
-/// s of the FANUC coupling (+1 or -1) of spec, 0 when the convention is the model's own; InputError
-/// when it is "fanuc" and axes 2 and 3 are not parallel (or the robot has fewer than 3 joints).
+/// s of the FANUC coupling (+1 or -1, the sign of z2 . z3) of spec, 0 when the convention is the model's
+/// own; InputError when it is "fanuc" and axes 2 and 3 are more than 5 deg from parallel (a calibrated
+/// arm's misalignment, a fraction of a degree, is taken: the coupling is the controller's numbering, not
+/// the exact geometry) or the robot has fewer than 3 joints.
 int j3_coupling(const ModelSpec& spec);
 
 /// In place, n angles (deg): the model's to the controller's, and back.

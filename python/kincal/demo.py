@@ -274,7 +274,7 @@ in the direction the commanded motion arrives from. Errors on the true robot, as
 result (the mean position and orientation errors over the line's poses; the orientation error is the angle of
 the rotation between the commanded and the attained tool orientation):</p>
 {report.table(["program", "mean position error (mm)", "max (mm)", "mean orientation error (deg)", "max (deg)"],
-              [[label, f"{summary[f'position_error_{k}_mm']['mean']:.3f}", f"{summary[f'position_error_{k}_mm']['max']:.3f}",
+              [[label, f"{summary[f'position_error_{k}_mm']['mean']:.4f}", f"{summary[f'position_error_{k}_mm']['max']:.4f}",
                 f"{summary[f'orientation_error_{k}_deg']['mean']:.4f}", f"{summary[f'orientation_error_{k}_deg']['max']:.4f}"]
                for label, k in (("uncompensated (nominal IK)", "uncompensated"),
                                 ("compensated on the identified model", "compensated"),
@@ -301,7 +301,9 @@ hidden robot by {hb['fit'] * 1000:.0f} um, fit plus the 5 mm error matrix by {hb
 {sections['axis']}
 
 <h2>Files</h2>
-<p>{", ".join(sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()))}, report.html, summary.json</p>
+<p>{", ".join(f'<a href="{report.esc(f)}">{report.esc(f)}</a>' for f in
+             sorted({str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()} | {"summary.json"}
+                    - {"report.html"}))}</p>
 """
     report.write(out / "report.html", "kincal demo", body)
 

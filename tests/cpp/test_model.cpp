@@ -75,3 +75,25 @@ TEST(Model, AbcConvention) {
     EXPECT_NEAR((rotation_to_abc(abc_to_rotation(abc)) - abc).norm(), 0, 1e-9);
   }
 }
+
+// Near B = +-90 deg only a - c (or a + c) is determined, from entries of size cos b: the rotation
+// the ABC angles give back must still be the one they came from, however close to the pole
+// (the angles themselves may differ). Truth: a, c drawn in +-179 deg, b = +-(90 - delta) for
+// delta from 0 to 1e-2 deg, each entry of the rotation then off by up to 2e-15 as a forward
+// kinematics chain leaves it; a b 1e-10 deg from the pole once made a - c wrong by 0.005 deg.
+TEST(Model, AbcNearThePoleGivesTheSameRotation) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> ang(-179, 179), fk_rounding(-2e-15, 2e-15);
+  double worst = 0;
+  for (double delta : {0.0, 1e-13, 1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2}) {
+    for (double sign : {1.0, -1.0}) {
+      for (int k = 0; k < 50; ++k) {
+        Mat3 r = abc_to_rotation(Vec3(ang(rng), sign * (90.0 - delta), ang(rng)));
+        for (int e = 0; e < 9; ++e) r(e / 3, e % 3) += fk_rounding(rng);
+        const Mat3 back = abc_to_rotation(rotation_to_abc(r));
+        worst = std::max(worst, Eigen::AngleAxisd(r.transpose() * back).angle() / kDeg);
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-5);  // deg
+}

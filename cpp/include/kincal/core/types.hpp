@@ -40,7 +40,11 @@ inline Vec3 rotation_to_abc_rad(const Mat3& r) {
   // the entries of a rotation are at most 1: a plain square root is safe (and much faster than hypot)
   const double cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
   const double b = fastmath::atan2(-r(2, 0), cb);
-  if (cb < 1e-12) return Vec3(fastmath::atan2(-r(0, 1), r(1, 1)), b, 0.0);
+  // Near the pole (b = +-90 deg) a and c come from entries of size cos b that carry the rounding of
+  // the matrix (~1e-15 after a kinematic chain): an error of 1e-15 / cos b each. Below cos b = 3e-8
+  // c is set to 0 and a taken from the second column, which cos b does not scale: an error of about
+  // cos b. Both stay below 3e-8 rad (2e-6 deg).
+  if (cb < 3e-8) return Vec3(fastmath::atan2(-r(0, 1), r(1, 1)), b, 0.0);
   return Vec3(fastmath::atan2(r(1, 0), r(0, 0)), b, fastmath::atan2(r(2, 1), r(2, 2)));
 }
 Eigen::Isometry3d pose_to_iso(const Pose6& p);

@@ -71,7 +71,8 @@ def _step_progress(label: str):
 def cmd_accuracy_iso9283(args) -> None:
     from . import accuracy_report as rep
 
-    res = rep.run_iso9283(args.data, args.out, distance=args.distance, model=args.model, frame=args.frame)
+    res = rep.run_iso9283(args.data, args.out, distance=args.distance, model=args.model, frame=args.frame,
+                          label=args.label)
     print(rep.iso9283_summary(res, args.out))
 
 
@@ -85,7 +86,7 @@ def cmd_accuracy_plan(args) -> None:
 def cmd_accuracy_axis(args) -> None:
     from . import accuracy_report as rep
 
-    print(rep.axis_summary(rep.run_axis(args.data, args.out, args.unit), args.out))
+    print(rep.axis_summary(rep.run_axis(args.data, args.out, args.unit, label=args.label), args.out))
 
 
 
@@ -125,6 +126,8 @@ def add_commands(sub, robot_opts, effect_opts) -> None:
     sp.add_argument("--frame", choices=["base", "instrument"], default="base",
                     help="frame of the attained x,y,z[,a,b,c]: the commanded poses' (base, default) or the "
                          "instrument's (mapped to the base with --model)")
+    sp.add_argument("--label", help="what was run, in the report's title (default: the output folder's and the data "
+                                    "file's names)")
     sp.set_defaults(func=cmd_accuracy_iso9283)
     sp = asub.add_parser("plan-iso9283", help="the ISO 9283 test poses P1..P5 and their 30-cycle pose program")
     robot_opts(sp)
@@ -139,5 +142,7 @@ def add_commands(sub, robot_opts, effect_opts) -> None:
     sp.add_argument("--data", required=True, help="AXIS.csv: target,direction,run,measured (one unit throughout)")
     sp.add_argument("--unit", choices=["mm", "deg"], default="mm", help="the file's unit (default mm)")
     sp.add_argument("--out", required=True, help="folder for axis.json, report.html and the figure")
+    sp.add_argument("--label", help="what was run, in the report's title (default: the output folder's and the data "
+                                    "file's names)")
     sp.set_defaults(func=cmd_accuracy_axis)
 

@@ -1,15 +1,19 @@
 // Program files: G-code words replaced with everything else passing through, modal words, joint
 // programs read back; bad input named by file, line and cause, and no output file written.
 #include "kincal/compensation/program.hpp"
+#include "kincal/io/csv.hpp"
+#include "kincal/io/native.hpp"
 #include "kincal/io/programs.hpp"
 
 #include "test_files.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <sstream>
 
 using namespace kincal;
 using test::kr500_calibrated;
@@ -18,6 +22,18 @@ using test::tmp;
 namespace {
 
 bool exists(const std::string& p) { return std::ifstream(p).good(); }
+
+std::string slurp(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::string replaced(std::string s, const std::string& a, const std::string& b) {
+  for (size_t at = s.find(a); at != std::string::npos; at = s.find(a, at + b.size())) s.replace(at, a.size(), b);
+  return s;
+}
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -92,5 +108,149 @@ TEST(Io, BadInputNamesFileLineAndCauseAndWritesNothing) {
     EXPECT_FALSE(exists(out)) << c.name;
   }
   EXPECT_NE(error_of([&] { read_pose_program(::testing::TempDir() + "missing.csv"); }).find("cannot open"),
+            std::string::npos);
+}
+
+// A number that is not a finite decimal (NaN, infinity, an exponent, a decimal comma) in a pose or joint
+// word is an error naming the file, the line and the word; the motion is never dropped and no output is
+// written. (Before: "G1 Xnan" passed through as an unknown word, "X1,5" and "X1e400" read as X1.)
+TEST(Io, NonFiniteOrNonDecimalGcodeNumbersAreErrors) {
+  const Robot r = kr500_calibrated();
+  const std::string out = ::testing::TempDir() + "never.gcode";
+  std::remove(out.c_str());
+  const std::string first = "G1 X2000 Y-100 Z500 A180 B0 C180\n";
+  const char* words[] = {"Xnan", "XNaN", "Xinf", "XINFINITY", "X-inf", "X+nan", "X1,5", "X1e400", "X1E-3", "Y2000.5.", "C1/2"};
+  for (const char* w : words) {
+    const std::string in = tmp("nf.gcode", first + "G1 " + w + " Z600\n");
+    const std::string e = error_of([&] { compensate_program_file(r, in, out, ProgramOptions{}); });
+    const std::string letter(1, w[0]);
+    EXPECT_NE(e.find("nf.gcode:2: broken number in word " + letter + " ('" + w + "'): not a finite decimal number"),
+              std::string::npos) << w << ": " << e;
+    EXPECT_FALSE(exists(out)) << w;
+  }
+  // joint words too
+  const std::string jin = tmp("nfj.gcode", "G1 A1=0 A2=-90 A3=90 A4=0 A5=30 A6=0\nG1 A2=nan\n");
+  EXPECT_NE(error_of([&] { read_joint_program(jin, 6); })
+                .find("nfj.gcode:2: broken number in word A2= ('A2=nan'): not a finite decimal number"),
+            std::string::npos);
+  // what stays valid: packed words, a sign, a leading or trailing point, a word E without a number
+  const PoseProgram p = parse_pose_program("G1X2000Y-100Z+500.A180B.0C180 E F10\n", "ok.gcode", ProgramFormat::Gcode);
+  EXPECT_EQ(p.poses[0].xyz, Vec3(2000, -100, 500));
+}
+
+// A joint program holding a Cartesian motion line is ambiguous: an error naming file:line (before: the
+// line was skipped and the motion dropped).
+TEST(Io, CartesianWordsInAJointProgramAreErrors) {
+  const std::string head = "G1 A1=0 A2=-90 A3=90 A4=0 A5=30 A6=0\n";
+  for (const char* l : {"G1 X100 Y5", "G1 A180", "N20 G0 Z-5.5", "G1 A1=1 C0", "G1 Bnan"}) {
+    const std::string e =
+        error_of([&] { parse_joint_program(head + l + "\n", "j.gcode", ProgramFormat::Gcode, 6); });
+    EXPECT_NE(e.find("j.gcode:2: pose word '"), std::string::npos) << l << ": " << e;
+    EXPECT_NE(e.find("in a joint program"), std::string::npos) << l << ": " << e;
+  }
+  // comments, feed and other words still pass
+  const JointProgram jp =
+      parse_joint_program(head + "G1 A1=5 F2000 (X100) ; Y5\nM30\n", "j.gcode", ProgramFormat::Gcode, 6);
+  ASSERT_EQ(jp.q.size(), 2u);
+  EXPECT_EQ(jp.q[1][0], 5.0);
+}
+
+// A CRLF program comes back with CRLF, line by line (the LF program's output with each "\n" a "\r\n");
+// mixed line ends and a last line without a newline are kept as they were.
+TEST(Io, GcodeLinesKeepTheirOwnLineEnds) {
+  const Robot r = kr500_calibrated();
+  const std::string lf_in = tmp("lf.gcode", kGcode), crlf_in = tmp("crlf.gcode", replaced(kGcode, "\n", "\r\n"));
+  const std::string lf_out = ::testing::TempDir() + "lf_o.gcode", crlf_out = ::testing::TempDir() + "crlf_o.gcode";
+  compensate_program_file(r, lf_in, lf_out, ProgramOptions{});
+  compensate_program_file(r, crlf_in, crlf_out, ProgramOptions{});
+  const std::string lf = slurp(lf_out), crlf = slurp(crlf_out);
+  EXPECT_EQ(lf.find('\r'), std::string::npos);
+  EXPECT_EQ(crlf, replaced(lf, "\n", "\r\n"));
+  // mixed, and no newline at the end
+  const std::string mixed = "; a\r\nG1 X2000 Y-100 Z500 A180 B0 C180\nG1 Y-95\r\nM30";
+  const std::string mixed_in = tmp("mixed.gcode", mixed), mixed_out = ::testing::TempDir() + "mixed_o.gcode";
+  compensate_program_file(r, mixed_in, mixed_out, ProgramOptions{});
+  std::string got = slurp(mixed_out);
+  ASSERT_EQ(std::count(got.begin(), got.end(), '\n'), 3) << got;
+  EXPECT_EQ(got.substr(0, 5), "; a\r\n");
+  const size_t l2 = got.find('\n', 5), l3 = got.find('\n', l2 + 1);
+  EXPECT_NE(got[l2 - 1], '\r');
+  EXPECT_EQ(got[l3 - 1], '\r');
+  EXPECT_EQ(got.substr(l3 + 1), "M30");
+}
+
+// RFC 4180 CSV: quoted fields with commas, doubled quotes and line breaks; blanks around fields; a UTF-8
+// byte order mark (as Excel writes it) skipped. (Before: the quoted comma split the field, "8 fields, the
+// header has 7"; the mark made the first column "\xEF\xBB\xBFx", "missing column 'x'".)
+TEST(Io, CsvQuotedFieldsAndByteOrderMark) {
+  const CsvTable t = parse_csv("\xEF\xBB\xBF" "x,\"note, with comma\",y\n"
+                               "1,\"hello, world\",2\n"
+                               "  3 , \"say \"\"hi\"\"\" ,4\r\n"
+                               "\n"
+                               "5,\"two\nlines\",6\n"
+                               "\"7\",,8\n",
+                               "q.csv");
+  ASSERT_EQ(t.header, (std::vector<std::string>{"x", "note, with comma", "y"}));
+  ASSERT_EQ(t.cells.size(), 4u);
+  EXPECT_EQ(t.cells[0][1], "hello, world");
+  EXPECT_EQ(t.cells[1][1], "say \"hi\"");
+  EXPECT_EQ(t.cells[2][1], "two\nlines");
+  EXPECT_EQ(t.number(3, 0), 7.0);
+  EXPECT_EQ(t.cells[3][1], "");
+  EXPECT_EQ(t.line, (std::vector<int>{2, 3, 5, 7}));  // the line each row starts on
+  EXPECT_EQ(t.number(1, 2), 4.0);
+  EXPECT_NE(error_of([&] { parse_csv("x,y\n1,\"open\n2,3\n", "u.csv"); }).find("u.csv:2: a quoted field is not closed"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { parse_csv("x,y\n1,\"a\"b\n", "t.csv"); }).find("t.csv:2: text after the closing"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { parse_csv("x,y\n1,2,3\n", "f.csv"); }).find("f.csv:2: 3 fields, the header has 2"),
+            std::string::npos);
+
+  // a pose program and a measurement file with both: read as the plain ones
+  const Robot r = kr500_calibrated();
+  const std::string plain = tmp("plain.csv", "x,y,z,a,b,c\n2000,-100,500,180,0,180\n");
+  const std::string excel = tmp("excel.csv", "\xEF\xBB\xBF" "x,y,z,a,b,c,note\r\n2000,-100,500,180,0,180,\"hello, world\"\r\n");
+  const std::string o1 = ::testing::TempDir() + "plain_o.csv", o2 = ::testing::TempDir() + "excel_o.csv";
+  compensate_program_file(r, plain, o1, ProgramOptions{});
+  compensate_program_file(r, excel, o2, ProgramOptions{});
+  EXPECT_EQ(slurp(o1), slurp(o2));
+}
+
+// A native program filtered into a file of another name takes that name where the controller ties
+// module and file (KRL DEF / DEFDAT, RAPID MODULE); a name the controller would not take is refused,
+// naming --out and the rule. Every other byte stays.
+TEST(Io, NativeProgramTakesTheNameOfItsNewFile) {
+  const std::string src = "&ACCESS RVP\nDEF tape( ) ; main\n  PTP XP1\nEND\nDEF helper( )\nEND\n";
+  const std::string dat = "DEFDAT  tape PUBLIC\nDECL E6POS XP1={X 2000.0,Y -100.0,Z 500.0,A 180.0,B 0.0,C 180.0}\nENDDAT\n";
+  tmp("tape.src", src);
+  tmp("tape.dat", dat);
+  const NativeProgram p = read_native_program(::testing::TempDir() + "tape.src", ControllerFormat::Krl);
+  ASSERT_EQ(p.targets.size(), 1u);
+  std::vector<Pose6> pose{p.targets[0].pose};
+  std::vector<ControllerTarget> t(1);
+  t[0].pose = p.targets[0].pose;
+  t[0].kuka_s = 2;
+  t[0].kuka_t = 2;
+  const auto files = write_native_program(p, pose, t, {false}, "out/other_2.src");
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].path, "out/other_2.src");
+  EXPECT_EQ(files[0].text, replaced(src, "DEF tape( )", "DEF other_2( )"));  // not the helper
+  EXPECT_EQ(files[1].text.substr(0, files[1].text.find('\n')), "DEFDAT  other_2 PUBLIC");
+  // the same name in another case: unchanged
+  EXPECT_EQ(write_native_program(p, pose, t, {false}, "out/TAPE.src")[0].text, src);
+  for (const char* bad : {"out/other-2.src", "out/2other.src", "out/a_name_longer_than_24_chars.src"}) {
+    const std::string e = error_of([&] { write_native_program(p, pose, t, {false}, bad); });
+    EXPECT_NE(e.find(std::string("--out ") + bad + ": a KRL module is named by its files"), std::string::npos) << e;
+    EXPECT_NE(e.find("a letter, then letters, digits or '_', at most 24 characters"), std::string::npos) << e;
+  }
+  const std::string mod = "MODULE tape\n  CONST robtarget p1:=[[2000,-100,500],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                          "  PROC main()\n    MoveL p1,v100,fine,tool0;\n  ENDPROC\nENDMODULE\r\n";
+  const NativeProgram m = read_native_program(tmp("tape.mod", mod), ControllerFormat::Rapid);
+  std::vector<ControllerTarget> mt(1);
+  mt[0].pose = m.targets[0].pose;
+  const auto mf = write_native_program(m, {m.targets[0].pose}, mt, {false}, "other.mod");
+  EXPECT_EQ(mf[0].text.substr(0, 13), "MODULE other\n");
+  EXPECT_NE(error_of([&] { write_native_program(m, {m.targets[0].pose}, mt, {false}, "o.t.mod"); })
+                .find("--out o.t.mod: a RAPID module is named by its file, and 'o.t' is not a RAPID name"),
             std::string::npos);
 }

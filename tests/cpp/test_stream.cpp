@@ -140,3 +140,58 @@ TEST(Io, SolvePoseAllocatesNothingOnTheNearestBranch) {
   EXPECT_EQ(g_allocs.load() - before, 0);
   EXPECT_EQ(solved, 50);
 }
+
+// The stream stops at the first bad line (README): a NaN, infinite or non-decimal pose word is an error
+// naming stdin:line and the word (before: "G1 Xnan" came out unchanged and the motion was dropped).
+TEST(Io, StreamStopsAtANonFiniteWord) {
+  const Robot r = kr500_calibrated();
+  for (const char* w : {"Xnan", "Xinf", "X1,5", "X1e400"}) {
+    StreamCompensator sc(r, ProgramOptions{});
+    char buf[8192];
+    const std::string l1 = "G1 X2000 Y-100 Z500 A180 B0 C180", l2 = std::string("G1 ") + w;
+    sc.process(l1.data(), l1.size(), buf, sizeof buf);
+    std::string e;
+    try {
+      sc.process(l2.data(), l2.size(), buf, sizeof buf);
+    } catch (const InputError& x) {
+      e = x.what();
+    }
+    EXPECT_NE(e.find(std::string("stdin:2: broken number in word X ('") + w + "'): not a finite decimal number"),
+              std::string::npos) << w << ": " << e;
+  }
+}
+
+// A CRLF G-code line comes out with its '\r' (the caller adds the '\n'), an LF line without; a CSV stream
+// may start with Excel's byte order mark and carry quoted extra columns.
+TEST(Io, StreamKeepsCrlfAndReadsExcelCsv) {
+  const Robot r = kr500_calibrated();
+  StreamCompensator sc(r, ProgramOptions{});
+  char buf[8192];
+  const std::string crlf = "N10 G1 X2000 Y-100 Z500 A180 B0 C180 F2000\r", lf = "N20 Y-95", pass = "M30\r";
+  std::string a(buf, sc.process(crlf.data(), crlf.size(), buf, sizeof buf));
+  ASSERT_EQ(a.back(), '\r');
+  EXPECT_EQ(a.rfind(" F2000\r"), a.size() - 7);
+  std::string b(buf, sc.process(lf.data(), lf.size(), buf, sizeof buf));
+  EXPECT_NE(b.back(), '\r');
+  EXPECT_EQ(std::string(buf, sc.process(pass.data(), pass.size(), buf, sizeof buf)), "M30\r");
+  const std::string comment = "N30 Y-90 (slow, here)";  // a comma in a G-code comment: still G-code
+  EXPECT_NE(std::string(buf, sc.process(comment.data(), comment.size(), buf, sizeof buf)).find("A1="), std::string::npos);
+
+  StreamCompensator plain(r, ProgramOptions{}), excel(r, ProgramOptions{});
+  const std::string ph = "x,y,z,a,b,c", pl = "2000,-100,500,180,0,180";
+  const std::string eh = "\xEF\xBB\xBF" "x,\"note, free text\",y,z,a,b,c", el = "\"2000\",\"hello, world\",-100,500,180,0,180";
+  std::string hp(buf, plain.process(ph.data(), ph.size(), buf, sizeof buf));
+  std::string he(buf, excel.process(eh.data(), eh.size(), buf, sizeof buf));
+  EXPECT_EQ(hp, he);
+  std::string rp(buf, plain.process(pl.data(), pl.size(), buf, sizeof buf));
+  std::string re(buf, excel.process(el.data(), el.size(), buf, sizeof buf));
+  EXPECT_EQ(rp, re);
+  const std::string broken = "2000,\"open,-100,500,180,0,180";
+  std::string e;
+  try {
+    excel.process(broken.data(), broken.size(), buf, sizeof buf);
+  } catch (const InputError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("stdin:3: a quoted field is not closed"), std::string::npos) << e;
+}

@@ -40,6 +40,21 @@ def _cases():
          ["compensate", "--model", "kr500", "--program", "{d}/p.gcode", "--out", "OUT"], "p.gcode:1"),
         ("compensate-gcode-unset", {"p.gcode": "G1 X2000 Y0\n"},
          ["compensate", "--model", "kr500", "--program", "{d}/p.gcode", "--out", "OUT"], "p.gcode:1"),
+        # a number that is not a finite decimal names the word (before: "G1 Xnan" was copied through and its
+        # motion dropped, exit 0; "X1,5" and "X1e400" read as X1)
+        *[(f"compensate-gcode-{k}", {"p.gcode": "G1 X2000 Y0 Z1000 A180 B0 C180\nG1 " + w + " Y10\n"},
+           ["compensate", "--model", "kr500", "--program", "{d}/p.gcode", "--out", "OUT"],
+           f"p.gcode:2: broken number in word {w[0]} ('{w}'): not a finite decimal number")
+          for k, w in (("nan", "Xnan"), ("NaN", "XNaN"), ("inf", "Xinf"), ("comma", "X1,5"), ("exponent", "X1e400"),
+                       ("minus-inf", "Z-inf"))],
+        # a joint program holding a Cartesian motion is ambiguous (before: the line was skipped)
+        *[(f"{cmd}-gcode-cartesian", {"j.gcode": "G1 A1=0 A2=-90 A3=90 A4=0 A5=30 A6=0\nG1 X100 Y5\n"},
+           [cmd, "--robot", "kr500", opt, "{d}/j.gcode", "--out", "OUT"],
+           "j.gcode:2: pose word 'X100' in a joint program")
+          for cmd, opt in (("fk", "--joints"), ("feed", "--program"))],
+        ("csv-quote-unclosed", {"p.csv": 'x,y,z,a,b,c,note\n2000,0,1000,180,0,180,"open\n'},
+         ["compensate", "--model", "kr500", "--program", "{d}/p.csv", "--out", "OUT"],
+         "p.csv:2: a quoted field is not closed"),
         ("model-version", {"m.json": json.dumps({"format": "kincal-model", "version": 99, "nominal": {}})},
          ["compensate", "--model", "{d}/m.json", "--program", "{d}/p.csv", "--out", "OUT"], "m.json"),
         ("model-not-json", {"m.json": "{not json"},
@@ -90,3 +105,42 @@ def test_bad_input(tmp_path, name, files, argv, expect):
     assert not out.exists()
     leftovers = [p for p in tmp_path.rglob("*") if p.name.startswith(".") or p.suffix == ".tmp"]
     assert not leftovers
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_nonfinite_gcode_stops_the_stream_and_writes_no_file(tmp_path, tool):
+    # the same through the standalone program, its --stream included (README: it stops at the first bad line)
+    (tmp_path / "p.gcode").write_text("G1 X2000 Y0 Z1000 A180 B0 C180\nG1 Xinf\nG1 X2010\n")
+    out = tmp_path / "o.gcode"
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", "kr500", "--program", str(tmp_path / "p.gcode"), "--out", str(out))
+    assert r.returncode == 1 and "p.gcode:2: broken number in word X ('Xinf')" in r.stderr, r.stderr
+    assert not out.exists()
+    if tool == "kincal-compensate":
+        r = run(tool, "--model", "kr500", "--stream", stdin=(tmp_path / "p.gcode").read_text())
+        assert r.returncode == 1 and "stdin:2: broken number in word X ('Xinf')" in r.stderr, r.stderr
+        assert len(r.stdout.splitlines()) == 1  # the first pose only
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_standard_csv_variants_are_not_bad_input(tmp_path, tool):
+    # RFC 4180 quoted fields (a comma and a doubled quote inside) in an extra column and the UTF-8 byte
+    # order mark Excel writes, CRLF line ends: read as the plain file (before: "8 fields, the header has 7"
+    # and "missing column 'x'")
+    (tmp_path / "plain.csv").write_text(GOOD_P)
+    (tmp_path / "excel.csv").write_bytes(b"\xef\xbb\xbfx,y,z,a,b,c,note\r\n"
+                                         b'2000,0,1000,180,0,180,"hello, ""world"""\r\n')
+    args = ["compensate"] if tool == "kincal" else []
+    for name in ("plain", "excel"):
+        r = run(tool, *args, "--model", "kr500", "--program", str(tmp_path / f"{name}.csv"), "--out",
+                str(tmp_path / f"{name}_out.csv"))
+        assert r.returncode == 0, r.stderr
+    assert (tmp_path / "excel_out.csv").read_text() == (tmp_path / "plain_out.csv").read_text()
+    if tool == "kincal":  # joints for fk, the C++ reader through the bindings
+        (tmp_path / "q.csv").write_bytes(b"\xef\xbb\xbfq1,q2,q3,q4,q5,q6,\"note, free\"\n0,-90,90,0,45,0,\"a, b\"\n")
+        (tmp_path / "q0.csv").write_text(GOOD_Q)
+        for name in ("q", "q0"):
+            r = run("kincal", "fk", "--robot", "kr500", "--joints", str(tmp_path / f"{name}.csv"), "--out",
+                    str(tmp_path / f"{name}_fk.csv"))
+            assert r.returncode == 0, r.stderr
+        assert (tmp_path / "q_fk.csv").read_text() == (tmp_path / "q0_fk.csv").read_text()

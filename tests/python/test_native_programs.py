@@ -230,3 +230,54 @@ def test_program_tool_and_base(tmp_path, model, calibrated):
     got = iso(kincal.fk(calibrated, q)[0])
     assert np.abs(got[:3, 3] - want[:3, 3]).max() < 1e-3
     assert np.degrees(Rotation.from_matrix(got[:3, :3].T @ want[:3, :3]).magnitude()) < 1e-4
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_crlf_gcode_keeps_its_line_ends(tmp_path, model, tool):
+    # G-code with CRLF line ends comes back with CRLF (the LF program's output with each "\n" a "\r\n"),
+    # --tolerance's inserted lines included; before, both tools wrote LF only
+    poses = kincal.line_program(count=3, step_mm=700.0)
+    text = "; course 1\nN10 G90 (absolute)\n" + "".join(
+        f"N{20 + 10 * i} G1 " + " ".join(f"{k}{v:.4f}" for k, v in zip("XYZABC", p)) + " F3000 ; pose\n"
+        for i, p in enumerate(poses)) + "M30\n"
+    args = ["compensate"] if tool == "kincal" else []
+    for d, eol in (("lf", b"\n"), ("crlf", b"\r\n")):
+        (tmp_path / d).mkdir()
+        (tmp_path / d / "p.gcode").write_bytes(text.encode().replace(b"\n", eol))
+        r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / d / "p.gcode"), "--out",
+                str(tmp_path / d / "o.gcode"), "--tolerance", "0.001")
+        assert r.returncode == 0, r.stderr
+    lf, crlf = (tmp_path / "lf" / "o.gcode").read_bytes(), (tmp_path / "crlf" / "o.gcode").read_bytes()
+    assert lf.count(b"\n") > text.count("\n")  # targets were inserted
+    assert b"\r" not in lf and crlf == lf.replace(b"\n", b"\r\n")
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_filtered_module_takes_the_name_of_its_file(tmp_path, model, tool):
+    # a KRL module is named by its files (DEF in the .src, DEFDAT in the .dat), a RAPID module by MODULE:
+    # written to another file name it takes that name, every other line as when written under its own
+    # name; a file name the controller cannot take is refused, naming --out and the rule, nothing written
+    for f in ("tape.src", "tape.dat", "tape.mod"):
+        shutil.copy(DATA / f, tmp_path / f)
+    args = ["compensate"] if tool == "kincal" else []
+    for d in ("same", "other", "bad"):
+        (tmp_path / d).mkdir()
+    for prog, new, head in (("tape.src", "other.src", ["DEF tape( )", "DEFDAT  tape"]),
+                            ("tape.mod", "other.mod", ["MODULE tape"])):
+        common = [*args, "--model", str(model), "--program", str(tmp_path / prog), "--targets", "filtered"]
+        assert run(tool, *common, "--out", str(tmp_path / "same" / prog)).returncode == 0
+        r = run(tool, *common, "--out", str(tmp_path / "other" / new))
+        assert r.returncode == 0, r.stderr
+        exts = (".src", ".dat") if prog.endswith(".src") else (".mod",)
+        same = "".join((tmp_path / "same" / ("tape" + e)).read_text() for e in exts)
+        other = "".join((tmp_path / "other" / ("other" + e)).read_text() for e in exts)
+        for h in head:
+            assert h in same
+            same = same.replace(h, h.replace("tape", "other"))
+        assert other == same
+        bad = tmp_path / "bad" / ("other-1" + Path(prog).suffix)
+        r = run(tool, *common, "--out", str(bad))
+        lang = "KRL" if prog.endswith(".src") else "RAPID"
+        assert r.returncode == 1 and f"--out {bad}: a {lang} module is named by its file" in r.stderr, r.stderr
+        assert "'other-1' is not a" in r.stderr and "a letter, then letters, digits or '_'" in r.stderr
+        assert not any((tmp_path / "bad").iterdir())

@@ -6,6 +6,7 @@
 #include "kincal/io/gcode.hpp"
 #include "kincal/io/programs.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -24,20 +25,58 @@ Vec6 stream_directions(const Robot& robot, const ProgramOptions& opt) {
   return initial_directions(opt.initial_direction);
 }
 
-// The next comma-separated field of [f, e) without its surrounding blanks; f moves past its comma.
+// The next comma-separated field of [f, e) without its surrounding blanks (RFC 4180: a field in double
+// quotes may hold commas; its quotes are not part of it, a quote written twice inside stays so); f moves
+// past its comma. `broken`: an unclosed quote, or text after the closing one.
 struct Field {
   const char* begin;
   const char* end;
+  bool broken = false;
+  bool quoted = false;
 };
 Field next_field(const char*& f, const char* e) {
+  auto blank = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
   const char* c = f;
+  while (c < e && blank(*c)) ++c;
+  if (c < e && *c == '"') {
+    Field field{c + 1, c + 1, false, true};
+    for (++c; c < e; ++c) {
+      if (*c != '"') continue;
+      if (c + 1 < e && c[1] == '"') {
+        ++c;
+        continue;
+      }
+      break;
+    }
+    field.end = c;
+    field.broken = c >= e;
+    if (c < e) ++c;
+    while (c < e && blank(*c)) ++c;
+    field.broken = field.broken || (c < e && *c != ',');
+    while (c < e && *c != ',') ++c;
+    f = c + 1;
+    return field;
+  }
   while (c < e && *c != ',') ++c;
   Field field{f, c};
-  while (field.begin < field.end && std::isspace(static_cast<unsigned char>(*field.begin))) ++field.begin;
-  while (field.end > field.begin && std::isspace(static_cast<unsigned char>(field.end[-1]))) --field.end;
+  while (field.begin < field.end && blank(*field.begin)) ++field.begin;
+  while (field.end > field.begin && blank(field.end[-1])) --field.end;
   f = c + 1;
   return field;
 }
+
+// Whether a line with commas reads as G-code rather than as a CSV header: its first field (unquoted)
+// holds a blank, a comment or a parenthesis, as "G1 X1,5" or "G1 X10 (a, b)" do.
+bool gcode_with_commas(const char* s, size_t n) {
+  const char* f = s;
+  const Field fl = next_field(f, s + n);
+  if (fl.quoted) return false;
+  for (const char* c = fl.begin; c < fl.end; ++c)
+    if (*c == ' ' || *c == '\t' || *c == '(' || *c == ';') return true;
+  return false;
+}
+
+constexpr const char* kBrokenQuote = "a quoted field is not closed, or text follows its closing '\"'";
 
 }  // namespace
 
@@ -73,14 +112,24 @@ Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
 size_t StreamCompensator::process(const char* s, size_t n, char* out, size_t cap) {
   ++line_no_;
   warning_.clear();
-  while (n > 0 && (s[n - 1] == '\r' || s[n - 1] == '\n')) --n;
-  // CSV when the line has commas and no pose letters in it
+  bool cr = false;  // a CRLF line: a G-code line comes out with its '\r' (the caller adds the '\n')
+  while (n > 0 && (s[n - 1] == '\r' || s[n - 1] == '\n')) cr = cr || s[n - 1] == '\r', --n;
+  // CSV when the line has commas, unless it reads as G-code (below); a header when it has letters
   bool has_comma = false, has_letter = false;
   for (size_t i = 0; i < n; ++i) {
     has_comma = has_comma || s[i] == ',';
     has_letter = has_letter || std::isalpha(static_cast<unsigned char>(s[i]));
   }
-  if (!has_comma) return gcode_line(s, n, out, cap);
+  // a stream of G-code stays G-code (a comma there is in a comment or a broken number)
+  const bool gcode_seen = std::find(modal_set_, modal_set_ + 6, true) != modal_set_ + 6;
+  if (!has_comma || gcode_seen || (!csv_header_seen_ && has_letter && gcode_with_commas(s, n))) {
+    const size_t len = gcode_line(s, n, out, cap);
+    if (!cr) return len;
+    if (len + 1 >= cap) fail_at("stdin", line_no_, "line too long");
+    out[len] = '\r';
+    return len + 1;
+  }
+  if (line_no_ == 1 && n >= 3 && std::memcmp(s, "\xEF\xBB\xBF", 3) == 0) s += 3, n -= 3;  // Excel's byte order mark
   if (has_letter && !csv_header_seen_) return csv_header(s, n, out, cap);
   return csv_line(s, n, out, cap);
 }
@@ -91,6 +140,7 @@ size_t StreamCompensator::csv_header(const char* s, size_t n, char* out, size_t 
   int found = 0, col = 0;
   for (const char* f = s; f <= s + n; ++col) {
     const Field fl = next_field(f, s + n);
+    if (fl.broken) fail_at("stdin", line_no_, kBrokenQuote);
     for (int k = 0; k < 6; ++k)
       if (fl.end - fl.begin == 1 && *fl.begin == names[k][0]) csv_cols_[k] = col, found |= 1 << k;
     if (fl.end - fl.begin == 13 && std::strncmp(fl.begin, "temperature_c", 13) == 0) csv_temperature_col_ = col;
@@ -109,6 +159,7 @@ size_t StreamCompensator::csv_line(const char* s, size_t n, char* out, size_t ca
   int got = 0, col = 0;
   for (const char* f = s; f <= s + n; ++col) {
     const Field fl = next_field(f, s + n);
+    if (fl.broken) fail_at("stdin", line_no_, kBrokenQuote);
     for (int k = 0; k < 7; ++k) {
       if (k < 6 ? csv_cols_[k] != col : csv_temperature_col_ != col) continue;
       const NumberParse r = parse_number(fl.begin, fl.end, vals[k]);

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <sstream>
 
 namespace kincal {
 
@@ -62,37 +61,74 @@ double CsvTable::number(size_t row, int col) const {
   }
 }
 
+// RFC 4180 with the contract's leniencies: a UTF-8 byte order mark (as Excel writes it) is skipped; blank
+// lines are skipped; blanks around a field are not part of it; a field in double quotes may hold commas,
+// line breaks and quotes (written twice); a quote inside an unquoted field is a character like any other.
+// Each row carries the line it starts on.
 CsvTable parse_csv(const std::string& text, const std::string& source) {
   CsvTable t;
   t.source = source;
-  std::istringstream in(text);
-  std::string raw;
-  int line = 0;
+  const size_t n = text.size();
+  size_t i = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  int line = 1;
   bool have_header = false;
-  while (std::getline(in, raw)) {
-    ++line;
-    const std::string s = trim(raw);
-    if (s.empty()) continue;
+  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  while (i < n) {
+    const int first_line = line;
     std::vector<std::string> fields;
-    size_t pos = 0;
+    bool empty_row = true;  // nothing but blanks so far
     while (true) {
-      const size_t c = s.find(',', pos);
-      fields.push_back(trim(s.substr(pos, c == std::string::npos ? std::string::npos : c - pos)));
-      if (c == std::string::npos) break;
-      pos = c + 1;
+      const size_t a = i;
+      while (i < n && blank(text[i])) ++i;
+      if (i < n && text[i] == '"') {
+        const int open_line = line;
+        std::string f;
+        for (++i;; ++i) {
+          if (i >= n)
+            throw InputError(where(source, open_line) + ": a quoted field is not closed (its '\"' opens here)");
+          if (text[i] == '"') {
+            if (i + 1 < n && text[i + 1] == '"') {
+              f += '"';
+              ++i;
+              continue;
+            }
+            ++i;
+            break;
+          }
+          if (text[i] == '\n') ++line;
+          f += text[i];
+        }
+        while (i < n && blank(text[i])) ++i;
+        if (i < n && text[i] != ',' && text[i] != '\n')
+          throw InputError(where(source, line) + ": text after the closing '\"' of a quoted field");
+        fields.push_back(std::move(f));
+        empty_row = false;
+      } else {
+        while (i < n && text[i] != ',' && text[i] != '\n') ++i;
+        fields.push_back(trim(text.substr(a, i - a)));
+        empty_row = empty_row && fields.back().empty();
+      }
+      if (i < n && text[i] == ',') {
+        ++i;
+        empty_row = false;
+        continue;
+      }
+      break;  // the line's end or the text's
     }
+    if (i < n) ++i, ++line;  // the '\n'
+    if (empty_row) continue;
     if (!have_header) {
       for (const auto& f : fields)
-        if (f.empty()) throw InputError(where(source, line) + ": empty column name in the header");
-      t.header = fields;
+        if (f.empty()) throw InputError(where(source, first_line) + ": empty column name in the header");
+      t.header = std::move(fields);
       have_header = true;
       continue;
     }
     if (fields.size() != t.header.size())
-      throw InputError(where(source, line) + ": " + std::to_string(fields.size()) + " fields, the header has " +
+      throw InputError(where(source, first_line) + ": " + std::to_string(fields.size()) + " fields, the header has " +
                        std::to_string(t.header.size()));
     t.cells.push_back(std::move(fields));
-    t.line.push_back(line);
+    t.line.push_back(first_line);
   }
   if (!have_header) throw InputError(source + ": empty file (no header row)");
   return t;

@@ -19,8 +19,45 @@ int pose_axis(char c) {
   return (p && u) ? static_cast<int>(p - kPoseLetters) : -1;
 }
 
-// Parses a G-code number at s[i..n): [+-]digits[.digits]; returns the end or fails.
-size_t gcode_number(const char* s, size_t i, size_t n, double& v, const char* src, int line, const char* word) {
+// The word as written, for an error: from its letter to the next blank, ';', '(' or the line's end.
+std::string word_text(const char* s, size_t begin, size_t n) {
+  size_t e = begin;
+  while (e < n && !std::isspace(static_cast<unsigned char>(s[e])) && s[e] != ';' && s[e] != '(') ++e;
+  return std::string(s + begin, s + e);
+}
+
+[[noreturn]] void broken_number(const char* s, size_t word_begin, size_t n, const char* src, int line,
+                                const std::string& word) {
+  fail_at(src, line, "broken number in word " + word + " ('" + word_text(s, word_begin, n) +
+                         "'): not a finite decimal number");
+}
+
+// Whether [b, e) spells NaN or infinity (any case): what strtod would take for a number.
+// No allocation (the streaming corrector scans with it).
+bool nonfinite_name(const char* b, const char* e) {
+  auto is = [&](const char* w) {
+    const size_t m = std::strlen(w);
+    if (static_cast<size_t>(e - b) != m) return false;
+    for (size_t k = 0; k < m; ++k)
+      if (std::tolower(static_cast<unsigned char>(b[k])) != w[k]) return false;
+    return true;
+  };
+  return is("nan") || is("inf") || is("infinity");
+}
+
+// Whether s[i] can start a number (or a NaN/infinity spelled out, which is then refused).
+bool number_start(const char* s, size_t i, size_t n) {
+  if (i >= n) return false;
+  const char c = s[i];
+  return std::isdigit(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.';
+}
+
+// Parses a G-code number at s[i..n): [+-]digits[.digits], followed by the line's end, a blank, a
+// comment, a checksum '*', the next word's letter, or (allow_equals) '='. Anything else (a second
+// '.', a decimal comma, an exponent, NaN, infinity) is not a finite decimal number: InputError naming
+// the word (word_begin: where its letter stands). Returns the number's end.
+size_t gcode_number(const char* s, size_t i, size_t n, double& v, const char* src, int line, const std::string& word,
+                    size_t word_begin, bool allow_equals) {
   const size_t start = i;
   if (i < n && (s[i] == '+' || s[i] == '-')) ++i;
   size_t digits = 0;
@@ -29,11 +66,19 @@ size_t gcode_number(const char* s, size_t i, size_t n, double& v, const char* sr
     ++i;
     while (i < n && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
   }
-  if (digits == 0 || (i < n && (s[i] == '.' || s[i] == '+' || s[i] == '-')))
-    fail_at(src, line, std::string("broken number in word ") + word + " ('" +
-                           std::string(s + start - std::strlen(word), s + std::min(n, i + 1)) + "')");
-  if (parse_number(s + start, s + i, v) != NumberParse::Ok)
-    fail_at(src, line, std::string("broken number in word ") + word);
+  bool ok = digits > 0;
+  if (ok && i < n) {
+    const char c = s[i];
+    if (c == 'e' || c == 'E') {  // an exponent (1e400, 1E-3); a letter E with no number after is a word
+      size_t k = i + 1;
+      if (k < n && (s[k] == '+' || s[k] == '-')) ++k;
+      ok = !(k < n && std::isdigit(static_cast<unsigned char>(s[k])));
+    } else {
+      ok = std::isspace(static_cast<unsigned char>(c)) || std::isalpha(static_cast<unsigned char>(c)) || c == ';' ||
+           c == '(' || c == '*' || (allow_equals && c == '=');
+    }
+  }
+  if (!ok || parse_number(s + start, s + i, v) != NumberParse::Ok) broken_number(s, word_begin, n, src, line, word);
   return i;
 }
 
@@ -61,18 +106,20 @@ int scan_gcode(const char* s, size_t n, GcodeWords kind, int dof, GcodeWord* wor
       ++i;
       continue;
     }
-    // a run of letters; only a single letter is a word address
+    // a run of letters; only a single letter is a word address (a pose letter followed by NaN or
+    // infinity spelled out is a word with a number that is not finite)
     size_t j = i;
     while (j < n && (std::isalpha(static_cast<unsigned char>(s[j])) || s[j] == '_')) ++j;
     const bool single = (j == i + 1);
+    const int ax = pose_axis(c);
+    const bool nonfinite = ax >= 0 && !single && nonfinite_name(s + i + 1, s + j);
+    const std::string letter(1, static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
     if (kind == GcodeWords::Pose) {
-      const int ax = single ? pose_axis(c) : -1;
-      if (ax >= 0) {
-        const char word[2] = {static_cast<char>(std::toupper(static_cast<unsigned char>(c))), 0};
-        if (j >= n || !(std::isdigit(static_cast<unsigned char>(s[j])) || s[j] == '+' || s[j] == '-' || s[j] == '.'))
-          fail_at(src, line, std::string("word ") + word + " has no number");
+      if (nonfinite) broken_number(s, i, n, src, line, letter);
+      if (single && ax >= 0) {
+        if (!number_start(s, j, n)) fail_at(src, line, "word " + letter + " has no number");
         double v;
-        const size_t e = gcode_number(s, j, n, v, src, line, word);
+        const size_t e = gcode_number(s, j, n, v, src, line, letter, i, true);
         if (e < n && s[e] == '=')
           fail_at(src, line, std::string("joint word ") + std::string(s + i, s + e) +
                                  "= in a pose program (pose words are X Y Z A B C)");
@@ -81,24 +128,30 @@ int scan_gcode(const char* s, size_t n, GcodeWords kind, int dof, GcodeWord* wor
         i = e;
         continue;
       }
-    } else if (single && (c == 'A' || c == 'a') && j < n && std::isdigit(static_cast<unsigned char>(s[j]))) {
-      size_t k = j;
-      int axis = 0;
-      while (k < n && std::isdigit(static_cast<unsigned char>(s[k]))) {
-        if (axis < 1000) axis = axis * 10 + (s[k] - '0');  // a huge index stays huge, never overflows
-        ++k;
+    } else {
+      if (single && (c == 'A' || c == 'a') && j < n && std::isdigit(static_cast<unsigned char>(s[j]))) {
+        size_t k = j;
+        int axis = 0;
+        while (k < n && std::isdigit(static_cast<unsigned char>(s[k]))) {
+          if (axis < 1000) axis = axis * 10 + (s[k] - '0');  // a huge index stays huge, never overflows
+          ++k;
+        }
+        if (k < n && s[k] == '=') {
+          const std::string word = std::string(s + i, s + k) + "=";
+          if (axis < 1 || axis > dof)
+            fail_at(src, line, "word " + word + " but the robot has " + std::to_string(dof) + " joints");
+          double v;
+          const size_t e = gcode_number(s, k + 1, n, v, src, line, word, i, false);
+          if (count == cap) fail_at(src, line, "too many joint words on one line");
+          words[count++] = GcodeWord{axis - 1, i, e, v};
+          i = e;
+          continue;
+        }
       }
-      if (k < n && s[k] == '=') {
-        const std::string word = std::string(s + i, s + k) + "=";
-        if (axis < 1 || axis > dof)
-          fail_at(src, line, "word " + word + " but the robot has " + std::to_string(dof) + " joints");
-        double v;
-        const size_t e = gcode_number(s, k + 1, n, v, src, line, word.c_str());
-        if (count == cap) fail_at(src, line, "too many joint words on one line");
-        words[count++] = GcodeWord{axis - 1, i, e, v};
-        i = e;
-        continue;
-      }
+      // a pose word (X100, A180, Xnan) in a joint program: a Cartesian motion there is ambiguous
+      if (nonfinite || (single && ax >= 0 && number_start(s, j, n)))
+        fail_at(src, line, "pose word '" + word_text(s, i, n) + "' in a joint program (joint words are A1= .. A" +
+                               std::to_string(dof) + "=): a Cartesian motion in a joint program is ambiguous");
     }
     i = j;
   }

@@ -85,6 +85,42 @@ void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTar
     if (l.compare(0, 4, "/END") == 0) l.insert(0, positions);
 }
 
+// A module written to a file of another name takes that name where the controller ties the two: KRL
+// (the .src's first DEF or DEFFCT, the .dat's DEFDAT) and RAPID (MODULE). A name the controller would
+// not take is refused, naming --out and the rule. Names are compared as the controllers do, ignoring case.
+void rename_module(const NativeProgram& p, std::vector<std::vector<std::string>>& lines, const std::string& out_path) {
+  const bool krl = p.format == ControllerFormat::Krl;
+  if (!krl && p.format != ControllerFormat::Rapid) return;
+  const std::string name = ctl::stem_of(out_path);
+  const size_t max_len = krl ? 24 : 32;
+  const char* language = krl ? "KRL" : "RAPID";
+  static const std::regex def_re(R"(^(\s*(?:GLOBAL\s+)?DEF\s+)(\w+))", std::regex::icase),
+      fct_re(R"(^(\s*(?:GLOBAL\s+)?DEFFCT\s+\w+(?:\s*\[\s*\d*\s*\])?\s+)(\w+))", std::regex::icase),
+      dat_re(R"(^(\s*DEFDAT\s+)(\w+))", std::regex::icase), mod_re(R"(^(\s*MODULE\s+)(\w+))", std::regex::icase);
+  for (size_t f = 0; f < lines.size(); ++f) {
+    for (std::string& l : lines[f]) {
+      const std::string code = code_before(l, krl ? ';' : '!');
+      std::smatch m;
+      const bool found = !krl ? std::regex_search(code, m, mod_re)
+                              : f == 0 ? std::regex_search(code, m, def_re) || std::regex_search(code, m, fct_re)
+                                       : std::regex_search(code, m, dat_re);
+      if (!found) continue;
+      if (upper_case(m[2].str()) != upper_case(name)) {
+        bool valid = !name.empty() && name.size() <= max_len && std::isalpha(static_cast<unsigned char>(name[0]));
+        for (char c : name) valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+        if (!valid)
+          throw InputError("--out " + out_path + ": a " + language + " module is named by its file" +
+                           (krl ? "s" : "") + ", and '" + name + "' is not a " + language +
+                           " name (a letter, then letters, digits or '_', at most " + std::to_string(max_len) +
+                           " characters)");
+        const auto [b, e] = span_of(m, 2);
+        l.replace(b, e - b, name);
+      }
+      break;  // the module's own name: the first such line of the file
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
@@ -143,6 +179,7 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
     for (const Replacement& r : reps) l.replace(r.begin, r.end - r.begin, r.text);
   }
   with_inserted_targets(p, inserted, lines[0]);
+  rename_module(p, lines, out_path);
   std::vector<OutputFile> out;
   for (size_t f = 0; f < lines.size(); ++f) {
     std::string text;

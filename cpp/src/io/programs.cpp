@@ -30,19 +30,37 @@ PoseProgram parse_pose_csv(const std::string& text, const std::string& source) {
   return p;
 }
 
+// The text's lines without their ends, and each one's end: "\n", "\r\n", or for a last line without a
+// newline "" (or "\r").
+std::vector<std::pair<std::string, std::string>> lines_with_ends(const std::string& text) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (size_t b = 0; b < text.size();) {
+    size_t e = text.find('\n', b);
+    const bool nl = e != std::string::npos;
+    if (!nl) e = text.size();
+    const bool cr = e > b && text[e - 1] == '\r';
+    out.emplace_back(text.substr(b, e - b - (cr ? 1 : 0)), std::string(cr ? "\r" : "") + (nl ? "\n" : ""));
+    b = e + 1;
+  }
+  return out;
+}
+
 PoseProgram parse_pose_gcode(const std::string& text, const std::string& source) {
   PoseProgram p;
-  std::istringstream in(text);
-  std::string raw;
   int line = 0;
   Pose6 modal;
   bool set[6] = {false, false, false, false, false, false};
   GcodeWord words[16];
-  while (std::getline(in, raw)) {
+  const auto split = lines_with_ends(text);
+  if (!split.empty()) {
+    p.eol = split[0].second == "\r\n" ? "\r\n" : "\n";
+    p.final_newline = !split.back().second.empty() && split.back().second.back() == '\n';
+  }
+  for (const auto& [raw, eol] : split) {
     ++line;
-    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
     const int n = scan_gcode(raw.data(), raw.size(), GcodeWords::Pose, 6, words, 16, source.c_str(), line);
     PoseProgram::Line l;
+    l.eol = eol;
     if (n == 0) {
       l.text = raw;
       p.lines.push_back(std::move(l));
@@ -171,7 +189,8 @@ std::string format_joint_program(const PoseProgram& in, const std::vector<Vec6>&
     }
     return out;
   }
-  for (const PoseProgram::Line& l : in.lines) {
+  for (size_t i = 0; i < in.lines.size(); ++i) {
+    const PoseProgram::Line& l = in.lines[i];
     if (l.pose < 0) {
       out += l.text;
     } else {
@@ -179,7 +198,10 @@ std::string format_joint_program(const PoseProgram& in, const std::vector<Vec6>&
       out.append(line, emit_gcode_line(l.text.data(), l.text.size(), l.insert_at,
                                        q_deg[static_cast<size_t>(l.pose)], line, sizeof line));
     }
-    out += '\n';
+    // each line keeps its own end; a line without one (inserted after reading) takes the program's,
+    // but for the last line of a file that ends without a newline
+    const bool last = i + 1 == in.lines.size();
+    out += !l.eol.empty() ? l.eol : (last && !in.final_newline) ? std::string() : in.eol;
   }
   return out;
 }

@@ -1,5 +1,7 @@
 // kincal: CSV tables (a header row, then rows of string cells with their line numbers) and the one
-// number parser every reader uses (whole field, finite). Errors are InputError "file:line: cause".
+// number parser every reader uses (whole field, finite). RFC 4180 fields: double-quoted ones may hold
+// commas, line breaks and quotes written twice; a leading UTF-8 byte order mark (Excel's) is skipped.
+// Errors are InputError "file:line: cause".
 #pragma once
 
 #include "kincal/core/types.hpp"

@@ -24,14 +24,18 @@ struct PoseProgram {
   std::vector<Pose6> poses;
   std::vector<int> pose_line;  ///< line number of every pose
   std::vector<double> temperature_c;  ///< CSV: the temperature_c column per pose, when present
-  // G-code only: every input line with its pose words cut out, where to put the joint words, and
-  // which pose it carries (-1: passes through unchanged)
+  // G-code only: every input line with its pose words cut out, where to put the joint words, which
+  // pose it carries (-1: passes through unchanged), and its own line end ("\n" or "\r\n"; empty: the
+  // program's `eol`, for a line inserted after reading)
   struct Line {
     std::string text;
     size_t insert_at = 0;
     int pose = -1;
+    std::string eol{};
   };
   std::vector<Line> lines;
+  std::string eol = "\n";     ///< G-code: the first line's end ("\r\n" for a CRLF file)
+  bool final_newline = true;  ///< G-code: whether the last line ends in a newline
 };
 PoseProgram read_pose_program(const std::string& path);
 PoseProgram parse_pose_program(const std::string& text, const std::string& source, ProgramFormat format);
@@ -51,7 +55,8 @@ JointProgram parse_joint_program(const std::string& text, const std::string& sou
 size_t format_joints(char* out, size_t cap, const Vec6& q_deg, ProgramFormat format);
 
 /// The joint program of a pose program as text: CSV (q1..q6) or G-code (a G-code input's lines with
-/// A1=.. words in place of the pose words; "G1 A1=.." lines for a CSV input), one q_deg per pose.
+/// A1=.. words in place of the pose words, each with its own line end; "G1 A1=.." lines for a CSV
+/// input), one q_deg per pose.
 std::string format_joint_program(const PoseProgram& in, const std::vector<Vec6>& q_deg, ProgramFormat format);
 
 }  // namespace kincal

@@ -21,14 +21,14 @@ def format_rows(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
 
 def header(path: str) -> list:
     """The column names of a CSV file (stripped; empty for an empty file)."""
-    with open(path, newline="") as f:
+    with open(path, newline="", encoding="utf-8-sig") as f:  # a leading BOM (Excel) is no part of a name
         return [h.strip() for h in next(csv.reader(f), [])]
 
 
 def text_columns(path: str, names: Sequence[str]) -> dict:
     """The columns of ``names`` a CSV has (e.g. pose, target), as texts row by row (blank lines
     skipped); the names it lacks are left out."""
-    with open(path, newline="") as f:
+    with open(path, newline="", encoding="utf-8-sig") as f:  # a leading BOM (Excel) is no part of a name
         rows = [r for r in csv.reader(f) if any(c.strip() for c in r)]
     if not rows:
         return {}

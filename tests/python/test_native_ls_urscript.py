@@ -64,7 +64,8 @@ def _reaches(calibrated, q, desired, tol_mm) -> bool:
 def test_ls_only_target_values_change(tmp_path, model, calibrated, tool):
     shutil.copy(DATA / "tape.ls", tmp_path / "tape.ls")
     args = ["compensate"] if tool == "kincal" else []
-    out = tmp_path / "out.ls"
+    (tmp_path / "out").mkdir()
+    out = tmp_path / "out" / "tape.ls"  # the program's own name: /PROG TAPE stays (a new name renames it)
     base = [*args, "--model", str(model), "--program", str(tmp_path / "tape.ls"), "--out", str(out), "--targets", "filtered"]
     r = run(tool, *base)
     assert r.returncode != 0 and not out.exists()
@@ -162,6 +163,7 @@ def _several_frames_program(tmp_path) -> Path:
     for n, (uf, ut) in LS_FRAMES.items():
         text = re.sub(r"(P\[" + str(n) + r"[^\]]*\]\{\s*GP1:\s*)UF : 0, UT : 1,", rf"\g<1>UF : {uf}, UT : {ut},", text)
     path = tmp_path / "frames.ls"
+    text = text.replace("/PROG  TAPE", "/PROG  FRAMES", 1)  # named by its file, as on the controller
     path.write_text(text)
     return path
 
@@ -172,7 +174,8 @@ def _reached_in_frames(tool, tmp_path, model, calibrated, uframes: dict) -> list
     program means), run through the nominal IK branch its CONFIG selects, puts the calibrated robot's tool
     where the program's pose is (within 5e-3 mm, 1e-3 deg). Checks that only X..R and CONFIG lines change."""
     program = _several_frames_program(tmp_path)
-    out = tmp_path / "out.ls"
+    (tmp_path / "out").mkdir(exist_ok=True)
+    out = tmp_path / "out" / program.name  # under its own name: only positions change (/PROG too otherwise)
     args = ["compensate"] if tool == "kincal" else []
     frames = [a for n, f in uframes.items() for a in ("--uframe", f"{n}=" + ",".join(map(str, f)))]
     frames += [a for n, f in UTOOLS.items() for a in ("--utool", f"{n}=" + ",".join(map(str, f)))]
@@ -244,3 +247,25 @@ def test_ls_several_frames_need_each_given(tmp_path, model, tool):
     r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "poses.csv"), "--out",
             str(tmp_path / "o.csv"), "--utool", "1=0,0,0,0,0,0")
     assert r.returncode == 1 and "apply to FANUC LS programs" in r.stderr and not (tmp_path / "o.csv").exists(), r.stderr
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_ls_program_takes_the_name_of_its_file(tmp_path, model, tool):
+    """A FANUC LS program is named by /PROG (upper case, as its file on the controller): tape.ls
+    written as other.ls says /PROG OTHER, every other line as when written under its own name; a
+    name the controller cannot take is refused, naming --out and the rule, nothing written."""
+    shutil.copy(DATA / "tape.ls", tmp_path / "tape.ls")
+    args = ["compensate"] if tool == "kincal" else []
+    common = [*args, "--model", str(model), "--program", str(tmp_path / "tape.ls"), "--targets", "filtered",
+              "--skip-unresolved"]
+    for d in ("same", "other", "bad"):
+        (tmp_path / d).mkdir()
+    assert run(tool, *common, "--out", str(tmp_path / "same" / "tape.ls")).returncode == 0
+    r = run(tool, *common, "--out", str(tmp_path / "other" / "other.ls"))
+    assert r.returncode == 0, r.stderr
+    same, other = (tmp_path / "same" / "tape.ls").read_text(), (tmp_path / "other" / "other.ls").read_text()
+    head = next(l for l in same.splitlines() if l.startswith("/PROG"))
+    assert "TAPE" in head and other == same.replace(head, head.replace("TAPE", "OTHER"), 1)
+    r = run(tool, *common, "--out", str(tmp_path / "bad" / "2nd.ls"))
+    assert r.returncode == 1 and "a FANUC LS module is named by its file" in r.stderr and "'2ND' is not a" in r.stderr
+    assert not any((tmp_path / "bad").iterdir())

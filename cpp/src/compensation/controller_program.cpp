@@ -244,7 +244,7 @@ void with_inserted_targets(PoseProgram& prog, const std::vector<int>& original) 
       const int k = refined_of[static_cast<size_t>(l.pose)];
       for (; next < k; ++next) lines.push_back({"G1 ", 3, next});
       next = k + 1;
-      lines.push_back({l.text, l.insert_at, k});
+      lines.push_back({l.text, l.insert_at, k, l.eol});
     } else {
       lines.push_back(l);
     }

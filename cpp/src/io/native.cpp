@@ -89,21 +89,24 @@ void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTar
 // (the .src's first DEF or DEFFCT, the .dat's DEFDAT) and RAPID (MODULE). A name the controller would
 // not take is refused, naming --out and the rule. Names are compared as the controllers do, ignoring case.
 void rename_module(const NativeProgram& p, std::vector<std::vector<std::string>>& lines, const std::string& out_path) {
-  const bool krl = p.format == ControllerFormat::Krl;
-  if (!krl && p.format != ControllerFormat::Rapid) return;
-  const std::string name = ctl::stem_of(out_path);
-  const size_t max_len = krl ? 24 : 32;
-  const char* language = krl ? "KRL" : "RAPID";
+  const bool krl = p.format == ControllerFormat::Krl, ls = p.format == ControllerFormat::FanucLs;
+  if (!krl && !ls && p.format != ControllerFormat::Rapid) return;
+  // an LS program's /PROG name is upper case on the controller (its file name is the same name)
+  const std::string name = ls ? upper_case(ctl::stem_of(out_path)) : ctl::stem_of(out_path);
+  const size_t max_len = krl ? 24 : ls ? 36 : 32;
+  const char* language = krl ? "KRL" : ls ? "FANUC LS" : "RAPID";
   static const std::regex def_re(R"(^(\s*(?:GLOBAL\s+)?DEF\s+)(\w+))", std::regex::icase),
       fct_re(R"(^(\s*(?:GLOBAL\s+)?DEFFCT\s+\w+(?:\s*\[\s*\d*\s*\])?\s+)(\w+))", std::regex::icase),
-      dat_re(R"(^(\s*DEFDAT\s+)(\w+))", std::regex::icase), mod_re(R"(^(\s*MODULE\s+)(\w+))", std::regex::icase);
+      dat_re(R"(^(\s*DEFDAT\s+)(\w+))", std::regex::icase), mod_re(R"(^(\s*MODULE\s+)(\w+))", std::regex::icase),
+      prog_re(R"(^(\s*/PROG\s+)(\w+))", std::regex::icase);
   for (size_t f = 0; f < lines.size(); ++f) {
     for (std::string& l : lines[f]) {
-      const std::string code = code_before(l, krl ? ';' : '!');
+      const std::string code = ls ? l : code_before(l, krl ? ';' : '!');
       std::smatch m;
-      const bool found = !krl ? std::regex_search(code, m, mod_re)
-                              : f == 0 ? std::regex_search(code, m, def_re) || std::regex_search(code, m, fct_re)
-                                       : std::regex_search(code, m, dat_re);
+      const bool found = ls     ? std::regex_search(code, m, prog_re)
+                         : !krl ? std::regex_search(code, m, mod_re)
+                         : f == 0 ? std::regex_search(code, m, def_re) || std::regex_search(code, m, fct_re)
+                                  : std::regex_search(code, m, dat_re);
       if (!found) continue;
       if (upper_case(m[2].str()) != upper_case(name)) {
         bool valid = !name.empty() && name.size() <= max_len && std::isalpha(static_cast<unsigned char>(name[0]));

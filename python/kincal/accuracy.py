@@ -58,7 +58,7 @@ ANGLES = ["a", "b", "c"]
 def read_table(path: str, required: Sequence[str], optional: Sequence[str] = ()) -> dict:
     """The columns ``required`` (a missing one is an error naming it) and those of ``optional`` the
     CSV has, as texts, with ``line`` (the file's line of each row; blank lines skipped)."""
-    with open(path, newline="") as f:
+    with open(path, newline="", encoding="utf-8-sig") as f:  # a leading BOM (Excel) is no part of a name
         reader = csv.reader(f)
         head: Optional[list] = None
         cols: dict = {}

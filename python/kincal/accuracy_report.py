@@ -7,14 +7,12 @@ from __future__ import annotations
 import io
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 from typing import Optional, Union
 
 import numpy as np
 
-from . import _core, report
+from . import report
 from . import accuracy as acc
 
 COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
@@ -35,22 +33,11 @@ def _png(fig) -> bytes:
 
 
 def write_folder(out: Union[str, Path], files: dict) -> None:
-    """``files`` (name -> text or bytes) written into the folder ``out`` (created), each atomically."""
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    for name, content in files.items():
-        path = folder / name
-        if isinstance(content, str):
-            _core.write_file_atomic(str(path), content)
-            continue
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{name}.")
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(content)
-            os.replace(tmp, path)
-        except BaseException:
-            os.unlink(tmp)
-            raise
+    """``files`` (name -> text or bytes) written into the folder ``out`` (created), whole or not at
+    all (report.staged_folder)."""
+    with report.staged_folder(out) as stage:
+        for name, content in files.items():
+            (stage / name).write_bytes(content.encode() if isinstance(content, str) else content)
 
 
 def _f(v: Optional[float], digits: int = 4) -> str:

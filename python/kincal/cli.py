@@ -18,7 +18,7 @@ from . import cli_fivebar as hidden
 from . import cli_programs as programs
 from . import diagnose as diagnosis
 from . import feed as feedmod
-from . import fivebar, priors
+from . import fivebar, priors, report
 from . import identify as ident
 from .kinematics_files import fk_file, ik_file
 from .setups import robot_for_setup
@@ -205,6 +205,7 @@ def _say(text: str) -> None:
 
 def _diagnose_fivebar(args) -> None:
     pts = fivebar.read_table(args.data)
+    report.check_folder(args.out)
     diag = fivebar.diagnose(pts, folds=args.folds, seed=args.seed, noise_mm=args.noise, say=_say)
     fivebar.write_diagnosis(pts, diag, args.out, title=f"kincal diagnose: {Path(args.data).name} (five-bar hidden robot)")
     print(fivebar.diagnosis_summary(diag))
@@ -264,12 +265,10 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--harmonics", type=_harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                         help="harmonic orders of transmission_error (default 1,2)")
 
-    def loss_opts(sp, scale=0.1):
+    def loss_opts(sp, scale=0.1, why=""):
         sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
         sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
-                        + (f"{scale}, one bend for every model compared; 0: from the residuals' robust spread, as "
-                           "identify (on UR10 series B it fits B better and predicts A, C, D worse: BENCHMARKS.md))"
-                           if scale else "from the residuals' robust spread)"))
+                        + (f"{scale}{why})" if scale else "from the residuals' robust spread)"))
 
     def model_opts(sp):
         sp.add_argument("--tool-targets", metavar="CSV",
@@ -412,7 +411,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
     sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
     effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")
-    loss_opts(sp)
+    loss_opts(sp, why=", one bend for every model compared; 0: from the residuals' robust spread, as identify (on "
+                      "UR10 series B it fits B better and predicts A, C, D worse: BENCHMARKS.md)")
     model_opts(sp)
     sp.set_defaults(func=cmd_diagnose)
 

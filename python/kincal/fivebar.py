@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Callable, Optional, Union
 
@@ -159,8 +160,14 @@ def check_commanded_by(model: FiveBar, pts: dict, fit_file: str, grid_file: str)
     """``pts`` when its angles are the commands ``model`` gives for its desired points: an error
     matrix corrects the model that commanded the grid, and only that one. Otherwise a ValueError
     naming the grid's line, the angles and the model's."""
-    q = command(model, pts["desired"])
-    diff = np.max(np.abs(q - np.c_[pts["theta1_deg"], pts["theta2_deg"]]), axis=1)
+    try:
+        q = command(model, pts["desired"])
+    except ValueError as e:  # "row K: ..." (K from 1): said at the grid file's line of that point
+        m = re.match(r"row (\d+): (.*)", str(e))
+        where = f"{grid_file}:{int(pts['line'][int(m.group(1)) - 1])}" if m else grid_file
+        raise ValueError(f"{where}: {m.group(2) if m else e} for {fit_file}") from None
+    d = q - np.c_[pts["theta1_deg"], pts["theta2_deg"]]
+    diff = np.max(np.abs((d + 180.0) % 360.0 - 180.0), axis=1)  # angles modulo a turn (368.7 is 8.7)
     k = int(np.argmax(diff))
     if diff[k] > COMMAND_TOLERANCE_DEG:
         raise ValueError(f"{grid_file}:{int(pts['line'][k])}: the grid was not commanded by {fit_file}: point "
@@ -359,6 +366,7 @@ def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0
     concl = engine.conclude(problem, found, e, len(x), noise_mm, alpha, say)
     return {"steps": found.steps, "final_rms_mm": found.cv_rms_mm, "noise_rms_mm": concl["noise_rms_mm"],
             "noise_known": concl["noise_known"], "fit_scatter_mm": concl["fit_scatter_mm"],
+            "noise_per_coordinate_mm": concl["noise_per_coordinate_mm"],
             "verdict": concl["verdict"], "notes": [], "history": found.history, "folds": folds,
             "lengths_mm": x[:4].tolist()}
 

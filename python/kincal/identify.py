@@ -256,8 +256,7 @@ class Identification:
         converted), with its standard deviation, prior and why it was held, if it was."""
         f = self.fit
 
-        def scale(unit: str) -> tuple:
-            return (math.degrees(1.0), unit.replace("rad", "deg")) if unit.startswith("rad") else (1.0, unit)
+        scale = priors.file_unit
 
         return [{"name": p.name, "kind": p.kind, "joint": p.joint or None, "unit": scale(p.unit)[1],
                  "value": float(v) * scale(p.unit)[0],

@@ -29,6 +29,12 @@ AUTO_SCALES = (0.1, 0.3, 1.0, 3.0, 10.0)
 _GEOMETRIC = ("joint_mm", "joint_deg", "compliance", "tool_mm", "tool_deg", "base_mm", "base_deg", "target_mm")
 
 
+def file_unit(unit: str) -> tuple:
+    """(factor, unit) taking a fit parameter from the core's unit to the model file's: radians (and
+    rad/h) to degrees, every other unit as it is."""
+    return (math.degrees(1.0), unit.replace("rad", "deg")) if unit.startswith("rad") else (1.0, unit)
+
+
 def parse_prior_sd(text: Optional[str]) -> dict:
     """``--prior-sd``: comma separated KIND=SD (file units) over the defaults; ``none`` removes every
     prior. Errors name the bad item and the kinds known."""
@@ -186,8 +192,9 @@ def summary_lines(fit: "_core.IdentifyResult", info: dict, worst: Sequence) -> l
         lines.append("held at prior: not determined by these poses (posterior sd / prior sd):")
         params = fit.layout.parameters
         for i, p in enumerate(params):
-            if fit.at_prior[i]:
+            if fit.at_prior[i]:  # in the file's units, as the parameters' list (angles in deg)
+                k, unit = file_unit(p.unit)
                 sd = fit.stddev[i]
-                post = "" if math.isnan(sd) else f"{sd:.3g} / "
-                lines.append(f"  {p.name:<22} {post}{fit.prior_sd[i]:.3g} {p.unit}")
+                post = "" if math.isnan(sd) else f"{sd * k:.3g} / "
+                lines.append(f"  {p.name:<22} {post}{fit.prior_sd[i] * k:.3g} {unit}")
     return lines

@@ -59,13 +59,16 @@ def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = 
 def error_norm(values: Any):
     """The colour scale of error maps drawn side by side (before and after a calibration or a
     diagnosis): logarithmic and shared, so a map of microns beside one of millimetres is neither
-    one colour nor misread as the same size; from the largest value down to a thousandth of it."""
+    one colour nor misread as the same size; from the largest finite value down to the smallest
+    positive one, but no lower than a thousandth of the largest."""
     from matplotlib.colors import LogNorm
     import numpy as np
     v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
     hi = float(np.max(v)) if v.size and np.max(v) > 0 else 1.0
     pos = v[v > 0]
-    return LogNorm(vmin=max(float(np.min(pos)) if pos.size else hi, hi * 1e-3), vmax=hi)
+    # a value at or below the bottom (an error of exactly 0 too) is drawn in the bottom colour
+    return LogNorm(vmin=max(float(np.min(pos)) if pos.size else hi, hi * 1e-3), vmax=hi, clip=True)
 
 
 def figure(src: str, alt: str) -> str:
@@ -78,14 +81,24 @@ def write(path: Union[str, Path], title: str, body: str) -> None:
     _core.write_file_atomic(str(path), page(title, body))
 
 
+def check_folder(out: Union[str, Path]) -> None:
+    """An error, before any work, when ``out`` cannot be an output folder (a file stands there)."""
+    if Path(out).exists() and not Path(out).is_dir():
+        raise ValueError(f"{out}: is a file, not a folder (the output folder's name is taken; nothing was written)")
+
+
 @contextlib.contextmanager
 def staged_folder(out: Union[str, Path]) -> Iterator[Path]:
-    """A folder of outputs written whole or not at all: the files go into a hidden folder beside
-    ``out``, and only once every one is written (and none of their names is taken by a folder in
-    ``out``) are they moved into ``out`` (created). On any error ``out`` is left as it was."""
+    """A folder of outputs written whole or not at all: the files go into a hidden folder inside
+    ``out`` (created; the same file system, so moving them is a rename), and only once every one is
+    written (and none of their names is taken by a folder in ``out``) are they moved into ``out``.
+    On any error ``out`` is left as it was (removed again if this call created it)."""
     folder = Path(out)
-    folder.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
+    check_folder(folder)
+    created = not folder.exists()
+    folder.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".kincal-staging.", dir=folder))
+    done = False
     try:
         yield stage
         names = sorted(p.name for p in stage.iterdir())
@@ -93,8 +106,10 @@ def staged_folder(out: Union[str, Path]) -> Iterator[Path]:
         if taken:
             raise ValueError(f"{folder / taken[0]} is a folder: it is in the way of the file of that name "
                              "(nothing was written)")
-        folder.mkdir(parents=True, exist_ok=True)
         for n in names:
             os.replace(stage / n, folder / n)
+        done = True
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+        if created and not done:
+            shutil.rmtree(folder, ignore_errors=True)

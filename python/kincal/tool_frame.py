@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 
 import numpy as np
 
@@ -46,8 +45,5 @@ def tool_from_targets(result: Identification, known: np.ndarray) -> Identificati
 
 
 def _abc_of(r: np.ndarray) -> list:
-    """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c)."""
-    b = math.degrees(math.atan2(-r[2, 0], math.hypot(r[0, 0], r[1, 0])))
-    a = math.degrees(math.atan2(r[1, 0], r[0, 0]))
-    c = math.degrees(math.atan2(r[2, 1], r[2, 2]))
-    return [a, b, c]
+    """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c) (the core's, exact at the pole)."""
+    return [float(v) for v in _core.rotation_to_abc(np.asarray(r, dtype=float))]

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _core
+
 
 def _floats(text: str | None, n: int, where: str) -> np.ndarray:
     if text is None:
@@ -47,12 +49,8 @@ def _origin(el: ET.Element | None, where: str) -> np.ndarray:
 
 
 def _abc(r: np.ndarray) -> list[float]:
-    b = math.atan2(-r[2, 0], math.hypot(r[0, 0], r[1, 0]))
-    if math.hypot(r[0, 0], r[1, 0]) < 1e-12:
-        a, c = math.atan2(-r[0, 1], r[1, 1]), 0.0
-    else:
-        a, c = math.atan2(r[1, 0], r[0, 0]), math.atan2(r[2, 1], r[2, 2])
-    return [math.degrees(a), math.degrees(b), math.degrees(c)]
+    """KUKA ABC (deg) of a rotation matrix (the core's, exact at the pole)."""
+    return [float(v) for v in _core.rotation_to_abc(np.asarray(r, dtype=float))]
 
 
 def _link_of(joint: ET.Element, tag: str, path: str) -> str:

@@ -148,11 +148,27 @@ TEST(Io, CartesianWordsInAJointProgramAreErrors) {
     EXPECT_NE(e.find("j.gcode:2: pose word '"), std::string::npos) << l << ": " << e;
     EXPECT_NE(e.find("in a joint program"), std::string::npos) << l << ": " << e;
   }
-  // comments, feed and other words still pass
-  const JointProgram jp =
-      parse_joint_program(head + "G1 A1=5 F2000 (X100) ; Y5\nM30\n", "j.gcode", ProgramFormat::Gcode, 6);
+  // comments, feed and other words still pass; so does a dwell (G4 / G04: its X or P is a time)
+  const JointProgram jp = parse_joint_program(head + "G1 A1=5 F2000 (X100) ; Y5\nG4 X1.5\nG04 P500\nM30\n", "j.gcode",
+                                              ProgramFormat::Gcode, 6);
   ASSERT_EQ(jp.q.size(), 2u);
   EXPECT_EQ(jp.q[1][0], 5.0);
+  // G40 (cutter compensation off) and G4.1 are no dwells: their X is still a pose word
+  for (const char* l : {"G40 X100", "G4.1 X2"})
+    EXPECT_NE(error_of([&] { parse_joint_program(head + l + "\n", "j.gcode", ProgramFormat::Gcode, 6); })
+                  .find("pose word 'X"),
+              std::string::npos)
+        << l;
+}
+
+// A dwell's X (G4 X1.5: seconds) is no position in a pose program either: the line passes through as
+// text and the next motion keeps the modal pose before it.
+TEST(Io, ADwellIsNoMotion) {
+  const PoseProgram p = parse_pose_program("G1 X2000 Y0 Z500 A180 B0 C180\nG4 X1.5\nG1 Y10\n", "p.gcode",
+                                           ProgramFormat::Gcode);
+  ASSERT_EQ(p.poses.size(), 2u);
+  EXPECT_EQ(p.poses[1].xyz.x(), 2000.0);
+  EXPECT_EQ(p.poses[1].xyz.y(), 10.0);
 }
 
 // A CRLF program comes back with CRLF, line by line (the LF program's output with each "\n" a "\r\n");

@@ -73,7 +73,7 @@ def test_nothing_hidden_nothing_named(kr500):
     out = dg.diagnose(kr500, data)
     assert out["steps"] == []
     assert out["verdict"].startswith("no structure left that the library finds") and not out["noise_known"]
-    assert "noise level" not in out["verdict"]
+    assert "at the noise level" not in out["verdict"]
     known = dg.diagnose(kr500, data, noise_mm=0.02)
     assert known["steps"] == [] and known["noise_known"]
     assert known["verdict"] == "what remains is at the noise level"
@@ -276,7 +276,7 @@ def test_fivebar_report_without_a_named_effect_says_so(tmp_path):
     doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
     assert doc["steps"] == [] and not doc["noise_known"]
     page = (tmp_path / "d" / "report.html").read_text()
-    assert "No effect was named" in page and "noise level" not in page and "noise not known" in page
+    assert "No effect was named" in page and "at the noise level" not in page and "noise not known" in page
 
 
 def test_a_failed_diagnosis_leaves_its_folder_as_it_was(tmp_path):

@@ -167,3 +167,21 @@ def test_matrix_refuses_a_grid_another_model_commanded(tmp_path):
     assert not out.exists()
     r = run("kincal", "hidden-robot", "matrix", "--fit", str(fit), "--data", str(tmp_path / "grid.csv"), "--out", str(out))
     assert r.returncode == 0 and out.exists(), r.stderr
+    # angles a turn apart are the same command (a controller may count 368.7 for 8.7)
+    pts = fb.read_table(str(tmp_path / "grid.csv"))
+    turned = dict(pts, theta1_deg=pts["theta1_deg"] + 360.0, theta2_deg=pts["theta2_deg"] - 360.0)
+    assert fb.check_commanded_by(fb.load_fit(str(fit)), turned, "fit.json", "grid.csv") is turned
+
+
+def test_matrix_names_the_line_of_a_point_out_of_reach(tmp_path):
+    """A regular grid whose second column (x = 700 mm) the 150 mm links cannot reach: the error
+    names the grid's line of the first such point and the fit, no matrix written."""
+    (tmp_path / "fit.json").write_text(json.dumps({"a": 150, "b": 150, "c": 150, "d": 150}))
+    (tmp_path / "g.csv").write_text("point,theta1_deg,theta2_deg,x_desired_mm,y_desired_mm,x_measured_mm,y_measured_mm\n"
+                                    "1,0,0,200,0,200,0\n2,0,0,700,0,700,0\n3,0,0,200,5,200,5\n4,0,0,700,5,700,5\n")
+    out = tmp_path / "m.json"
+    r = run("kincal", "hidden-robot", "matrix", "--fit", str(tmp_path / "fit.json"), "--data", str(tmp_path / "g.csv"),
+            "--out", str(out))
+    assert r.returncode == 1 and f"{tmp_path / 'g.csv'}:3: (700.000000, 0.000000) is out of the hidden robot's reach" \
+        in r.stderr, r.stderr
+    assert not out.exists()

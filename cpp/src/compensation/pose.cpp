@@ -98,7 +98,7 @@ inline AbcTrig abc_trig(const Mat3& r) {
   AbcTrig tr;
   tr.cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
   tr.sb = -r(2, 0);
-  if (tr.cb >= 1e-12) {
+  if (tr.cb >= kAbcPoleCos) {
     const double inv = 1 / tr.cb;
     tr.ca = r(0, 0) * inv;
     tr.sa = r(1, 0) * inv;
@@ -160,7 +160,7 @@ struct DeviationEvaluator {
     return f;
   }
 
-  bool orientation_singular() const { return abc && std::abs(tr.cb) < 1e-9; }
+  bool orientation_singular() const { return abc && std::abs(tr.cb) < kAbcPoleCos; }
 
   // angular velocity per unit of the orientation rows' rates (E), and its inverse
   void rates(Mat3& e, Mat3& e_inv) const {

@@ -82,12 +82,34 @@ size_t gcode_number(const char* s, size_t i, size_t n, double& v, const char* sr
   return i;
 }
 
+// Whether a line is a dwell (G4 / G04, outside comments): its X or P word is a time, not a position,
+// so the line passes through as text in pose and joint programs alike.
+bool dwell_line(const char* s, size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    const char c = s[i];
+    if (c == ';') return false;
+    if (c == '(') {
+      while (i < n && s[i] != ')') ++i;
+      continue;
+    }
+    if ((c == 'G' || c == 'g') && (i == 0 || !std::isalpha(static_cast<unsigned char>(s[i - 1])))) {
+      size_t k = i + 1;
+      while (k < n && s[k] == '0') ++k;
+      if (k < n && s[k] == '4' && (k + 1 == n || !std::isdigit(static_cast<unsigned char>(s[k + 1]))) &&
+          (k + 1 == n || s[k + 1] != '.' || (k + 2 < n && s[k + 2] == '0')))
+        return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 int scan_gcode(const char* s, size_t n, GcodeWords kind, int dof, GcodeWord* words, int cap, const char* src,
                int line) {
   int count = 0;
   size_t i = 0;
+  if (dwell_line(s, n)) return 0;
   while (i < n) {
     const char c = s[i];
     if (c == ';') break;

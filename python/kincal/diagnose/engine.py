@@ -276,13 +276,13 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
         at_noise = not left
     if at_noise:
         verdict = ("what remains is at the noise level" if noise_mm is not None else
-                   "no structure left that the library finds: what remains looks like noise (its level is not "
-                   "known)")
+                   f"no structure left that the library finds ({len(errors)} points; the noise level is not known)")
     else:
         gains = ", ".join(f"{problem.label(s['_cand'])} {s['cv_gain']:.1%}" for s in left[:3])
         verdict = ("what remains is structured but not explained by the library"
                    + (f" (significant candidates gain too little: {gains})" if left else ""))
-    out = {"noise_rms_mm": noise, "noise_known": noise_mm is not None, "fit_scatter_mm": scatter, "verdict": verdict}
+    out = {"noise_rms_mm": noise, "noise_known": noise_mm is not None, "fit_scatter_mm": scatter, "verdict": verdict,
+           "noise_per_coordinate_mm": noise_mm}
     say(f"{len(found.steps)} effect(s) named; cross-validated RMS {found.cv_rms_mm * 1000:.1f} um, {noise_phrase(out)}: "
         f"{verdict}")
     return out
@@ -292,7 +292,9 @@ def noise_phrase(diag: dict) -> str:
     """How a summary or report names the noise a verdict compares with: the instrument's, when given,
     or else the final fit's own scatter, which only bounds it (it also holds what no model explains)."""
     if diag["noise_known"]:
-        return f"the instrument's noise {diag['noise_rms_mm'] * 1000:.1f} um"
+        per = diag.get("noise_per_coordinate_mm")
+        return (f"the instrument's noise {diag['noise_rms_mm'] * 1000:.1f} um per point" +
+                (f" ({per * 1000:.1f} um per coordinate)" if per is not None else ""))
     return (f"noise not known (the final fit's own scatter, {diag['noise_rms_mm'] * 1000:.1f} um, only bounds it; "
             f"--noise gives it)")
 

@@ -283,6 +283,7 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = 1e-6, m
                    "started_from": [x.label for x in start_effects]}
     return {"steps": found.steps, "final_rms_mm": found.cv_rms_mm, "noise_rms_mm": concl["noise_rms_mm"],
             "noise_known": concl["noise_known"], "fit_scatter_mm": concl["fit_scatter_mm"],
+            "noise_per_coordinate_mm": concl["noise_per_coordinate_mm"],
             "verdict": concl["verdict"], "residual_variables": rest, "residual_summary": residual_vars.summary(rest),
             "notes": notes, "history": found.history, "folds": folds,
             "validation": grouping.describe(data, f"{folds}-fold"),
@@ -321,6 +322,7 @@ def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_tar
     from .serial_report import write_report
 
     say = progress or (lambda s: None)
+    report.check_folder(out)  # before the work, not after it
     diag = diagnose(robot, data, progress=progress, **options)
     say("identifying the final model on all the data")
     model = final_identification(robot, data, diag, tool_targets)

@@ -36,6 +36,10 @@ Mat3 abc_to_rotation(const Vec3& abc_deg);
 /// ABC angles in degrees of a rotation (b in [-90, 90]).
 Vec3 rotation_to_abc(const Mat3& r);
 /// The same in radians, inlined for the hot paths (at gimbal lock everything goes into a).
+/// cos b below which ABC angles are at their pole (b = +-90 deg): rotation_to_abc_rad takes c = 0
+/// there, and an ABC residual's rates are singular (compensation says so).
+constexpr double kAbcPoleCos = 3e-8;
+
 inline Vec3 rotation_to_abc_rad(const Mat3& r) {
   // the entries of a rotation are at most 1: a plain square root is safe (and much faster than hypot)
   const double cb = std::sqrt(r(0, 0) * r(0, 0) + r(1, 0) * r(1, 0));
@@ -44,7 +48,7 @@ inline Vec3 rotation_to_abc_rad(const Mat3& r) {
   // the matrix (~1e-15 after a kinematic chain): an error of 1e-15 / cos b each. Below cos b = 3e-8
   // c is set to 0 and a taken from the second column, which cos b does not scale: an error of about
   // cos b. Both stay below 3e-8 rad (2e-6 deg).
-  if (cb < 3e-8) return Vec3(fastmath::atan2(-r(0, 1), r(1, 1)), b, 0.0);
+  if (cb < kAbcPoleCos) return Vec3(fastmath::atan2(-r(0, 1), r(1, 1)), b, 0.0);
   return Vec3(fastmath::atan2(r(1, 0), r(0, 0)), b, fastmath::atan2(r(2, 1), r(2, 2)));
 }
 Eigen::Isometry3d pose_to_iso(const Pose6& p);

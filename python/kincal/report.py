@@ -88,11 +88,13 @@ def check_folder(out: Union[str, Path]) -> None:
 
 
 @contextlib.contextmanager
-def staged_folder(out: Union[str, Path]) -> Iterator[Path]:
+def staged_folder(out: Union[str, Path], owned: Sequence[str] = ()) -> Iterator[Path]:
     """A folder of outputs written whole or not at all: the files go into a hidden folder inside
     ``out`` (created; the same file system, so moving them is a rename), and only once every one is
     written (and none of their names is taken by a folder in ``out``) are they moved into ``out``.
-    On any error ``out`` is left as it was (removed again if this call created it)."""
+    On any error ``out`` is left as it was (removed again if this call created it). ``owned``: glob
+    patterns of the files this tool writes a varying number of (step3.png): those of an earlier run
+    that this one did not write are removed, so the folder shows one run."""
     folder = Path(out)
     check_folder(folder)
     created = not folder.exists()
@@ -108,6 +110,10 @@ def staged_folder(out: Union[str, Path]) -> Iterator[Path]:
                              "(nothing was written)")
         for n in names:
             os.replace(stage / n, folder / n)
+        for pattern in owned:
+            for old in folder.glob(pattern):
+                if old.is_file() and old.name not in names:
+                    old.unlink()
         done = True
     finally:
         shutil.rmtree(stage, ignore_errors=True)

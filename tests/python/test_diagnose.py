@@ -311,3 +311,20 @@ def test_a_model_without_masses_says_why_compliance_is_no_candidate(tmp_path, kr
     massed = kincal.load_robot(str(tmp_path / "m.urdf"))
     assert "joint_compliance" in {c.name for c in dg.serial.candidates(massed, ident.simulate(_truth(massed), 20,
                                                                                              seed=5))[0]}
+
+
+def test_a_rerun_leaves_no_figure_of_the_run_before(tmp_path):
+    """The folder shows one run: step figures an earlier diagnosis wrote into it and this one did not
+    are removed (a file the diagnosis does not write stays). Truth: kr500 (simulate's default), 40
+    poses, nothing hidden: no step named."""
+    r = run("kincal", "simulate", "--robot", "kr500", "--poses", "40", "--out", str(tmp_path / "m.csv"))
+    assert r.returncode == 0, r.stderr
+    (tmp_path / "d").mkdir()
+    for f in ("step1.png", "step7.png", "notes.txt"):
+        (tmp_path / "d" / f).write_text("from before")
+    r = run("kincal", "diagnose", "--robot", "kr500", "--data", str(tmp_path / "m.csv"), "--out", str(tmp_path / "d"))
+    assert r.returncode == 0, r.stderr
+    steps = json.loads((tmp_path / "d" / "diagnosis.json").read_text())["steps"]
+    left = sorted(p.name for p in (tmp_path / "d").glob("step*.png"))
+    assert left == [f"step{k + 1}.png" for k in range(len(steps))]
+    assert (tmp_path / "d" / "notes.txt").read_text() == "from before"

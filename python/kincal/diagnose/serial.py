@@ -331,7 +331,7 @@ def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_tar
         {"effect": e.name, "joint": e.joint or None, "label": e.label,
          "values": [v * sc for v, sc in zip(vals, e.file_scale)], "units": e.file_units}
         for e, vals in model.robot.effects]
-    with report.staged_folder(out) as folder:  # the whole folder or nothing
+    with report.staged_folder(out, owned=("step*.png", "residual_variables.png")) as folder:  # whole or nothing
         write_report(robot, data, diag, folder, title=title, model_file="model.json")
         _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
         _core.write_file_atomic(str(folder / "model.json"), model.model_json())

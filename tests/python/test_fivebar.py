@@ -130,7 +130,7 @@ def test_hidden_robot_bad_input(tmp_path, case):
         _xy(tmp_path / "xy.csv", [(200, 0), (500, 0)])
         r = run("kincal", "hidden-robot", "command", "--fit", str(fit), "--targets", str(tmp_path / "xy.csv"),
                 "--out", str(out))
-        msg = "out of the hidden robot's reach"
+        msg = "xy.csv:3: (500.000000, 0.000000) is out of the hidden robot's reach"  # its second row
     elif case == "offgrid":
         (tmp_path / "g.csv").write_text("point,theta1_deg,theta2_deg,x_desired_mm,y_desired_mm,x_measured_mm,y_measured_mm\n"
                                         "1,0,0,0,0,0,0\n2,0,0,5,0,5,0\n3,0,0,0,5,0,5\n4,0,0,5.5,5,5,5\n")

@@ -39,8 +39,6 @@ def largest_error(model: FiveBar, pts: dict, desired: bool) -> float:
     return float(_core.fivebar_max_error(model, pts, desired))
 
 
-_max_error = largest_error
-
 
 def minimax_fit(pts: dict, start: FiveBar, desired: bool = False, sides: int = 64, max_iter: int = 200) -> FiveBar:
     """The four lengths that minimise the largest distance between model and target (Chebyshev fit):
@@ -51,7 +49,7 @@ def minimax_fit(pts: dict, start: FiveBar, desired: bool = False, sides: int = 6
 
     x = np.array([start.a, start.b, start.c, start.d], dtype=float)
     model = FiveBar(*x)
-    best = _max_error(model, pts, desired)
+    best = largest_error(model, pts, desired)
     radius = 1.0  # mm
     ang = 2 * np.pi * np.arange(sides) / sides
     normals = np.stack([np.cos(ang), np.sin(ang)], axis=1)  # n_k . v <= t  for all k  (outer polygon)
@@ -72,7 +70,7 @@ def minimax_fit(pts: dict, start: FiveBar, desired: bool = False, sides: int = 6
             continue
         trial = FiveBar(*(x + res.x[:4]))
         try:
-            err = _max_error(trial, pts, desired)
+            err = largest_error(trial, pts, desired)
         except ValueError:
             err = math.inf
         if err < best - 1e-12:
@@ -112,7 +110,7 @@ def fit(pts: dict, method: str = "lsq", score: str = "measured") -> dict:
         if method == "minimax":
             model = minimax_fit(pts, model, desired)
         out.update(points=ids)
-        err = _max_error(model, pts, desired)
+        err = largest_error(model, pts, desired)
     out.update(a=model.a, b=model.b, c=model.c, d=model.d, max_error_mm=float(err))
     return out
 

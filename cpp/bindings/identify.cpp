@@ -416,16 +416,17 @@ void define_identify(py::module_& m) {
   py::class_<PointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
       .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
                        bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
-                       std::optional<double> t_mean_s) {
+                       std::optional<double> t_mean_s, bool fit_gravity) {
              const Model& m = from_calibrated ? *r.calibrated : *r.nominal;
              return new PointModel(m, n_targets, effects, t_ref, setup_names_or_model(setups, m),
-                                   t_mean_s ? *t_mean_s : m.spec().t_mean_s);
+                                   t_mean_s ? *t_mean_s : m.spec().t_mean_s, fit_gravity);
            }),
            py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
            py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
-           py::arg("t_mean_s") = py::none(), py::keep_alive<1, 2>(),
+           py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false, py::keep_alive<1, 2>(),
            "setups: the data's setup names (default: the model's setups); t_mean_s: the drift's reference\n"
-           "time (default: the model's)")
+           "time (default: the model's); fit_gravity: the compliances' torques from fitted mass moments\n"
+           "(parameters of kind 'gravity_moment', 2 per link) instead of the model's masses")
       .def_property_readonly("layout", [](const PointModel& p) -> const ParamLayout& { return p.layout(); },
                              py::return_value_policy::reference_internal)
       .def_property_readonly("names", [](const PointModel& p) { return p.layout().names; })

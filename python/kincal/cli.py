@@ -20,6 +20,7 @@ from . import diagnose as diagnosis
 from . import feed as feedmod
 from . import fivebar, priors, report
 from . import identify as ident
+from .fitting import FitOptions, masses
 from .kinematics_files import fk_file, ik_file
 from .setups import robot_for_setup
 from .urdf import spec_urdf, urdf_left_out
@@ -138,22 +139,42 @@ def _tool_targets(path: Optional[str], data: dict, data_path: str) -> Optional[n
     return known
 
 
+def _fit_options(args, robot: _core.Robot) -> FitOptions:
+    """The fitting options of identify and diagnose (one group of options, one default each)."""
+    prior_model = load_robot(args.prior_model) if args.prior_model else None
+    if prior_model is not None and prior_model.dof != robot.dof:
+        raise ValueError(f"{args.prior_model}: {prior_model.dof} joints but the robot has {robot.dof}")
+    if args.gravity == "masses" and not masses(robot):
+        raise ValueError(f"--gravity masses: the model {args.robot} has no link masses (no inertial data); use "
+                         "--gravity fit (or auto)")
+    return FitOptions(loss=args.loss, loss_scale_mm=args.loss_scale or None,
+                      prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
+                      prior_scale=priors.parse_prior_scale(args.prior_scale), gravity=args.gravity,
+                      orientation_weight=args.orientation_weight, max_iterations=args.max_iterations)
+
+
+def _effects_arg(args, robot: _core.Robot, data: dict):
+    """--effects: "auto" (identify's default) or a list (checked against the data's columns)."""
+    if args.effects.strip() == "auto":
+        return "auto"
+    effects = ident.parse_effects(args.effects, robot, args.harmonics)
+    ident.check_data_for(effects, dict(data, source=args.data), robot)
+    return effects
+
+
 def cmd_identify(args) -> None:
     robot = _robot(args)
-    effects = ident.parse_effects(args.effects, robot, args.harmonics)
     data = ident.read_measurements(args.data, robot)
-    ident.check_data_for(effects, dict(data, source=args.data), robot)
+    effects = _effects_arg(args, robot, data)
     if args.holdout is not None and args.folds is not None:
         raise ValueError("--holdout and --folds: give one (a split, or cross-validation)")
     known = _tool_targets(args.tool_targets, data, args.data)
-    prior_model = load_robot(args.prior_model) if args.prior_model else None
-    res = ident.identify(robot, data, effects=effects, loss=args.loss, loss_scale_mm=args.loss_scale,
-                         prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
-                         prior_scale=priors.parse_prior_scale(args.prior_scale),
+    fit = _fit_options(args, robot)
+    res = ident.identify(robot, data, effects=effects, fit=fit, harmonics=args.harmonics,
                          holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
-                         progress=_progress("identify"), orientation_weight=args.orientation_weight,
-                         fold_progress=campaign._step_progress("cross-validation, fold"), hold_out_setups=args.hold_out_setups,
-                         gravity=args.gravity)
+                         progress=_progress("identify"),
+                         fold_progress=campaign._step_progress("cross-validation, fold"),
+                         hold_out_setups=args.hold_out_setups)
     if sys.stderr.isatty():
         print(file=sys.stderr)
     if known is not None:
@@ -216,15 +237,17 @@ def cmd_diagnose(args) -> None:
         _diagnose_fivebar(args)
         return
     robot = _robot(args)
-    start = ident.parse_effects(args.effects, robot, args.harmonics)
     data = ident.read_measurements(args.data, robot)
-    ident.check_data_for(start, dict(data, source=args.data), robot)
+    start = _effects_arg(args, robot, data)
+    if start == "auto":
+        raise ValueError("--effects auto: the diagnosis chooses its effects itself; --effects gives the model it "
+                         "starts from (default: the geometry alone)")
     known = _tool_targets(args.tool_targets, data, args.data)
+    fit = _fit_options(args, robot)
     t0 = time.perf_counter()
     diag, model = diagnosis.run(robot, data, args.out, title=f"kincal diagnose: {Path(args.data).name}",
                                 tool_targets=known, progress=_say, folds=args.folds, seed=args.seed,
-                                noise_mm=args.noise, effects=start, loss=args.loss, loss_scale_mm=args.loss_scale,
-                                orientation_weight=args.orientation_weight)
+                                noise_mm=args.noise, effects=start, fit=fit)
     print(diagnosis.summary(diag, model, args.out, time.perf_counter() - t0))
 
 
@@ -270,7 +293,21 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
                         + (f"{scale}{why})" if scale else "from the residuals' robust spread)"))
 
-    def model_opts(sp):
+    def fit_opts(sp):
+        """The fitting options of identify and diagnose: one group, one default each (kincal.fitting)."""
+        loss_opts(sp, None)
+        sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated "
+                        "geometry (e.g. last year's calibration; default: the starting model)")
+        sp.add_argument("--prior-sd", metavar="KIND=SD,..", help="prior standard deviations over the defaults "
+                        f"({', '.join(f'{k}={v:g}' for k, v in priors.DEFAULT_PRIOR_SD.items())}; also base_mm, "
+                        "base_deg, target_mm, an effect's name); 'none': no priors (what the data cannot determine "
+                        "is then refused)")
+        sp.add_argument("--prior-scale", default="1", help="times every prior sd, or 'auto' (grouped cross-validation)")
+        sp.add_argument("--gravity", choices=["auto", "masses", "fit"], default="auto", help="the compliances' "
+                        "gravity torques: the model's masses, or mass moments identified (fit); auto: fit when it "
+                        "has no masses")
+        sp.add_argument("--max-iterations", type=int, default=100, metavar="N",
+                        help="the cap of each Levenberg-Marquardt solve (default 100)")
         sp.add_argument("--tool-targets", metavar="CSV",
                         help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
                              "order): places the tool frame (TCP), which reflectors alone cannot")
@@ -355,14 +392,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--data", required=True, help="measurement CSV (pose, q1..qN, x, y, z[, target, payload_kg, "
                                                   "time_s, config, setup]; a setup column: one placement each)")
     sp.add_argument("--out", required=True, help="model JSON")
-    effect_opts(sp, "joint_compliance", "non-geometric effects to identify")
-    loss_opts(sp, None)
-    sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated geometry "
-                    "(e.g. last year's calibration; default: the starting model)")
-    sp.add_argument("--prior-sd", metavar="KIND=SD,..", help="prior standard deviations over the defaults "
-                    f"({', '.join(f'{k}={v:g}' for k, v in priors.DEFAULT_PRIOR_SD.items())}; also base_mm, base_deg, "
-                    "target_mm, an effect's name); 'none': no priors")
-    sp.add_argument("--prior-scale", default="1", help="times every prior sd, or 'auto' (grouped cross-validation)")
+    effect_opts(sp, "auto", "non-geometric effects to identify; 'auto': each library effect that applies is tried "
+                "and kept only when it lowers the grouped cross-validated RMS (the diagnosis's rule; chosen again in "
+                "each training fold of the validation)")
+    fit_opts(sp)
     sp.add_argument("--holdout", type=float, default=None,
                     help="validate on a held-out share of the configurations instead of cross-validation (the "
                          "model then excludes those rows)")
@@ -373,9 +406,6 @@ def build_parser() -> argparse.ArgumentParser:
                     "placement) whole, its placement and targets refitted, instead of folds")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
-    sp.add_argument("--gravity", choices=["auto", "masses", "fit"], default="auto", help="the compliances' gravity "
-                    "torques: the model's masses, or mass moments identified (fit); auto: fit when it has no masses")
-    model_opts(sp)
     sp.set_defaults(func=cmd_identify)
 
     sp = sub.add_parser("validate", help="check a calibration on new measurements (placements and targets refitted)")
@@ -411,9 +441,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
     sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
     effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")
-    loss_opts(sp, why=", one bend for every model compared; 0: from the residuals' robust spread, as identify (on "
-                      "UR10 series B it fits B better and predicts A, C, D worse: BENCHMARKS.md)")
-    model_opts(sp)
+    fit_opts(sp)
     sp.set_defaults(func=cmd_diagnose)
 
     hidden.add_commands(sub)

@@ -75,7 +75,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     say(2, n_steps, "identification: 30 geometric + 5 compliance parameters, tracker frame and reflectors (Ceres)")
     # the head's reflector nest was measured on a CMM: the targets' offsets in the tool frame are known,
     # which places the TCP (reflectors alone cannot)
-    res = ident.tool_from_targets(ident.identify(robot, data), ident.DEFAULT_TARGETS[:3])
+    res = ident.tool_from_targets(ident.identify(robot, data, effects="joint_compliance"), ident.DEFAULT_TARGETS[:3])
     w(str(out / "model.json"), res.model_json())
     w(str(out / "identify.txt"), res.summary() + "\n")
 

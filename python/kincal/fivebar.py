@@ -1,5 +1,5 @@
 """The Kiper paper's hidden robot: link-length synthesis, the error-correction matrix, commands,
-and the diagnosis of what the four lengths miss (the engine of kincal.diagnose, with this
+and the diagnosis of what the four lengths miss (the engine of kincal.stepwise, with this
 mechanism's candidates and refit) with its report.
 
 A point set is a dict of numpy arrays (``id``, ``theta1_deg``, ``theta2_deg``, ``desired`` n x 2,
@@ -20,7 +20,7 @@ import numpy as np
 from . import _core, report
 from ._core import ErrorMatrix, FiveBar
 from .csv_text import format_rows
-from .diagnose import engine
+from . import stepwise as engine
 
 METHODS = ("polynomial", "lsq", "minimax", "nonlinear")
 
@@ -287,7 +287,7 @@ def _subset(pts: dict, mask: Union[np.ndarray, slice]) -> dict:
 
 
 class Diagnosis:
-    """The hidden robot's diagnosis problem (kincal.diagnose.engine.Problem): the measured points,
+    """The hidden robot's diagnosis problem (kincal.stepwise.Problem): the measured points,
     folds of points dealt at random, the refit of the lengths and the effects' parameters
     (fit_with_effects) and its linearisation: the current model's columns by central differences,
     a candidate's by the chain rule on the five-bar's Jacobians."""
@@ -353,7 +353,7 @@ class Diagnosis:
 
 def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
              noise_mm: Optional[float] = None, say: Callable[[str], None] = lambda s: None) -> dict:
-    """The model-discrepancy workflow on the hidden robot (the engine of kincal.diagnose; contract
+    """The model-discrepancy workflow on the hidden robot (the engine of kincal.stepwise; contract
     names link_deflection, with "link": "a".."d", and transmission_error with the actuator as
     "joint"), every candidate of library() allowed."""
     problem = Diagnosis(pts, folds, seed)

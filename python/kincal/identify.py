@@ -15,8 +15,10 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core, gravity as _gravity, grouping, priors
+from . import _core, effect_choice, gravity as _gravity, grouping, priors
 from ._core import Robot
+from .effect_choice import applicable_joints, check_data as check_data_for  # noqa: F401  (as before)
+from .fitting import FitOptions, options, subset  # noqa: F401  (kincal.identify.options, as before)
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, _rms, validate  # noqa: F401  (kincal.identify.validate, as before)
 
@@ -28,6 +30,8 @@ DEFAULT_INSTRUMENT = (3500.0, -1500.0, -400.0, 35.0, 1.5, -0.8)
 DEFAULT_HARMONICS = (1, 2)
 #: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
 DEFAULT_MAP_ORDER = 4
+#: folds of whole configurations on which `--effects auto` scores its candidates (inside each training set)
+CHOICE_FOLDS = 5
 
 
 def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
@@ -76,14 +80,6 @@ def _effect_value(e: Sequence) -> tuple:
     if name == "joint_map":  # its order from the number of values: a sine and a cosine per order
         return _core.Effect("joint_map", int(joint), order=max(1, len(vals) // 2)), vals
     return _core.Effect(str(name), int(joint)), vals
-
-
-def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
-    """Joints (from 1) where a joint-wise effect applies: the gravity-loaded ones (from the
-    identification layout) for an effect that needs gravity, every joint otherwise."""
-    if kind.gravity_loaded_only:
-        return list(_core.PointModel(robot, 1).layout.loaded)
-    return list(range(1, robot.dof + 1))
 
 
 def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS,
@@ -176,40 +172,6 @@ def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_
     return e, [x / sc for x, sc in zip(v, e.file_scale)]
 
 
-def check_data_for(effects: Sequence, data: dict, robot: Robot) -> None:
-    """The data columns the effects read (the registry's ``needs``) are present: a clear error names
-    the file and the column otherwise."""
-    src = data.get("source", "<data>")
-    for e in effects:
-        need = _core.effect_kind(e.name).needs
-        if need == "dir" and "dir" not in data:
-            raise ValueError(f"{src}: {e.label} needs the dir1..dir{robot.dof} columns (the sign of each joint's "
-                             "last motion into the pose)")
-        if need == "temperature_c" and "temperature_c" not in data:
-            raise ValueError(f"{src}: {e.label} needs the temperature_c column")
-        if need == "time_s" and "time_s" not in data:
-            raise ValueError(f"{src}: {e.label} needs the time_s column (when each point was measured, s)")
-
-
-def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
-            orientation_weight: float = 100.0, max_iterations: int = 100,
-            fix: Sequence[str] = (), penalties: Sequence = (), prior_sd: Optional[dict] = None,
-            prior_scale: float = 0.0, gravity: str = "auto") -> "_core.IdentifyOptions":
-    """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
-    joints on; without any, the compliances stay at their start value). ``penalties``: ridge
-    penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
-    joint_map smoothness penalty. ``prior_sd`` (kinds in file units, priors.DEFAULT_PRIOR_SD) times
-    ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals."""
-    effects = list(effects)
-    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss, gravity=gravity,
-                              loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
-                              effects=effects, covariance=covariance, orientation_weight=orientation_weight)
-    o.penalties = [(str(n), float(w)) for n, w in penalties]
-    o.prior_sd = priors.core_prior_sd(priors.DEFAULT_PRIOR_SD if prior_sd is None else prior_sd)
-    o.prior_scale = float(prior_scale) if prior_sd is None or prior_sd else 0.0
-    return o
-
-
 def read_measurements(path: str, robot: Robot) -> dict:
     """The measurement CSV of the contract (errors name file:line and cause)."""
     return _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
@@ -217,11 +179,6 @@ def read_measurements(path: str, robot: Robot) -> dict:
 
 def measurements_csv(data: dict, dof: int) -> str:
     return _core.format_measurements(data, dof)
-
-
-def subset(data: dict, mask: np.ndarray) -> dict:
-    out = {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()}
-    return out
 
 
 def split_poses(data: dict, holdout: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -330,6 +287,8 @@ class Identification:
                      " (what the data determine)")
         if self.fit_info:
             lines += priors.summary_lines(f, self.fit_info, self.worst)
+        if "effect_choice" in self.fit_info:
+            lines += choice_lines(self.fit_info["effect_choice"])
         fixed = [(p.name, why) for p, fx, why in zip(f.layout.parameters, f.fixed, f.fixed_reason) if fx]
         if fixed:
             lines.append("held at their start value:")
@@ -347,6 +306,34 @@ class Identification:
         return "\n".join(lines)
 
 
+def choice_lines(ch: dict) -> list:
+    """The summary's lines on `--effects auto`: every candidate tried, with its test and its
+    cross-validated RMS, what was kept, how often the training folds kept it, and the held-out RMS
+    of the geometry beside the chosen model's."""
+    lines = [f"effects chosen by the data (--effects auto; {ch['rule']}):"]
+    if ch["tried"]:
+        lines.append(f"  {'candidate':<42}{'F':>10}{'p':>10}{'CV gain':>9}{'CV RMS (mm)':>13}")
+        for t in ch["tried"]:
+            p = "<1e-16" if t["p_value"] < 1e-16 else f"{t['p_value']:.2g}"
+            rms = "-" if t["cv_rms_linear_mm"] is None else f"{t['cv_rms_linear_mm']:.4f}"
+            lines.append(f"  {t['candidate']:<42}{t['F']:>10.3g}{p:>10}{t['cv_gain']:>9.1%}{rms:>13}"
+                         + (f"   kept (step {t['step']})" if t["kept"] else ""))
+        lines.append("  (CV RMS: the model of its round with the candidate, linearised at that round's fit, on the "
+                     "same folds)")
+    for n in ch["notes"]:
+        lines.append(f"  note: {n}")
+    kept = ", ".join(ch["kept"]) or "none: the geometry alone"
+    folds = ""
+    if ch["folds"]:
+        per = ", ".join(f"{k} in {v}" for k, v in ch["folds_kept"].items())
+        folds = f" (chosen again in each of the {ch['folds']} training folds: {per or 'none kept in any'})"
+    lines.append(f"  kept: {kept}{folds}")
+    if ch.get("start_cv_rms_mm") is not None and ch.get("chosen_cv_rms_mm") is not None:
+        lines.append(f"  held-out RMS: geometry alone {ch['start_cv_rms_mm']:.4f} mm, the chosen model "
+                     f"{ch['chosen_cv_rms_mm']:.4f} mm (nested: the choice made inside each training fold)")
+    return lines
+
+
 def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
     """Angle (deg) between the measured and the predicted tool orientation of every 6-D row (each
     row seen from its setup's placement, the model's drift at its time)."""
@@ -360,6 +347,9 @@ def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARM
         return parse_effects(effects, robot, harmonics)
     out: list = []
     for e in effects:
+        if isinstance(e, effect_choice.JointCompliance):
+            out.append(e)
+            continue
         for x in ([e] if isinstance(e, _core.Effect) else parse_effects(str(e), robot, harmonics)):
             x.check(robot.dof)
             if x not in out:
@@ -377,54 +367,75 @@ def _errors(r: "_core.IdentifyResult", h: dict) -> dict:
     return out
 
 
-def _cross_validated_errors(fit: priors.Fitter, data: dict, opts, held_masks,
-                            progress: Optional[Callable[[int, int], None]]) -> dict:
-    """_errors of every held-out row, each fold predicted by the model fitted on the other folds."""
-    parts = []
+def _fold_errors(model_of: Callable, data: dict, held_masks, progress: Optional[Callable[[int, int], None]],
+                 refit: Optional[Callable] = None) -> tuple[dict, list]:
+    """_errors of every held-out row, each fold predicted by the model fitted without it
+    (``model_of(train)``: (result, choice or None)); with ``refit`` (a setup held out whole) the held
+    rows' placement and targets are refitted on them first. Returns the errors and each fold's
+    choice."""
+    parts, choices = [], []
     for i, held in enumerate(held_masks):
         if progress:
             progress(i, len(held_masks))
         try:
-            model = fit(subset(data, ~held), opts)
+            model, choice = model_of(subset(data, ~held))
         except ValueError as e:  # the core names the data's source and the fold's rows: say they are a fold's
             raise ValueError(f"cross-validation fold {i + 1} of {len(held_masks)} (the model fitted without "
                              f"{int(np.sum(held))} held-out rows): {e}") from None
-        parts.append(_errors(model, subset(data, held)))
-    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+        choices.append(choice)
+        if refit is not None:
+            parts.append(refit(model.robot, subset(data, held)))
+            continue
+        part = _errors(model, subset(data, held))
+        if choice is not None:  # the starting model fitted on the same rows: its held-out figure, for free
+            part["e0"] = effect_choice.point_errors(effect_choice.start_fit(choice), subset(data, held))
+        parts.append(part)
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}, choices
 
 
-def _setup_errors(fit: priors.Fitter, data: dict, opts, held_masks, loss: str, loss_scale_mm: float,
-                  progress: Optional[Callable[[int, int], None]]) -> dict:
-    """Errors of every setup held out whole: the model fitted on the other setups, the held one's
-    placement and targets refitted on its rows (validate()'s refit)."""
-    parts = []
-    for i, held in enumerate(held_masks):
-        if progress:
-            progress(i, len(held_masks))
-        r = fit(subset(data, ~held), opts)
-        ea, eb, oa, ob, _ = _refit_placements(r.robot, subset(data, held), loss, loss_scale_mm)
-        parts.append(dict(ea=ea, eb=eb, **({"oa": oa, "ob": ob} if oa is not None else {})))
-    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+def _setup_refit(loss: str, loss_scale_mm: float) -> Callable:
+    """The errors of a setup held out whole: its placement and targets refitted on its rows
+    (validate()'s refit) on the model fitted on the other setups."""
+    def refit(robot: Robot, held: dict) -> dict:
+        ea, eb, oa, ob, _ = _refit_placements(robot, held, loss, loss_scale_mm)
+        return dict(ea=ea, eb=eb, **({"oa": oa, "ob": ob} if oa is not None else {}))
+    return refit
 
 
-def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: str = "huber",
+def _fit_options(fit: Optional[FitOptions], **kw) -> FitOptions:
+    """The fitting options: ``fit`` when given, else made of identify()'s keywords (prior_scale
+    "auto" or None: chosen by grouped cross-validation)."""
+    if fit is not None:
+        return fit
+    scale = kw.pop("prior_scale")
+    kw["prior_scale"] = None if scale is None or scale == "auto" else float(scale)
+    return FitOptions(**kw)
+
+
+def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptions] = None, loss: str = "huber",
              loss_scale_mm: Optional[float] = None, prior_sd: Optional[dict] = None, prior_scale=1.0,
              prior_model: Optional[Robot] = None, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
              fold_progress: Optional[Callable[[int, int], None]] = None,
-             penalties: Sequence = (), hold_out_setups: bool = False, gravity: str = "auto") -> Identification:
+             penalties: Sequence = (), hold_out_setups: bool = False, gravity: str = "auto",
+             max_iterations: int = 100, say: Optional[Callable[[str], None]] = None) -> Identification:
     """Identify the robot's parameters from measurements.
 
-    ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread).
+    ``fit``: the fitting options (kincal.fitting.FitOptions: priors, robust loss, gravity, orientation
+    weight, iteration cap), shared with `kincal diagnose`; without it they are made of the keywords:
+    ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread);
     ``prior_sd``: prior standard deviations by kind in file units (None: priors.DEFAULT_PRIOR_SD; {}:
     no priors), times ``prior_scale`` ("auto" or None: chosen by grouped cross-validation inside
     each training set), centred on ``prior_model``'s calibrated geometry when given (e.g. last
     year's calibration), else on the nominal model.
 
-    ``effects``: what the model carries besides the geometry: _core.Effect objects or texts of
-    ``--effects`` (``"joint_compliance"``, ``"transmission_error:3"``, ``"backlash:2"``,
-    ``"thermal_expansion"``, or one comma-separated text).
+    ``effects``: "auto" (the default: the data choose, see kincal.effect_choice: every library effect
+    that applies is tried from the geometry and kept only when the diagnosis's significance rule
+    says so; the choice made again inside each training fold of the validation, so that its figure
+    does not favour the choice), or what the model carries besides the geometry: _core.Effect
+    objects or texts of ``--effects`` (``"joint_compliance"``, ``"transmission_error:3"``,
+    ``"backlash:2"``, ``"thermal_expansion"``, or one comma-separated text; ``"none"``: the geometry).
 
     The model returned is fitted on every row. Its validation figures come from ``k_folds``-fold
     cross-validation (whole configurations per fold; 0: no validation). With ``holdout`` (a share in
@@ -434,22 +445,28 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     ``hold_out_setups``: the validation holds out each setup (instrument placement) whole instead:
     the model fitted on the other setups, the held setup's placement and targets refitted on it as
     validate() does."""
-    effects = check_effects(effects, robot, harmonics)
+    fit = _fit_options(fit, loss=loss, loss_scale_mm=loss_scale_mm, prior_sd=prior_sd, prior_scale=prior_scale,
+                       prior_model=prior_model, gravity=gravity, orientation_weight=orientation_weight,
+                       max_iterations=max_iterations)
+    auto = isinstance(effects, str) and effects.strip() == "auto"
+    effects = [] if auto else check_effects(effects, robot, harmonics)
     check_data_for(effects, data, robot)
-    if loss not in ("none", "huber", "cauchy"):
-        raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
     if k_folds == 1 or k_folds < 0:
         raise ValueError(f"--folds must be 0 (no validation) or at least 2, not {k_folds}")
     if holdout is not None and not 0.0 <= holdout < 1.0:
         raise ValueError(f"--holdout must be a share in (0, 1), not {holdout}")
     holdout = holdout or None  # a share of 0 holds nothing out
-    auto = prior_scale is None or prior_scale == "auto"
-    opts, cv_opts = (options(effects, loss=loss, loss_scale_mm=loss_scale_mm or 0.0, covariance=cov,
-                             orientation_weight=orientation_weight, penalties=penalties, prior_sd=prior_sd,
-                             prior_scale=1.0 if auto else float(prior_scale), gravity=gravity)
-                     for cov in (True, False))
-    fit = priors.Fitter(robot, prior_model, auto_scale=auto, seed=seed)
+    core_effects, gravity_of = effect_choice.expand(effects, robot)
+
+    def model_of(train: dict) -> tuple:
+        """The model of a training set: its effects chosen on it (auto), then fitted on it."""
+        if auto:
+            ch = effect_choice.choose(robot, train, fit, k_folds=CHOICE_FOLDS, seed=seed)
+            return ch.fit, ch
+        return fit.fit(robot, train, core_effects, penalties=penalties, gravity=gravity_of, seed=seed), None
+
     every_row = np.ones(len(data["pose"]), dtype=bool)
+    refit = None
     if hold_out_setups:
         codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
         if len(np.unique(codes)) < 2:
@@ -458,6 +475,7 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
         val = {"scheme": f"each of the {len(masks)} setups held out whole (its placement and targets refitted)",
                "grouping": "setup column", "configurations": int(grouping.configurations(data).count),
                "held_rows": int(len(codes)), "model_rows": "every row (validated by holding out setups)"}
+        refit = _setup_refit(fit.loss, fit.loss_scale_mm or 0.0)
     elif holdout is not None:
         fit_mask, held = split_poses(data, holdout, seed)
         val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()),
@@ -470,27 +488,83 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     else:
         fit_mask, masks = every_row, []
         val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
-    # folds: each predicted by a model fitted without it; a split: by the delivered model itself
-    if hold_out_setups:
-        e = _setup_errors(fit, data, cv_opts, masks, loss, loss_scale_mm or 0.0, fold_progress)
-    else:
-        e = _cross_validated_errors(fit, data, cv_opts, masks, fold_progress) if masks and holdout is None else {}
-    fit.scales.clear()
-    r = fit(subset(data, fit_mask), opts, progress)
+    # folds: each predicted by a model fitted (its effects chosen) without it; a split: by the delivered model
+    e: dict = {}
+    fold_choices: list = []
+    if masks and holdout is None:
+        e, fold_choices = _fold_errors(model_of, data, masks, fold_progress, refit)
+    train = subset(data, fit_mask)
+    top = None
+    if auto:
+        if say:
+            say("choosing the effects (--effects auto)")
+        top = effect_choice.choose(robot, train, fit, k_folds=CHOICE_FOLDS, seed=seed, fit_chosen=False)
+        effects = top.spec.effects
+        core_effects, gravity_of = effect_choice.expand(effects, robot)
+        penalties = list(penalties) + top.spec.penalties
+    fitter = fit.fitter(robot, seed)
+    r = fitter(train, fit.core(core_effects, covariance=True, penalties=penalties, gravity=gravity_of), progress)
     if holdout is not None and val["held_rows"]:
         e = _errors(r, subset(data, ~fit_mask))
+        if top is not None:
+            e["e0"] = effect_choice.point_errors(effect_choice.start_fit(top), subset(data, ~fit_mask))
     if e:
         val.update(_figures(e["eb"], "before", "mm"), **_figures(e["ea"], "after", "mm"))
         if "oa" in e:
             val.update(_figures(e["ob"], "before", "deg"), **_figures(e["oa"], "after", "deg"))
     val["fit_rows"] = int(fit_mask.sum())
-    choice = (f"{fit.scales[0]:g} (chosen by grouped cross-validation)" if fit.scales else f"{opts.prior_scale:g}")
-    info = priors.report(r, loss, loss_scale_mm, choice)
-    info["priors"]["centred_on"] = "the prior model's calibrated geometry" if prior_model else "the starting model"
+    choice = (f"{fitter.scales[0]:g} (chosen by grouped cross-validation)" if fitter.scales else
+              f"{fit.core().prior_scale:g}")
+    info = priors.report(r, fit.loss, fit.loss_scale_mm, choice)
+    info["priors"]["centred_on"] = "the prior model's calibrated geometry" if fit.prior_model else "the starting model"
+    if top is not None:
+        info["effect_choice"] = _choice_report(top, fold_choices, e, val)
     # the model records the angles its fit saw: where its periodic effects were measured
     calibrated = r.robot.with_fitted_ranges(_core.joint_ranges(data["q_deg"][fit_mask]))
-    return Identification(robot=calibrated, targets=np.asarray(r.targets), fit=r, effects=list(effects),
-                          validation=val, fit_info=info, worst=priors.down_weighted(r, subset(data, fit_mask)))
+    return Identification(robot=calibrated, targets=np.asarray(r.targets), fit=r, effects=list(core_effects),
+                          validation=val, fit_info=info, worst=priors.down_weighted(r, train))
+
+
+def _choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val: dict) -> dict:
+    """What `--effects auto` tried and kept: every candidate with its F-test, its linear
+    cross-validated gain and RMS where it was last scored (kept: the step that took it), how many of
+    the validation's training folds kept each effect, and the held-out RMS of the starting model
+    (the geometry) beside the chosen one's."""
+    tried: dict = {}
+    for i, h in enumerate(top.search.history):
+        for c in h.get("candidates", []):
+            label = _label_of(c)
+            tried[label] = {"candidate": label, "F": c["F"], "p_value": c["p_value"], "cv_gain": c["cv_gain"],
+                            "cv_rms_linear_mm": c.get("cv_rms_linear_mm"), "parameters": c.get("parameters", 0),
+                            "round": i + 1, "kept": False}
+    kept = [x.label for x in top.effects]
+    for k, label in enumerate(kept):
+        if label in tried:
+            tried[label]["kept"] = True
+            tried[label]["step"] = k + 1
+    counts: dict = {}
+    for ch in fold_choices:
+        for x in (ch.effects if ch is not None else []):
+            counts[x.label] = counts.get(x.label, 0) + 1
+    out = {"mode": "auto", "rule": f"F-test p < {effect_choice.ALPHA:g} and linear cross-validated gain > "
+                                   f"{effect_choice.MIN_GAIN:.0%} (the diagnosis's), on {CHOICE_FOLDS} folds of "
+                                   "whole configurations",
+           "kept": kept, "tried": sorted(tried.values(), key=lambda t: (not t["kept"], t.get("step", 0), -t["cv_gain"])),
+           "notes": list(top.notes), "nested": bool(fold_choices),
+           "folds_kept": counts, "folds": len(fold_choices)}
+    if "e0" in e:
+        out["start_cv_rms_mm"] = _rms(e["e0"])
+        out["chosen_cv_rms_mm"] = val.get("after_rms_mm")
+    return out
+
+
+def _label_of(c: dict) -> str:
+    """A scored candidate's label (as _core.Effect.label names it)."""
+    if c.get("gravity"):
+        return effect_choice.JointCompliance(c["gravity"]).label
+    if c["effect"] == "joint_map":
+        return _core.Effect("joint_map", c["joint"], order=c["order"]).label
+    return _core.Effect(c["effect"], c["joint"] or 0).label
 
 
 def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:

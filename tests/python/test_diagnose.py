@@ -47,12 +47,13 @@ def test_each_hidden_effect_is_named(kr500, hidden, expect):
 
 def test_hidden_compliance_is_named(kr500):
     """truth with joint compliance (~0.003 deg/kN m on joints 2-5, the 300 kg head): compliance is
-    named on the joints that carry most torque, and nothing else."""
+    named, as the library's effect on every gravity-loaded joint (one candidate, the torques from the
+    model's masses: the first step `identify --effects auto` takes too), and nothing else."""
     data = ident.simulate(_truth(kr500, 0.003), 250, seed=4, targets=3)
     out = dg.diagnose(kr500, data)
-    named = [(s["effect"], s["joint"]) for s in out["steps"]]
-    assert named[:2] == [("joint_compliance", 2), ("joint_compliance", 3)]
-    assert all(e == "joint_compliance" for e, _ in named)
+    named = [(s["effect"], s["joint"], s.get("gravity")) for s in out["steps"]]
+    assert named == [("joint_compliance", None, "masses")]
+    assert out["steps"][0]["set"] == "standard"
     assert out["final_rms_mm"] <= 1.3 * NOISE
 
 
@@ -84,12 +85,12 @@ def test_nothing_hidden_nothing_named(kr500):
     ([("transmission_error", 4, [0, D(0.03), 0, 0])], [("transmission_error", 4)]),
     ([("backlash", 3, [D(0.01)])], [("backlash", 3)]),
     ([("thermal_expansion", 0, [2e-5])], [("thermal_expansion", None)]),
-    (None, [("joint_compliance", 2), ("joint_compliance", 3)]),
+    (None, [("joint_compliance", None)]),
 ])
 def test_urdf_robot(tmp_path, kr500, hidden, expect):
     """A URDF robot (the kr500 geometry and link masses written as URDF, so without kincal's
     300 kg head): each effect hidden in turn is named (joint compliance: ~0.01 deg/kN m, the arm's
-    own weight loads joints 2 and 3 most)."""
+    own weight loads joints 2 and 3 most; named as one effect on every loaded joint)."""
     spec = json.loads(kr500.to_json())["nominal"]
     (tmp_path / "r.urdf").write_text(spec_urdf(spec, "urdf_robot"))
     robot = kincal.load_robot(str(tmp_path / "r.urdf"))
@@ -97,10 +98,7 @@ def test_urdf_robot(tmp_path, kr500, hidden, expect):
     data = ident.simulate(truth, 250, seed=5, targets=3, effects=hidden or [])
     out = dg.diagnose(robot, data)
     named = [(s["effect"], s["joint"]) for s in out["steps"]]
-    if hidden is None:
-        assert named[:2] == expect and all(e == "joint_compliance" for e, _ in named)
-    else:
-        assert named == expect
+    assert named == expect
     assert out["final_rms_mm"] <= 1.3 * NOISE
 
 
@@ -292,25 +290,32 @@ def test_a_failed_diagnosis_leaves_its_folder_as_it_was(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "m.csv"]
 
 
-def test_a_model_without_masses_says_why_compliance_is_no_candidate(tmp_path, kr500):
+def test_a_model_without_masses_tries_compliance_with_fitted_moments(tmp_path, kr500):
     """A URDF robot without <inertial> blocks (the kr500 geometry): no joint carries a known gravity
-    torque, so joint_compliance is no candidate, and the notes say so and how to start from it."""
+    torque, so joint_compliance is a candidate with the torques' mass moments fitted with it (one
+    candidate for every gravity-loaded joint, as `identify --gravity auto` fits it), and the notes
+    say so; with the masses (the same URDF with them) it is the mass-based one; with --gravity fit
+    the fitted one again."""
     import re
+
+    from kincal.effect_choice import JointCompliance
 
     spec = json.loads(kr500.to_json())["nominal"]
     text = re.sub(r"<inertial>.*?</inertial>", "", spec_urdf(spec, "urdf_robot"), flags=re.S)
     assert "<inertial" not in text
     (tmp_path / "r.urdf").write_text(text)
     robot = kincal.load_robot(str(tmp_path / "r.urdf"))
-    cands, notes = dg.serial.candidates(robot, ident.simulate(_truth(robot), 20, seed=5))
-    assert "joint_compliance" not in {c.name for c in cands}
-    assert any(n.startswith("joint_compliance skipped: the model has no link masses") and
-               "--effects joint_compliance" in n for n in notes), notes
-    # the massed URDF keeps the candidate (the note is about the masses, not the URDF)
+    data = ident.simulate(_truth(robot), 20, seed=5)
+    cands, notes = dg.serial.candidates(robot, data)
+    assert [c for c in cands if c.name == "joint_compliance"] == [JointCompliance("fit")]
+    assert any(n.startswith("joint_compliance on joints 2, 3, 4, 5, 6") and "the model has no link masses" in n
+               for n in notes), notes
     (tmp_path / "m.urdf").write_text(spec_urdf(spec, "urdf_robot"))
     massed = kincal.load_robot(str(tmp_path / "m.urdf"))
-    assert "joint_compliance" in {c.name for c in dg.serial.candidates(massed, ident.simulate(_truth(massed), 20,
-                                                                                             seed=5))[0]}
+    data = ident.simulate(_truth(massed), 20, seed=5)
+    assert [c for c in dg.serial.candidates(massed, data)[0] if c.name == "joint_compliance"] == [JointCompliance()]
+    assert [c for c in dg.serial.candidates(massed, data, gravity="fit")[0]
+            if c.name == "joint_compliance"] == [JointCompliance("fit")]
 
 
 def test_a_rerun_leaves_no_figure_of_the_run_before(tmp_path):

@@ -12,7 +12,7 @@ from .. import _core
 from .. import report
 from .._core import Robot
 from . import residual_vars
-from .engine import noise_phrase
+from ..stepwise import noise_phrase
 from .serial import Spec, step_effect
 
 
@@ -33,6 +33,9 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
         return data["temperature_c"], "temperature (C)"
     if effect == "drift":
         return np.asarray(data["time_s"]) / 3600.0, "time of the measurement (h)"
+    if joint is None:  # compliance of every loaded joint: the shoulder's gravity torque, when the masses are known
+        tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, 1] / 1000.0
+        return (tau, "gravity torque on joint 2 (kN m)") if np.ptp(tau) > 0 else (data["q_deg"][:, 1], "q2 (deg)")
     tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, j - 1] / 1000.0
     return tau, f"gravity torque on joint {joint} (kN m)"
 
@@ -193,7 +196,7 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     files.append("gap.png")
     # 2. residual maps before (geometry only) and after (final model), in the instrument frame
     start: Spec = diag["_start"]
-    e0 = start.errors(start.fit(robot, data), data)
+    e0 = start.errors(start.fit(data), data)
     e1 = diag["_spec"].errors(diag["_final_fit"], data)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
     norm = report.error_norm(np.concatenate([e0, e1]) * 1000)
@@ -209,11 +212,11 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     files.append("residual_map.png")
     # 3. residuals against each named effect's variable, before and after it was added
     spec = start
-    before = spec.fit(robot, data)
+    before = spec.fit(data)
     for k, st in enumerate(diag["steps"]):
         eff = step_effect(st)
         spec = spec.with_(eff, diag["_spec"].penalties_of(eff))
-        after = spec.fit(robot, data)
+        after = spec.fit(data)
         name = f"step{k + 1}.png"
         _step_figure(plt, robot, data, k, st, before, after, out / name)
         files.append(name)

@@ -18,7 +18,12 @@ told to the Problem (``chosen``: its refits use the same penalty), then scored a
 the same folds.
 
 A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
-candidates; effects are _core.Effect objects.
+candidates; effects are _core.Effect objects (or objects with their ``name`` and ``joint``).
+
+Without the refit's confirmation (``confirm=False``: `kincal identify --effects auto`, which chooses
+again inside every training fold of its own cross-validation, so its figure is honest without it) a
+step is taken on the F-test and the linear cross-validated gain alone, and no refit but the
+linearisation's is made: one fit per step.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from typing import Any, Callable, Optional, Protocol, Sequence
 
 import numpy as np
 
-from .. import _core
+from . import _core
 
 #: how many of a round's candidates (best cross-validated gain first) the history lists and the
 #: verdict weighs
@@ -88,8 +93,18 @@ def cv_rms(problem: Problem, effects: list) -> float:
 
 
 def _basis(Jc: np.ndarray) -> np.ndarray:
-    """An orthonormal basis of the current model's columns."""
-    Q, _ = np.linalg.qr(Jc)
+    """An orthonormal basis of the span of the current model's columns (those of a rank-deficient
+    set that add nothing left out). From the eigen-decomposition of the small Gram matrix of the
+    unit-scaled columns, orthonormalised twice ("twice is enough"): a tall QR in a multi-threaded
+    LAPACK takes 100 times longer on a loaded machine."""
+    if Jc.shape[1] == 0:
+        return np.zeros((Jc.shape[0], 0))
+    n = np.linalg.norm(Jc, axis=0)
+    Q = Jc[:, n > 0] / n[n > 0]
+    for _ in range(2):
+        w, V = np.linalg.eigh(Q.T @ Q)
+        keep = w > 1e-12 * max(float(w[-1]), 1e-300)
+        Q = Q @ (V[:, keep] / np.sqrt(w[keep]))
     return Q
 
 
@@ -107,18 +122,19 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
     span, when the caller has it; ``ridge``: a penalty weight per column, in the fits of the
     cross-validation). Columns the span absorbs are dropped; a candidate absorbed whole scores
     nothing."""
-    from scipy.stats import f as fdist
+    from scipy.special import fdtrc  # the F distribution's survival function (scipy.stats: a 2 s import)
 
     Rp, keep = _projected(_basis(Jc) if Q is None else Q, R)
     if not keep.any():
         return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": True}
     Rp = Rp[:, keep]
-    k = Rp.shape[1]
+    sv = np.linalg.svd(Rp, compute_uv=False)
+    k = int(np.sum(sv > 1e-9 * sv[0])) if len(sv) else 0  # the columns' rank: a redundant one adds nothing
     beta, *_ = np.linalg.lstsq(Rp, r, rcond=None)
     rss0, rss1 = float(r @ r), float(np.sum((r - Rp @ beta) ** 2))
     dof = len(r) - Jc.shape[1] - k
     F = ((rss0 - rss1) / k) / (rss1 / dof) if rss1 > 0 and dof > 0 else math.inf
-    p = float(fdist.sf(F, k, dof)) if math.isfinite(F) else 0.0
+    p = float(fdtrc(k, dof, F)) if math.isfinite(F) else 0.0
     before = after = 0.0
     for h in row_folds:
         if ridge is None:
@@ -129,7 +145,8 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
         before += float(r[h] @ r[h])
         after += float(np.sum((r[h] - Rp[h] @ b) ** 2))
     gain = 1.0 - math.sqrt(after / before) if before > 0 else 0.0
-    return {"F": float(F), "p_value": p, "cv_gain": gain, "absorbed": False, "parameters": int(k)}
+    return {"F": float(F), "p_value": p, "cv_gain": gain, "absorbed": False, "parameters": int(k),
+            "cv_ss_before": before, "cv_ss_after": after}
 
 
 def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, np.ndarray]],
@@ -172,33 +189,47 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
 @dataclass
 class Search:
     """What the search found: the effects added to the starting ones (in order) and the model's
-    cross-validated RMS; ``history`` (each model, its CV RMS and its LISTED best candidates),
-    ``last_scores`` (the LISTED best candidates of the last round, best gain first; empty when the
-    search stopped at its step limit)."""
+    cross-validated RMS (None without the refits' confirmation); ``history`` (each model, its CV RMS
+    and its LISTED best candidates), ``last_scores`` (the LISTED best candidates of the last round,
+    best gain first; empty when the search stopped at its step limit); ``linearised``: the last
+    linearisation (the model with ``effects`` fitted on every point, unless the search stopped at
+    its step limit: then None)."""
     effects: list
     steps: list
     history: list
-    cv_rms_mm: float
+    cv_rms_mm: Optional[float]
     last_scores: list
+    linearised: Any = None
 
 
 def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: float = 1e-6, min_gain: float = 0.03,
-           max_steps: int = 6, say: Callable[[str], None] = lambda s: None) -> Search:
+           max_steps: int = 6, say: Callable[[str], None] = lambda s: None, confirm: bool = True,
+           cur: Optional[float] = None, listed: int = LISTED, refit: bool = True) -> Search:
     """The greedy search from the model with the ``start`` effects: at most ``max_steps`` effects of
     ``candidates`` added, each significant (F-test p below ``alpha``), gaining more than ``min_gain``
-    in the linear cross-validation, and lowering the refitted model's cross-validated RMS."""
+    in the linear cross-validation, and (with ``confirm``) lowering the refitted model's
+    cross-validated RMS. ``cur``: the starting model's cross-validated RMS when the caller has it
+    (a search that goes on from another's end). ``listed``: how many of each round's candidates the
+    history keeps. Without ``refit`` (and then without ``confirm``) the model is fitted once, at the
+    start: each step's candidate columns join the model's and the next round scores against the
+    residual of their linear fit (_Stepped)."""
+    confirm = confirm and refit
     effects = list(start)
     row_folds = [np.repeat(m, problem.dims) for m in problem.folds]
-    say(f"fitting the starting model ({problem.model_label(effects)})")
-    cur = cv_rms(problem, effects)
+    if confirm and cur is None:
+        say(f"fitting the starting model ({problem.model_label(effects)})")
+        cur = cv_rms(problem, effects)
     history: list[dict[str, Any]] = [{"model": problem.model_label(effects), "cv_rms_mm": cur}]
+    regressors = None
     steps: list[dict[str, Any]] = []
     scored: list[dict[str, Any]] = []
     variants = getattr(problem, "variants", None)
     covered = getattr(problem, "covered", None)
+    score_folds = getattr(problem, "score_folds", None)
     chosen = getattr(problem, "chosen", None)
     for _ in range(max_steps):
-        regressors = problem.linearise(effects)
+        if regressors is None:
+            regressors = problem.linearise(effects)
         scored = []
         basis: tuple = (None, None)  # the current model's columns and their orthonormal basis
         for c in candidates:
@@ -221,23 +252,28 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
                 if chosen:
                     chosen(c, ridge)
                 order = {"variant_cv_gain": [round(x, 6) for x in gains], "variant": i}
-            s = score(r, Jc, R, row_folds, basis[1], ridge)
+            own = score_folds(c) if score_folds else None  # e.g. a periodic effect: ranges of its angle
+            s = score(r, Jc, R, [np.repeat(f, problem.dims) for f in own] if own else row_folds, basis[1], ridge)
+            if "cv_ss_after" in s:  # the linearised cross-validated RMS per point, with the candidate
+                s["cv_rms_linear_mm"] = math.sqrt(problem.dims * s.pop("cv_ss_after") / len(r))
+                s.pop("cv_ss_before")
             s.update(problem.describe(c))
             s.update(order)
             s["_cand"] = c
+            s["_cols"] = (r, Jc, R)
             scored.append(s)
         scored.sort(key=lambda s: -s["cv_gain"])
-        history[-1]["candidates"] = [{k: v for k, v in s.items() if k != "_cand" and not k.startswith("variant")}
-                                     for s in scored[:LISTED]]
+        history[-1]["candidates"] = [{k: v for k, v in s.items() if not k.startswith(("_", "variant"))}
+                                     for s in scored[:listed]]
         sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
         if not sig:
             break
         best = sig[0]
         cand = best["_cand"]
         say(f"step {len(steps) + 1}: {problem.label(cand)} (F = {best['F']:.3g}, cross-validated gain "
-            f"{best['cv_gain']:.1%}); refitting")
-        new = cv_rms(problem, effects + [cand])
-        if new >= cur:
+            f"{best['cv_gain']:.1%})" + ("; refitting" if confirm else ""))
+        new = cv_rms(problem, effects + [cand]) if confirm else None
+        if new is not None and cur is not None and new >= cur:
             history[-1]["rejected"] = dict(problem.describe(cand), cv_rms_mm=new)
             break
         runners_up = [dict(problem.describe(s["_cand"]), cv_gain_linear=s["cv_gain"], p_value=s["p_value"])
@@ -252,8 +288,31 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
         steps.append(dict(problem.describe(cand), evidence=evidence, rms_before_mm=cur, rms_after_mm=new))
         effects, cur = effects + [cand], new
         history.append({"model": problem.model_label(effects), "cv_rms_mm": cur})
+        if refit:
+            regressors = None
+        elif hasattr(regressors, "step"):  # the problem's own step (e.g. re-weighed for a robust loss)
+            regressors = regressors.step(cand)
+        else:
+            regressors = _Stepped(regressors, *best["_cols"])
         scored = []
-    return Search(effects=effects, steps=steps, history=history, cv_rms_mm=cur, last_scores=scored[:LISTED])
+    return Search(effects=effects, steps=steps, history=history, cv_rms_mm=cur, last_scores=scored[:LISTED],
+                  linearised=None if steps and not refit else regressors)
+
+
+class _Stepped:
+    """The linearisation after a step taken without a refit (search's ``refit=False``): the step's
+    candidate columns R join the model's Jc, and the residual is what their joint linear
+    least-squares fit leaves of r (one Gauss-Newton step from the last fit); every candidate's
+    columns stay those of the last fit."""
+
+    def __init__(self, base: Linearisation, r: np.ndarray, Jc: np.ndarray, R: np.ndarray):
+        self.base = base
+        self.Jc = np.hstack([Jc, R])
+        Q = _basis(self.Jc)
+        self.r = r - Q @ (Q.T @ r)
+
+    def __call__(self, cand) -> tuple:
+        return self.r, self.Jc, self.base(cand)[2]
 
 
 def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int, noise_mm: Optional[float],
@@ -265,7 +324,7 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
     the known noise; with the noise unknown, "no structure left that the library finds" when no
     candidate of the last round (of the LISTED best) is even significant (not "at the noise level":
     with few points nothing is significant, whatever remains)."""
-    dims = problem.dims
+    dims = getattr(problem, "point_dims", problem.dims)  # the errors' coordinates (3 with 6-D rows too)
     scatter = math.sqrt(float(np.sum(errors ** 2)) / max(1, dims * len(errors) - n_params)) * math.sqrt(dims)
     left = [s for s in found.last_scores if s["p_value"] < alpha]
     if noise_mm is not None:

@@ -4,11 +4,13 @@ joint where it concerns one), their refit (Ceres, C++ core) and their linearisat
 candidate's parameters would add to the identification Jacobian at the current fit, every
 candidate's in one evaluation), for the stepwise search of kincal.stepwise.
 
-`kincal identify --effects auto` searches the STANDARD candidates (every library effect that
-applies but the open-ended joint_map) with the diagnosis's significance rule (F test, 3% linear
-cross-validated gain) and, to report an honest figure, makes the same choice again inside every
-training fold (choose(), nested()). `kincal diagnose` takes the same first steps, then goes on to
-the effects beyond the standard set (joint_map of any order).
+`kincal identify --effects auto` searches these candidates (every library effect that applies to
+the robot and the data's columns) with the diagnosis's significance rule (F test, 3% linear
+cross-validated gain), the model fitted once and each step taken on its linearisation, and, to
+report an honest figure, makes the same choice again inside every training fold of its validation
+(choose()). `kincal diagnose` searches the same candidates with the same rule, refitting the model
+and confirming the cross-validated RMS at every step, then scores what remains against every
+variable.
 
 Joint compliance is a candidate in the form ``--gravity`` gives: per joint with the model's link
 masses (``masses``, or ``auto`` on a model that has masses), or as one candidate for every
@@ -39,8 +41,6 @@ MAX_MAP_ORDER = 8
 MAP_SMOOTHING = (1e-1, 1e-2, 1e-3)
 #: joint_map's variant (order, smoothing) is chosen leaving out each of this many ranges of its angle
 VARIANT_BLOCKS = 5
-#: effects beyond the standard set: the diagnosis's, not `identify --effects auto`'s
-BEYOND_STANDARD = ("joint_map",)
 #: periodic errors of a joint angle: scored holding out ranges of that angle (SerialProblem.score_folds)
 PERIODIC = ("transmission_error", "joint_map")
 #: the significance rule of a step (the diagnosis's): F-test p below ALPHA and a linear
@@ -89,17 +89,15 @@ def _needs_column(kind) -> str:
     return "dir" if kind.needs == "dir" else kind.needs
 
 
-def candidates(robot: Robot, data: dict, start: Sequence = (), gravity: str = "auto",
-               standard_only: bool = False) -> tuple[list, list]:
+def candidates(robot: Robot, data: dict, start: Sequence = (), gravity: str = "auto") -> tuple[list, list]:
     """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
-    compliance in the form ``gravity`` gives) the data can support, and notes on those skipped.
-    Effects of ``start`` (the model the search starts from) are no candidates. ``standard_only``:
-    without the effects beyond the standard set (BEYOND_STANDARD)."""
+    compliance as one JointCompliance in the form ``gravity`` gives) the data can support, and notes
+    on those skipped. Effects of ``start`` (the model the search starts from) are no candidates."""
     out: list = []
     notes: list = []
     have = {(e.name, e.joint) for e in start}
     for kind in _core.effect_kinds():
-        if kind.domain != "serial" or (standard_only and kind.name in BEYOND_STANDARD):
+        if kind.domain != "serial":
             continue
         col = _needs_column(kind)
         if col == "dir" and col not in data:
@@ -295,7 +293,7 @@ class _Linearised:
         self.cols: Optional[dict] = None
         self.added: list = []  # the columns of the steps taken since the fit (unweighted)
         self.r_now: Optional[np.ndarray] = None  # the residual after them (unweighted; None: the fit's)
-        self.scale = res.loss_scale_mm
+        self.scale: Optional[float] = None  # where the candidates' scores bend (from the residual's spread)
         self.w: Optional[np.ndarray] = None
 
     def raw(self, cand) -> tuple:
@@ -325,8 +323,16 @@ class _Linearised:
         if self.added:
             cur = np.hstack([cur] + self.added)
         if self.w is None:
-            self.w = robust_weights(r, self.dims, self.fit.loss, self.scale)
+            self.w = self._weights(r, cur.shape[1])
         return r * self.w, cur, R
+
+    def _weights(self, r: np.ndarray, p: int) -> np.ndarray:
+        """The pseudo-residuals' weights of the residual r (p parameters fitted): the fit's loss, bending
+        where the residual's own robust spread puts it (4.03 x; the fit's own bend, e.g. a fixed
+        0.1 mm, would clip the very structure a candidate is to explain when the model lacks it)."""
+        if self.scale is None:
+            self.scale = loss_threshold(robust_noise(r, self.dims, p), self.dims)
+        return robust_weights(r, self.dims, self.fit.loss, self.scale)
 
     def step(self, cand) -> "_Linearised":
         """The linearisation after ``cand`` was added without a refit: its columns join the model's,
@@ -336,15 +342,14 @@ class _Linearised:
         r, cur, R = self.raw(cand)
         r = r if self.r_now is None else self.r_now
         A = np.hstack([cur] + self.added + [R])
-        w = self.w if self.w is not None else robust_weights(r, self.dims, self.fit.loss, self.scale)
+        w = self.w if self.w is not None else self._weights(r, cur.shape[1] + sum(a.shape[1] for a in self.added))
         sw = np.sqrt(w)  # iteratively reweighted least squares: the robust cost's Gauss-Newton step
         delta, *_ = np.linalg.lstsq(A * sw[:, None], r * sw, rcond=None)
         out = _Linearised.__new__(_Linearised)
         out.__dict__.update(self.__dict__)
         out.added = self.added + [R]
         out.r_now = r - A @ delta
-        if self.fit.loss != "none" and not self.fit.loss_scale_mm:
-            out.scale = loss_threshold(robust_noise(out.r_now, self.dims, A.shape[1]), self.dims)
+        out.scale = None  # from the new residual's spread, as the refit's would be
         out.w = None
         return out
 
@@ -396,6 +401,24 @@ class SerialProblem:
         edges = np.quantile(q, np.linspace(0.0, 1.0, VARIANT_BLOCKS + 1))
         block = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, VARIANT_BLOCKS - 1)
         return [block == b for b in range(VARIANT_BLOCKS)]
+
+    def size(self, effect) -> int:
+        """How many parameters an effect adds (none of them with a prior by default)."""
+        if isinstance(effect, JointCompliance):
+            layout = _core.PointModel(self.robot, 1, fit_gravity=effect.gravity == "fit").layout
+            return sum(p.kind in ("compliance", "gravity_moment") for p in layout.parameters)
+        return int(effect.size)
+
+    def admits(self, effects: Sequence, cand) -> bool:
+        """Whether the model with ``cand`` added keeps no more parameters without a prior than the data
+        have points (the core refuses such a fit): the starting fit's and every added effect's."""
+        if not self.fits:
+            return True
+        start_effects, res = self.fits[0]
+        free = np.asarray(res.fixed) == 0
+        unconstrained = int(np.sum(free & ~np.isfinite(np.asarray(res.prior_sd))))
+        added = sum(self.size(e) for e in list(effects)[len(start_effects):]) + self.size(cand)
+        return unconstrained + added < len(self.data["pose"])
 
     def score_folds(self, cand) -> Optional[list]:
         """The folds a candidate's linear cross-validated gain is measured on, when not the
@@ -458,12 +481,12 @@ class Choice:
 
 def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k_folds: int = 5, seed: int = 0,
            max_steps: int = 6, say: Callable[[str], None] = lambda s: None, fit_chosen: bool = True) -> Choice:
-    """`--effects auto` on one data set: the stepwise search over the standard candidates from the
+    """`--effects auto` on one data set: the stepwise search over the candidates from the
     ``start`` effects (the significance rule of the diagnosis: ALPHA, MIN_GAIN, on ``k_folds`` folds
     of whole configurations), the starting model fitted once and each step's effect added to its
     linearisation (stepwise.search's refit=False); then, with ``fit_chosen``, the model chosen
     fitted on the data (``fit``; else None when a step was taken)."""
-    cands, notes = candidates(robot, data, start, fit.gravity, standard_only=True)
+    cands, notes = candidates(robot, data, start, fit.gravity)
     problem = SerialProblem(robot, data, grouped_folds(data, k_folds, seed), fit, cands)
     if not problem.folds:
         spec = problem.spec(list(start))

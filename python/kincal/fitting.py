@@ -6,7 +6,9 @@ One default each, measured on the real data the project has (BENCHMARKS.md, "One
 - priors on the joint geometry (1 mm, 0.1 deg) and the tool (5 mm, 1 deg) at their overall width 1
   (priors.DEFAULT_PRIOR_SD): what the data cannot determine stays at its prior and is listed, never a
   refusal;
-- the robust loss (Huber) bends where the residuals' robust spread puts it (``loss_scale_mm`` None);
+- the robust loss (Huber) bends at 0.1 mm (DEFAULT_LOSS_SCALE_MM; ``loss_scale_mm`` None: where the
+  residuals' robust spread puts it, 4.03 x the noise): on the UR10 path (diagnose on series B,
+  validate on A, C, D) the data's bend predicted the other series worse (BENCHMARKS.md);
 - ``gravity`` "auto": the model's link masses when it has any, else the mass moments fitted.
 """
 
@@ -22,6 +24,8 @@ from . import _core, grouping, priors
 from ._core import Robot
 
 LOSSES = ("none", "huber", "cauchy")
+#: where the robust loss bends unless told (mm; measured on the UR10 path, BENCHMARKS.md "One fitting engine")
+DEFAULT_LOSS_SCALE_MM = 0.1
 GRAVITY = ("auto", "masses", "fit")
 
 
@@ -29,13 +33,13 @@ GRAVITY = ("auto", "masses", "fit")
 class FitOptions:
     """How every fit of a campaign is made (the command line's fitting options).
 
-    ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread);
+    ``loss_scale_mm``: where the robust loss bends (mm; None or 0: from the residuals' robust spread);
     ``prior_sd``: prior standard deviations by kind in file units (None: priors.DEFAULT_PRIOR_SD, {}: no
     priors); ``prior_scale``: times every prior sd (None: chosen by grouped cross-validation inside
     each fit's own data); ``prior_model``: the priors' centre and the fits' start (default: the robot's
     nominal model); ``gravity``: the compliances' gravity torques (auto, masses, fit)."""
     loss: str = "huber"
-    loss_scale_mm: Optional[float] = None
+    loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM
     prior_sd: Optional[dict] = None
     prior_scale: Optional[float] = 1.0
     prior_model: Optional[Robot] = None

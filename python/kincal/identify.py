@@ -18,7 +18,7 @@ import numpy as np
 from . import _core, effect_choice, gravity as _gravity, grouping, priors
 from ._core import Robot
 from .effect_choice import applicable_joints, check_data as check_data_for  # noqa: F401  (as before)
-from .fitting import FitOptions, options, subset  # noqa: F401  (kincal.identify.options, as before)
+from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, options, subset  # noqa: F401  (options: as before)
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, _rms, validate  # noqa: F401  (kincal.identify.validate, as before)
 
@@ -413,7 +413,7 @@ def _fit_options(fit: Optional[FitOptions], **kw) -> FitOptions:
 
 
 def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptions] = None, loss: str = "huber",
-             loss_scale_mm: Optional[float] = None, prior_sd: Optional[dict] = None, prior_scale=1.0,
+             loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM, prior_sd: Optional[dict] = None, prior_scale=1.0,
              prior_model: Optional[Robot] = None, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
@@ -424,7 +424,8 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
 
     ``fit``: the fitting options (kincal.fitting.FitOptions: priors, robust loss, gravity, orientation
     weight, iteration cap), shared with `kincal diagnose`; without it they are made of the keywords:
-    ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread);
+    ``loss_scale_mm``: where the robust loss bends (mm, default 0.1; None or 0: from the residuals'
+    robust spread);
     ``prior_sd``: prior standard deviations by kind in file units (None: priors.DEFAULT_PRIOR_SD; {}:
     no priors), times ``prior_scale`` ("auto" or None: chosen by grouped cross-validation inside
     each training set), centred on ``prior_model``'s calibrated geometry when given (e.g. last

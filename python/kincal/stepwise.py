@@ -117,14 +117,17 @@ def _projected(Q: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray],
           Q: Optional[np.ndarray] = None, ridge: Optional[np.ndarray] = None) -> dict:
-    """F-test and cross-validated linear gain of regressors R on residual r, off the span of Jc
-    (``row_folds``: the held-out residual rows of each fold; ``Q``: an orthonormal basis of Jc's
-    span, when the caller has it; ``ridge``: a penalty weight per column, in the fits of the
+    """F-test and cross-validated linear gain of regressors R on residual r, both off the span of Jc
+    (the current model's columns refitted with the candidate's: a robust fit leaves part of r in
+    their span; ``row_folds``: the held-out residual rows of each fold; ``Q``: an orthonormal basis
+    of Jc's span, when the caller has it; ``ridge``: a penalty weight per column, in the fits of the
     cross-validation). Columns the span absorbs are dropped; a candidate absorbed whole scores
     nothing."""
     from scipy.special import fdtrc  # the F distribution's survival function (scipy.stats: a 2 s import)
 
-    Rp, keep = _projected(_basis(Jc) if Q is None else Q, R)
+    Q = _basis(Jc) if Q is None else Q
+    r = r - Q @ (Q.T @ r)  # the current model refitted on its linearisation too (a robust fit leaves r off its span)
+    Rp, keep = _projected(Q, R)
     if not keep.any():
         return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": True}
     Rp = Rp[:, keep]
@@ -133,7 +136,9 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
     beta, *_ = np.linalg.lstsq(Rp, r, rcond=None)
     rss0, rss1 = float(r @ r), float(np.sum((r - Rp @ beta) ** 2))
     dof = len(r) - Jc.shape[1] - k
-    F = ((rss0 - rss1) / k) / (rss1 / dof) if rss1 > 0 and dof > 0 else math.inf
+    if dof <= 0 or k == 0:  # more columns than the residual has coordinates: nothing can be tested
+        return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": False, "parameters": int(k), "untestable": True}
+    F = ((rss0 - rss1) / k) / (rss1 / dof) if rss1 > 0 else math.inf
     p = float(fdtrc(k, dof, F)) if math.isfinite(F) else 0.0
     before = after = 0.0
     for h in row_folds:
@@ -155,6 +160,7 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
     column; off the span of Q) by cross-validation: the held-out residual sum of squares of each;
     the first listed within ORDER_MARGIN of the best. Returns its index and the cross-validated gain
     of each."""
+    r = r - Q @ (Q.T @ r)  # as score(): the current model refitted on its linearisation too
     Rp, keep = _projected(Q, R)
     G, g = Rp.T @ Rp, Rp.T @ r
     groups: dict = {}  # variants of the same columns, solved together
@@ -226,6 +232,7 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
     variants = getattr(problem, "variants", None)
     covered = getattr(problem, "covered", None)
     score_folds = getattr(problem, "score_folds", None)
+    admits = getattr(problem, "admits", None)
     chosen = getattr(problem, "chosen", None)
     for _ in range(max_steps):
         if regressors is None:
@@ -234,6 +241,8 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
         basis: tuple = (None, None)  # the current model's columns and their orthonormal basis
         for c in candidates:
             if any(e.name == c.name and e.joint == c.joint for e in effects):
+                continue
+            if admits and not admits(effects, c):  # more parameters than the data can fit
                 continue
             r, Jc, R = regressors(c)
             if basis[0] is not Jc:

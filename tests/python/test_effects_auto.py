@@ -88,7 +88,6 @@ def test_auto_and_the_diagnosis_take_the_same_first_steps(robots):
     assert kept, "compliance is present: something is kept"
     steps = [dg.step_effect(s).label for s in diag["steps"]]
     assert steps[:len(kept)] == kept
-    assert all(s["set"] == "standard" for s in diag["steps"][:len(kept)])
 
 
 def test_auto_with_fitted_moments_is_one_candidate(robots):

@@ -91,7 +91,7 @@ def test_reported_held_out_rms_matches_leave_configurations_out(repeated):
     4-fold figure, built here too, shows what the grouping corrects."""
     data, truth_config = repeated
     robot = kincal.load_robot("kr500")
-    res = ident.identify(robot, data, k_folds=4)
+    res = ident.identify(robot, data, k_folds=4, effects="joint_compliance")  # the model without the effect
     v = res.validation
     assert v["configurations"] == CONFIGS and v["scheme"] == "4-fold, whole configurations"
     loco = _held_rms(robot, data, res.effects, [truth_config == c for c in range(CONFIGS)])
@@ -128,4 +128,4 @@ def test_a_failed_fold_says_it_is_a_fold():
     held = [np.arange(10) < 2, np.arange(10) >= 2]
     with pytest.raises(ValueError, match=r"cross-validation fold 1 of 2 \(the model fitted without 2 held-out rows\): "
                                          r"m.csv: the 8 measured points"):
-        ident._cross_validated_errors(refuses, data, None, held, None)
+        ident._fold_errors(lambda train: (refuses(train, None), None), data, held, None)

@@ -1,6 +1,7 @@
 """The diagnosis of a serial robot (`kincal diagnose --robot R`): the stepwise search over the
-candidate effects of kincal.effect_choice (the standard ones first, as `identify --effects auto`,
-then joint_map beyond them), with identify's fitting options in every fit; then what the final
+candidate effects of kincal.effect_choice (those `identify --effects auto` chooses from, with the
+same rule; here every step refitted and confirmed), with identify's fitting options in every fit;
+then what the final
 model still misses against every candidate variable (residual_vars), the final model identified on
 all the data, and the files of the command.
 """
@@ -17,23 +18,13 @@ from .. import _core, grouping, report
 from .. import identify as ident
 from .. import stepwise as engine
 from .._core import Robot
-from ..effect_choice import (ALPHA, BEYOND_STANDARD, MAX_MAP_ORDER, MIN_GAIN, JointCompliance,  # noqa: F401
+from ..effect_choice import (ALPHA, MAX_MAP_ORDER, MIN_GAIN, JointCompliance,  # noqa: F401
                              SerialProblem, Spec, candidates, check_data, evaluate)
 from ..fitting import FitOptions
 from . import residual_vars
 
 __all__ = ["JointCompliance", "SerialProblem", "Spec", "candidates", "diagnose", "final_identification", "run",
            "summary", "step_effect"]
-
-def _merged(first: engine.Search, then: engine.Search) -> engine.Search:
-    """A search that went on from another's end, as one: the steps of both; the model where the
-    first stopped listed once, with the second's (wider) candidates."""
-    joint = dict(first.history[-1])
-    joint.update(then.history[0])
-    return engine.Search(effects=then.effects, steps=first.steps + then.steps,
-                         history=first.history[:-1] + [joint] + then.history[1:], cv_rms_mm=then.cv_rms_mm,
-                         last_scores=then.last_scores, linearised=then.linearised)
-
 
 def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
              max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
@@ -47,29 +38,17 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = ALPHA, 
     priors, robust loss, gravity, ...; or as keywords of FitOptions). ``noise_mm``: the
     instrument's noise per coordinate, if known (see stepwise.conclude).
 
-    The search runs in two phases: first over the standard candidates (what `kincal identify
-    --effects auto` chooses from, with the same rule: its steps are identify's), then on from there
-    over every candidate (joint_map of any order beyond them); each step's refit must lower the
-    cross-validated RMS."""
+    The candidates and the rule are those `kincal identify --effects auto` chooses with (its kept
+    effects are these first steps); here each step is refitted and must lower the cross-validated
+    RMS."""
     say = progress or (lambda s: None)
     fit = fit or FitOptions(**fit_options)
     start_effects = ident.check_effects(effects, robot)
     check_data(start_effects, data, robot)
-    standard, notes = candidates(robot, data, start_effects, fit.gravity, standard_only=True)
-    every, _ = candidates(robot, data, start_effects, fit.gravity)
-    problem = SerialProblem(robot, data, ident.folds(data, folds, seed), fit, every)
-    found = engine.search(problem, start_effects, standard, alpha=alpha, min_gain=min_gain, max_steps=max_steps,
+    cands, notes = candidates(robot, data, start_effects, fit.gravity)
+    problem = SerialProblem(robot, data, ident.folds(data, folds, seed), fit, cands)
+    found = engine.search(problem, start_effects, cands, alpha=alpha, min_gain=min_gain, max_steps=max_steps,
                           say=say)
-    for st in found.steps:
-        st["set"] = "standard"
-    beyond = [c for c in every if c not in standard]
-    if beyond and len(found.steps) < max_steps:
-        say("going on beyond the standard effects (" + ", ".join(sorted({c.name for c in beyond})) + ")")
-        more = engine.search(problem, found.effects, every, alpha=alpha, min_gain=min_gain,
-                             max_steps=max_steps - len(found.steps), say=say, cur=found.cv_rms_mm)
-        for st in more.steps:
-            st["set"] = "standard" if st["effect"] not in BEYOND_STANDARD else "beyond"
-        found = _merged(found, more)
     spec = problem.spec(found.effects)
     final = spec.fit(data)
     concl = engine.conclude(problem, found, spec.errors(final, data), int(np.sum(~np.asarray(final.fixed))), noise_mm,

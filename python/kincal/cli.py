@@ -20,6 +20,7 @@ from . import diagnose as diagnosis
 from . import feed as feedmod
 from . import fivebar, priors, report
 from . import identify as ident
+from . import strict_json
 from .kinematics_files import fk_file, ik_file
 from .setups import robot_for_setup
 from .urdf import spec_urdf, urdf_left_out
@@ -175,7 +176,7 @@ def cmd_validate(args) -> None:
     data = ident.read_measurements(args.data, robot)
     v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
     v["model"] = str(args.model)
-    _core.write_file_atomic(args.out, json.dumps(v, indent=1, sort_keys=True) + "\n")
+    _core.write_file_atomic(args.out, strict_json.dumps(v, indent=1, sort_keys=True) + "\n")
     print(ident.validation_summary(v))
 
 
@@ -232,7 +233,7 @@ def cmd_bench(args) -> None:
     import kincal_benchmarks
 
     r = kincal_benchmarks.run(args.poses, args.seed, args.threads, args.identify_poses, identify=not args.no_identify)
-    print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
+    print(strict_json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
 
 
 def cmd_demo(args) -> None:

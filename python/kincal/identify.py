@@ -16,6 +16,7 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 
 from . import _core, gravity as _gravity, grouping, priors
+from . import strict_json
 from ._core import Robot
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, _rms, validate  # noqa: F401  (kincal.identify.validate, as before)
@@ -289,7 +290,7 @@ class Identification:
         drift = drift_report(f)
         if drift:
             d["identification"]["drift"] = drift
-        return json.dumps(d, indent=1, sort_keys=True) + "\n"
+        return strict_json.dumps(d, indent=1, sort_keys=True) + "\n"
 
     def summary(self) -> str:
         f, v = self.fit, self.validation

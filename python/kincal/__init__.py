@@ -18,6 +18,7 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from . import _core
+from . import strict_json
 from ._core import Robot
 from .urdf import urdf_model_json
 
@@ -40,7 +41,7 @@ def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: 
                              f"--joint-convention is for a URDF or a built-in robot")
         o = json.loads(text if text is not None else Robot.load(s).to_json())
         o["joint_convention"] = joint_convention
-        text = json.dumps(o)
+        text = strict_json.dumps(o)
     if text is not None:
         return Robot.from_json(text, s)
     return Robot.load(s)

@@ -5,7 +5,6 @@ touched: bad input leaves nothing behind."""
 from __future__ import annotations
 
 import io
-import json
 import math
 from pathlib import Path
 from typing import Optional, Union
@@ -13,6 +12,7 @@ from typing import Optional, Union
 import numpy as np
 
 from . import report
+from . import strict_json
 from . import accuracy as acc
 
 COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
@@ -286,7 +286,7 @@ def run_iso9283(data: str, out: str, distance: Optional[str] = None, model: Opti
     layout = deviation_layout(runs, res)
     title = f"ISO 9283 pose accuracy and repeatability: {label or _default_label(data, out)}"
     files = {"deviations.png": _deviation_figure(runs, res, layout), "summary.png": _summary_figure(res),
-             "iso9283.json": json.dumps(res, indent=1) + "\n",
+             "iso9283.json": strict_json.dumps(res, indent=1) + "\n",
              "report.html": iso9283_html(runs, res, title, layout, Path(data).name)}
     write_folder(out, files)
     return res
@@ -420,7 +420,7 @@ def run_axis(data_path: str, out: str, unit: str = "mm", label: Optional[str] = 
     data = acc.read_axis(data_path)
     res = acc.axis_statistics(data, unit)
     title = f"Positioning accuracy of one axis: {label or _default_label(data_path, out)}"
-    files = {"axis.png": _axis_figure(data, res), "axis.json": json.dumps(res, indent=1) + "\n",
+    files = {"axis.png": _axis_figure(data, res), "axis.json": strict_json.dumps(res, indent=1) + "\n",
              "report.html": axis_html(data, res, title, Path(data_path).name)}
     write_folder(out, files)
     return res

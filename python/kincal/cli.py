@@ -20,6 +20,7 @@ from . import diagnose as diagnosis
 from . import feed as feedmod
 from . import fivebar, priors, report
 from . import identify as ident
+from . import strict_json
 from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, masses
 from .kinematics_files import fk_file, ik_file
 from .setups import robot_for_setup
@@ -196,7 +197,7 @@ def cmd_validate(args) -> None:
     data = ident.read_measurements(args.data, robot)
     v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
     v["model"] = str(args.model)
-    _core.write_file_atomic(args.out, json.dumps(v, indent=1, sort_keys=True) + "\n")
+    _core.write_file_atomic(args.out, strict_json.dumps(v, indent=1, sort_keys=True) + "\n")
     print(ident.validation_summary(v))
 
 
@@ -255,7 +256,7 @@ def cmd_bench(args) -> None:
     import kincal_benchmarks
 
     r = kincal_benchmarks.run(args.poses, args.seed, args.threads, args.identify_poses, identify=not args.no_identify)
-    print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
+    print(strict_json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
 
 
 def cmd_demo(args) -> None:

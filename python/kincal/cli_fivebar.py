@@ -3,18 +3,18 @@ commands, the simulated over-constrained 6-bar), for kincal.cli."""
 
 from __future__ import annotations
 
-import json
 import re
 import sys
 
 from . import _core, fivebar
+from . import strict_json
 from .csv_text import format_rows
 
 
 def cmd_hr_fit(args) -> None:
     pts = fivebar.read_table(args.data)
     res = fivebar.fit(pts, args.method, args.score)
-    _core.write_file_atomic(args.out, json.dumps(res, indent=1) + "\n")
+    _core.write_file_atomic(args.out, strict_json.dumps(res, indent=1) + "\n")
     print(f"{args.method} ({args.score} score): a={res['a']:.3f} b={res['b']:.3f} c={res['c']:.3f} d={res['d']:.3f} mm, "
           f"points {res['points']}, largest error {res['max_error_mm'] * 1000:.1f} um")
 

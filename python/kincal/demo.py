@@ -17,7 +17,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from pathlib import Path
@@ -32,6 +31,7 @@ from . import feed as feedmod
 from . import fivebar as fb
 from . import identify as ident
 from . import report
+from . import strict_json
 from .csv_text import format_rows
 
 SEED = 7
@@ -84,7 +84,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     ddir.mkdir(exist_ok=True)
     diag = dg.diagnose(robot, data)
     dg.write_report(robot, data, diag, ddir, title="kincal demo: diagnosis")
-    w(str(ddir / "diagnosis.json"), json.dumps(dg.contract_json(diag), indent=1) + "\n")
+    w(str(ddir / "diagnosis.json"), strict_json.dumps(dg.contract_json(diag), indent=1) + "\n")
     diagnosed = dg.final_identification(robot, data, diag, ident.DEFAULT_TARGETS[:3])
     w(str(ddir / "model.json"), diagnosed.model_json())
 
@@ -123,7 +123,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     fdir.mkdir(exist_ok=True)
     for axis in range(1, 7):
         feedmod.figure(fres, *limits, feedmod.DEFAULT_FEED, axis, str(fdir / f"axis{axis}.png"))
-    w(str(fdir / "feed.json"), json.dumps({"feed_rad_s": feedmod.DEFAULT_FEED,
+    w(str(fdir / "feed.json"), strict_json.dumps({"feed_rad_s": feedmod.DEFAULT_FEED,
                                            "programs": {k: feedmod.json_ready(v) for k, v in fres.items()}}) + "\n")
 
     say(7, n_steps, "five-bar: the Kiper paper's Table I, fit and error matrix on the simulated 6-bar, VDI/DGQ 3441")
@@ -144,7 +144,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     val = np.c_[rng.uniform(163, 261, 400), rng.uniform(-74, 74, 400)]
     meas9 = _core.sixbar_campaign(sixbar, fb.FiveBar(), None, tab_xy, 0.020, 1)
     fit = fb.fit(meas9, "minimax")
-    w(str(hdir / "fit.json"), json.dumps(fit, indent=1) + "\n")
+    w(str(hdir / "fit.json"), strict_json.dumps(fit, indent=1) + "\n")
     model = fb.model_of(fit)
     grid = _core.sixbar_campaign(sixbar, model, None, fb.grid_targets(), 0.001, 2)
     matrix = _core.ErrorMatrix.from_points(grid, "grid")
@@ -196,7 +196,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
         "axis": accuracy_demo.axis_section(axes)}
     _report(out, res, diag, summary, err_unc, err_com, err_dia, fres, table_fits, sections)
     summary["files"] = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()) + ["summary.json"]
-    w(str(out / "summary.json"), json.dumps(summary, indent=2) + "\n")
+    w(str(out / "summary.json"), strict_json.dumps(summary, indent=2) + "\n")
     return summary
 
 

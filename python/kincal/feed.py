@@ -29,6 +29,8 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from . import strict_json
+
 METHODS = ("spline", "linear")
 DEFAULT_SAMPLES = 2900
 #: default commanded rate of s: about 250 mm/s of tool speed on the paper's 1480 mm line (rad/s)
@@ -444,7 +446,7 @@ def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_pat
            "limits": {"v_max_deg_s": limits[0], "a_max_deg_s2": limits[1], "j_max_deg_s3": limits[2]},
            "programs": {k: json_ready(r) for k, r in results.items()},
            "figures": figures}
-    _core.write_file_atomic(str(folder / "feed.json"), json.dumps(doc) + "\n")
+    _core.write_file_atomic(str(folder / "feed.json"), strict_json.dumps(doc) + "\n")
     return results
 
 

@@ -18,6 +18,7 @@ from typing import Callable, Optional, Union
 import numpy as np
 
 from . import _core, report
+from . import strict_json
 from ._core import ErrorMatrix, FiveBar
 from .csv_text import format_rows
 from . import stepwise as engine
@@ -116,7 +117,7 @@ def fit(pts: dict, method: str = "lsq", score: str = "measured") -> dict:
 
 
 def model_of(fit_json: dict) -> FiveBar:
-    return _core.fivebar_from_json(json.dumps(fit_json))
+    return _core.fivebar_from_json(strict_json.dumps(fit_json))
 
 
 def _read(path: str) -> str:
@@ -398,7 +399,7 @@ def _write_diagnosis(pts: dict, diag: dict, folder: Path, title: str) -> None:
 <p>{report.esc(diag['verdict'])}: cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um; {report.esc(engine.noise_phrase(diag))}.</p>
 {report.figure("residual_map.png", "residual map")}"""
     report.write(folder / "report.html", title, body)
-    _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
+    _core.write_file_atomic(str(folder / "diagnosis.json"), strict_json.dumps(engine.contract_json(diag), indent=1) + "\n")
 
 
 def diagnosis_summary(diag: dict) -> str:

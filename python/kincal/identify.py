@@ -16,6 +16,7 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 
 from . import _core, effect_choice, gravity as _gravity, grouping, priors
+from . import strict_json
 from ._core import Robot
 from .effect_choice import applicable_joints, check_data as check_data_for  # noqa: F401  (as before)
 from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, options, subset  # noqa: F401  (options: as before)
@@ -246,7 +247,7 @@ class Identification:
         drift = drift_report(f)
         if drift:
             d["identification"]["drift"] = drift
-        return json.dumps(d, indent=1, sort_keys=True) + "\n"
+        return strict_json.dumps(d, indent=1, sort_keys=True) + "\n"
 
     def summary(self) -> str:
         f, v = self.fit, self.validation

@@ -34,7 +34,7 @@ from typing import Any, Callable, Optional, Protocol, Sequence
 
 import numpy as np
 
-from . import _core
+from . import _core, strict_json
 
 #: how many of a round's candidates (best cross-validated gain first) the history lists and the
 #: verdict weighs
@@ -370,12 +370,4 @@ def noise_phrase(diag: dict) -> str:
 def contract_json(diag: dict) -> dict:
     """diagnosis.json: the contract's keys and the evidence, without the fitted objects (an infinite
     F statistic, from a perfect fit, is written as null: JSON has no infinity)."""
-    def clean(x):
-        if isinstance(x, float) and not math.isfinite(x):
-            return None
-        if isinstance(x, dict):
-            return {k: clean(v) for k, v in x.items()}
-        if isinstance(x, (list, tuple)):
-            return [clean(v) for v in x]
-        return x
-    return clean({k: v for k, v in diag.items() if not k.startswith("_")})
+    return strict_json.finite_or_none({k: v for k, v in diag.items() if not k.startswith("_")})

@@ -8,6 +8,7 @@ import json
 import numpy as np
 
 from . import _core
+from . import strict_json
 from ._core import Robot
 from .identify import Identification
 
@@ -40,7 +41,7 @@ def tool_from_targets(result: Identification, known: np.ndarray) -> Identificati
     new_r, new_t = m_r @ r, m_t + m_r @ t
     tool["xyz_mm"] = new_t.tolist()
     tool["abc_deg"] = _abc_of(new_r)
-    robot = Robot.from_json(json.dumps(doc), "<identified>")
+    robot = Robot.from_json(strict_json.dumps(doc), "<identified>")
     return dataclasses.replace(result, robot=robot, targets=known.copy())
 
 

@@ -7,7 +7,6 @@ centre of mass) for gravity torques. URDF lengths are metres and radians; kincal
 
 from __future__ import annotations
 
-import json
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -15,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _core
+from . import strict_json
 
 
 def _floats(text: str | None, n: int, where: str) -> np.ndarray:
@@ -179,7 +179,7 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
 
 
 def urdf_model_json(path: str | Path, base: str | None = None, tip: str | None = None) -> str:
-    return json.dumps({"format": "kincal-model", "version": 1, "nominal": urdf_spec(path, base, tip)})
+    return strict_json.dumps({"format": "kincal-model", "version": 1, "nominal": urdf_spec(path, base, tip)})
 
 
 def urdf_left_out(spec: dict) -> list:

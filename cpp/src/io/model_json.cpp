@@ -97,6 +97,11 @@ struct Reader {
     if (!v.is_number()) fail(where + "." + key, "not a number");
     return v.get<double>();
   }
+  /// A figure that may be undefined: null (how kincal writes an undefined figure) reads as ``unknown``.
+  double num_or_null(const json& o, const char* key, const std::string& where, double unknown) const {
+    if (at(o, key, where).is_null()) return unknown;
+    return num(o, key, where);
+  }
   Vec3 vec(const json& o, const char* key, const std::string& where) const {
     const json& v = at(o, key, where);
     if (!v.is_array() || v.size() != 3) fail(where + "." + key, "needs 3 numbers");
@@ -130,9 +135,10 @@ struct Reader {
         fail(w + ".limits_deg", "needs [lower, upper]");
       j.lower_deg = lim[0].get<double>();
       j.upper_deg = lim[1].get<double>();
-      j.max_velocity_deg_s = num(jo, "max_velocity_deg_s", w);
-      j.max_acceleration_deg_s2 = num(jo, "max_acceleration_deg_s2", w);
-      j.max_jerk_deg_s3 = num(jo, "max_jerk_deg_s3", w);
+      // a limit not known (0) may be written as null (an infinite limit from a URDF: no limit known)
+      j.max_velocity_deg_s = num_or_null(jo, "max_velocity_deg_s", w, 0.0);
+      j.max_acceleration_deg_s2 = num_or_null(jo, "max_acceleration_deg_s2", w, 0.0);
+      j.max_jerk_deg_s3 = num_or_null(jo, "max_jerk_deg_s3", w, 0.0);
       j.mass_kg = num(jo, "mass_kg", w);
       j.com = vec(jo, "com_mm", w);
       j.compliance_deg_per_knm = num(jo, "compliance_deg_per_knm", w);

@@ -17,6 +17,7 @@ import numpy as np
 from .. import _core, grouping, report
 from .. import identify as ident
 from .. import stepwise as engine
+from .. import strict_json
 from .._core import Robot
 from ..effect_choice import (ALPHA, MAX_MAP_ORDER, MIN_GAIN, JointCompliance,  # noqa: F401
                              SerialProblem, Spec, candidates, check_data, evaluate)
@@ -121,7 +122,7 @@ def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_tar
         for e, vals in model.robot.effects]
     with report.staged_folder(out, owned=("step*.png", "residual_variables.png")) as folder:  # whole or nothing
         write_report(robot, data, diag, folder, title=title, model_file="model.json")
-        _core.write_file_atomic(str(folder / "diagnosis.json"), json.dumps(engine.contract_json(diag), indent=1) + "\n")
+        _core.write_file_atomic(str(folder / "diagnosis.json"), strict_json.dumps(engine.contract_json(diag), indent=1) + "\n")
         _core.write_file_atomic(str(folder / "model.json"), model.model_json())
     return diag, model
 

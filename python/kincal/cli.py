@@ -296,8 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     def fit_opts(sp):
         """The fitting options of identify and diagnose: one group, one default each (kincal.fitting)."""
-        loss_opts(sp, DEFAULT_LOSS_SCALE_MM, "; 0: from the residuals' robust spread, 4.03 x the noise (on the UR10 "
-                  "data it predicted the other series worse: BENCHMARKS.md)")
+        loss_opts(sp, DEFAULT_LOSS_SCALE_MM)
         sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated "
                         "geometry (e.g. last year's calibration; default: the starting model)")
         sp.add_argument("--prior-sd", metavar="KIND=SD,..", help="prior standard deviations over the defaults "

@@ -304,7 +304,8 @@ class _Linearised:
         key = (cand.name, cand.joint, tuple(cand.harmonics), getattr(cand, "gravity", ""))
         if key not in self.cols:
             if isinstance(cand, JointCompliance) and cand.gravity == "fit":
-                self.cols[key] = (self.r, self.cur, fitted_compliance_columns(self.res, self.data, self.spec))
+                spec = self.spec or Spec(self.robot, list(self.res.layout.effect_list), fit=self.fit)
+                self.cols[key] = (self.r, self.cur, fitted_compliance_columns(self.res, self.data, spec))
                 return self.cols[key]
             if cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
                 r, cur, J, new, fit_of = evaluate(self.res, self.data, [cand])  # not among the round's candidates
@@ -421,11 +422,11 @@ class SerialProblem:
         return unconstrained + added < len(self.data["pose"])
 
     def score_folds(self, cand) -> Optional[list]:
-        """The folds a candidate's linear cross-validated gain is measured on, when not the
-        configurations': a periodic error of a joint angle (transmission_error, joint_map) holding out,
-        in turn, each of VARIANT_BLOCKS ranges of that angle. Such an effect must predict angles it
-        has not seen, as on the next campaign: a sinusoid fitted over part of a turn that only mimics
-        another effect there (the gravity's) is not kept for the turn."""
+        """The folds on which a candidate must also gain (besides the configurations'): for a periodic
+        error of a joint angle (transmission_error, joint_map), holding out in turn each of
+        VARIANT_BLOCKS ranges of that angle. Such an effect must predict angles it has not seen, as on
+        the next campaign: a sinusoid fitted over part of a turn that only mimics another effect there
+        (the gravity's) is not kept for the turn."""
         return self.variant_folds(cand) if cand.name in PERIODIC else None
 
     def variant_evidence(self, cand, i: int, gains: Sequence[float]) -> dict:
@@ -476,7 +477,7 @@ class Choice:
     notes: list
     spec: Spec
     fit: Any
-    problem: SerialProblem = field(repr=False, default=None)
+    problem: Optional[SerialProblem] = field(repr=False, default=None)
 
 
 def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k_folds: int = 5, seed: int = 0,

@@ -6,9 +6,10 @@ One default each, measured on the real data the project has (BENCHMARKS.md, "One
 - priors on the joint geometry (1 mm, 0.1 deg) and the tool (5 mm, 1 deg) at their overall width 1
   (priors.DEFAULT_PRIOR_SD): what the data cannot determine stays at its prior and is listed, never a
   refusal;
-- the robust loss (Huber) bends at 0.1 mm (DEFAULT_LOSS_SCALE_MM; ``loss_scale_mm`` None: where the
-  residuals' robust spread puts it, 4.03 x the noise): on the UR10 path (diagnose on series B,
-  validate on A, C, D) the data's bend predicted the other series worse (BENCHMARKS.md);
+- the robust loss (Huber) bends where the residuals' robust spread puts it (4.03 x the noise;
+  ``loss_scale_mm`` None): a fixed 0.1 mm predicted the UR10 series a little better from B, but bends
+  below the structure a model still lacks (a fit that misses an effect becomes an L1 fit, distorted,
+  slow to converge, and the diagnosis then misnames the effect), BENCHMARKS.md "One fitting engine";
 - ``gravity`` "auto": the model's link masses when it has any, else the mass moments fitted.
 """
 
@@ -24,8 +25,9 @@ from . import _core, grouping, priors
 from ._core import Robot
 
 LOSSES = ("none", "huber", "cauchy")
-#: where the robust loss bends unless told (mm; measured on the UR10 path, BENCHMARKS.md "One fitting engine")
-DEFAULT_LOSS_SCALE_MM = 0.1
+#: where the robust loss bends unless told (mm; None: from the residuals' robust spread; BENCHMARKS.md "One
+#: fitting engine")
+DEFAULT_LOSS_SCALE_MM: Optional[float] = None
 GRAVITY = ("auto", "masses", "fit")
 
 

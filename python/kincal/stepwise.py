@@ -261,8 +261,11 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
                 if chosen:
                     chosen(c, ridge)
                 order = {"variant_cv_gain": [round(x, 6) for x in gains], "variant": i}
+            s = score(r, Jc, R, row_folds, basis[1], ridge)
             own = score_folds(c) if score_folds else None  # e.g. a periodic effect: ranges of its angle
-            s = score(r, Jc, R, [np.repeat(f, problem.dims) for f in own] if own else row_folds, basis[1], ridge)
+            if own and not s.get("absorbed") and not s.get("untestable"):  # it must also predict those
+                s["extrapolation_cv_gain"] = score(r, Jc, R, [np.repeat(f, problem.dims) for f in own], basis[1],
+                                                   ridge)["cv_gain"]
             if "cv_ss_after" in s:  # the linearised cross-validated RMS per point, with the candidate
                 s["cv_rms_linear_mm"] = math.sqrt(problem.dims * s.pop("cv_ss_after") / len(r))
                 s.pop("cv_ss_before")
@@ -274,7 +277,8 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
         scored.sort(key=lambda s: -s["cv_gain"])
         history[-1]["candidates"] = [{k: v for k, v in s.items() if not k.startswith(("_", "variant"))}
                                      for s in scored[:listed]]
-        sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain]
+        sig = [s for s in scored if s["p_value"] < alpha and s["cv_gain"] > min_gain
+               and s.get("extrapolation_cv_gain", math.inf) > min_gain]
         if not sig:
             break
         best = sig[0]
@@ -338,7 +342,7 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
     left = [s for s in found.last_scores if s["p_value"] < alpha]
     if noise_mm is not None:
         noise = noise_mm * math.sqrt(dims)
-        at_noise = found.cv_rms_mm <= 1.3 * noise
+        at_noise = found.cv_rms_mm is not None and found.cv_rms_mm <= 1.3 * noise
     else:
         noise = scatter
         at_noise = not left
@@ -351,8 +355,8 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
                    + (f" (significant candidates gain too little: {gains})" if left else ""))
     out = {"noise_rms_mm": noise, "noise_known": noise_mm is not None, "fit_scatter_mm": scatter, "verdict": verdict,
            "noise_per_coordinate_mm": noise_mm}
-    say(f"{len(found.steps)} effect(s) named; cross-validated RMS {found.cv_rms_mm * 1000:.1f} um, {noise_phrase(out)}: "
-        f"{verdict}")
+    cv = "" if found.cv_rms_mm is None else f"; cross-validated RMS {found.cv_rms_mm * 1000:.1f} um"
+    say(f"{len(found.steps)} effect(s) named{cv}, {noise_phrase(out)}: {verdict}")
     return out
 
 

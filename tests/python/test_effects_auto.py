@@ -126,3 +126,28 @@ def test_cli_summary_lists_what_was_tried_and_kept(tmp_path):
     assert ch["mode"] == "auto" and ch["nested"] and "joint_compliance" in ch["kept"]
     assert doc["identification"]["effects"] == [t for t in doc["identification"]["effects"]
                                                if t.startswith("joint_compliance")]
+
+
+def test_diagnose_on_task_data_holds_the_wrist_at_its_prior(tmp_path):
+    """Simulated task data (a fixed wrist: joints 4-6 at one pose, axes 1-3 within +-10 deg of it, 60
+    configurations, one target at the tool's origin, 0.02 mm noise; truth default_truth seed 3):
+    `kincal diagnose` with its defaults exits 0, writes its model, and lists the wrist parameters as
+    held at prior (the data cannot determine them: without priors the fit refused them)."""
+    kr500 = kincal.load_robot("kr500")
+    truth = ident.default_truth(kr500, seed=3)
+    rng = np.random.default_rng(1)
+    q = np.tile([10.0, -80.0, 100.0, 20.0, 40.0, -30.0], (60, 1))
+    q[:, :3] += rng.uniform(-10.0, 10.0, (60, 3))
+    d = ident.simulate(truth, 1, seed=1, noise_mm=0.0)
+    d = {k: (np.repeat(v[:1], 60, axis=0) if isinstance(v, np.ndarray) else v) for k, v in d.items()}
+    d.update(pose=np.arange(60), q_deg=q, line=np.arange(60) + 2)
+    d["xyz"] = kincal.fk(truth, q, frame="instrument")[:, :3] + rng.normal(0.0, 0.02, (60, 3))
+    (tmp_path / "task.csv").write_text(ident.measurements_csv(d, kr500.dof))
+    r = run("kincal", "diagnose", "--robot", "kr500", "--data", str(tmp_path / "task.csv"), "--out",
+            str(tmp_path / "d"))
+    assert r.returncode == 0, r.stderr
+    model = json.loads((tmp_path / "d" / "model.json").read_text())
+    held = model["identification"]["priors"]["at_prior"]
+    wrist = [n for n in held if n.startswith(("joint5.", "joint6."))]
+    assert len(wrist) >= 4, held
+    assert kincal.load_robot(str(tmp_path / "d" / "model.json")).identified

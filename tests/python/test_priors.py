@@ -118,8 +118,7 @@ def _gross(data: dict, share: float, rng) -> dict:
 def test_data_scaled_loss_on_clean_and_gross_errors(kr500):
     """150 configurations x 3 targets, 0.02 mm noise, 3 seeds; scored on 300 other configurations
     measured with the same noise (the held-out RMS a validation reports), geometry and compliance.
-    Clean data: the data-scaled Huber loss (--loss-scale 0; identify's default until the fitting
-    options were unified at a fixed 0.1 mm) within 1% of --loss none. With 3% gross errors of 3-6 mm: the
+    Clean data: the default (Huber, scale from the data) within 1% of --loss none. With 3% gross errors of 3-6 mm: the
     default within 5% of its clean result, --loss none worse by more than 50%. The scale found is
     4.03 x the estimated noise (the 99.9% point of a 3-D Gaussian norm), which is within 10% of the
     true 0.02 mm. Measured held-out RMS (seeds 1-3): clean 0.0350, 0.0346, 0.0350 mm with either loss;
@@ -147,13 +146,12 @@ def test_data_scaled_loss_on_clean_and_gross_errors(kr500):
 
 
 @pytest.mark.skipif(not IPA.is_dir(), reason="needs ../shared/data/ipa-robot-accuracy")
-def test_ur10_series_b_data_scaled_loss_not_worse_than_none():
+def test_ur10_series_b_default_loss_not_worse_than_none():
     """UR10 series B (1495 real points), grouped 5-fold cross-validation (whole configurations per
-    fold), geometry and compliance: Huber at the data's scale (--loss-scale 0) against --loss none.
+    fold), geometry and compliance: the default loss (Huber at the data's scale) against --loss none.
     Measured 0.413181 against 0.413195 mm RMS: a margin of 3e-5 relative, at the resolution of this
     measure (bending at the 95% point instead, 2.80 x the noise: 0.413240, 0.011% worse; Huber at a
-    fixed 0.1 mm: 0.4148, 0.4% worse on B itself, but the default now: it predicts series A, C and D
-    better, BENCHMARKS.md "One fitting engine")."""
+    fixed 0.1 mm: 0.4148, 0.4% worse)."""
     robot = kincal.load_robot("ur10")
     data = datasets.read_ipa(IPA / "Series_B/measurements_joint_configurations.csv")
     default = ident.identify(robot, data, loss_scale_mm=None, effects="joint_compliance").validation
@@ -239,9 +237,8 @@ def test_cli_prior_options(tmp_path):
     doc = json.loads(out.read_text())["identification"]
     tilt = next(p for p in doc["parameters"] if p["name"] == "joint3.tilt_u")
     assert tilt["prior_sd"] == pytest.approx(0.05) and tilt["unit"] == "deg"  # the file's unit
-    assert doc["loss"]["scale_from"] == "--loss-scale" and doc["loss"]["scale_mm"] == 0.1  # the default bend
-    assert "robust loss: huber bending at 0.1000 mm" in r.stdout
-    r = run("kincal", "identify", "--robot", "kr500", "--data", str(data), "--out", str(out), "--loss-scale", "0",
+    assert doc["loss"]["scale_from"] == "the residuals' robust spread" and "robust loss: huber" in r.stdout
+    r = run("kincal", "identify", "--robot", "kr500", "--data", str(data), "--out", str(out), "--loss-scale", "0.1",
             "--folds", "0")
     assert r.returncode == 0, r.stderr
-    assert json.loads(out.read_text())["identification"]["loss"]["scale_from"] == "the residuals' robust spread"
+    assert json.loads(out.read_text())["identification"]["loss"]["scale_from"] == "--loss-scale"

@@ -200,8 +200,8 @@ void define_identify(py::module_& m) {
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("data"),
-      "Angle (deg) between every measured orientation (a 6-D set) and the calibrated model's (its effects\n"
-      "acting, each row seen from its setup's placement at its time)");
+      "Angle (deg) between every measured orientation (the 6-D rows, in order; reflector rows left out) and\n"
+      "the calibrated model's (its effects acting, each row seen from its setup's placement at its time)");
 
   py::class_<Parameter>(m, "Parameter", "One parameter of the identification vector")
       .def_readonly("name", &Parameter::name, "e.g. 'joint3.tilt_u', 'base.ry', 'joint2.te_sin1'")

@@ -72,7 +72,8 @@ py::dict measurements_to_dict(const MeasurementSet& m, int dof) {
   if (!std::isnan(temp.sum())) d["temperature_c"] = temp;
   if (m.orientation) {
     RowMatrix abc(n, 3);
-    for (size_t i = 0; i < n; ++i) abc.row(i) = m.rows[i].abc.transpose();
+    for (size_t i = 0; i < n; ++i)  // NaN: a reflector row (a point) among 6-D rows
+      abc.row(i) = (m.rows[i].has_abc ? m.rows[i].abc : Vec3::Constant(std::nan("")).eval()).transpose();
     d["abc"] = abc;
   }
   if (dir) d["dir"] = dirs;
@@ -136,8 +137,16 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
   if (d.contains("abc")) {
     const auto a = d["abc"].cast<RowMatrix>();
     if (static_cast<size_t>(a.rows()) != n || a.cols() != 3) throw InputError(m.source + ": abc of a different shape");
-    for (size_t i = 0; i < n; ++i) m.rows[i].has_abc = true, m.rows[i].abc = a.row(i).transpose();
-    m.orientation = true;
+    for (size_t i = 0; i < n; ++i) {
+      const int nan = static_cast<int>(std::isnan(a(i, 0))) + static_cast<int>(std::isnan(a(i, 1))) +
+                      static_cast<int>(std::isnan(a(i, 2)));
+      if (nan == 3) continue;  // a reflector row among 6-D rows
+      if (nan > 0 || !a.row(i).allFinite())
+        throw InputError(m.source + ": abc at row " + std::to_string(i) + " needs three finite angles (or three NaN: a point)");
+      m.rows[i].has_abc = true;
+      m.rows[i].abc = a.row(i).transpose();
+      m.orientation = true;
+    }
   }
   if (d.contains("dir")) {
     const auto dd = d["dir"].cast<RowMatrix>();

@@ -69,6 +69,12 @@ void define_model(py::module_& m) {
           py::arg("setups"),
           "The robot with its calibrated model seen from these placements: (name, xyz_mm, abc_deg) per\n"
           "setup, the first its base_in_instrument (one: no setups)")
+      .def_property_readonly("tcp", [](const Robot& r) { return r.calibrated->spec().tcp; },
+                             "where the calibrated model's tool frame comes from: 'measured' (6-D rows), "
+                             "'tool-targets', 'nominal' (reflectors only), '' when not recorded")
+      .def("tcp_warning", [](const Robot& r, const std::string& source) { return tcp_warning(r, source); },
+           py::arg("source"),
+           "The one warning line for a model whose TCP is nominal (not measured), naming source; '' otherwise")
       .def_property_readonly("fitted_ranges_deg", [](const Robot& r) { return r.calibrated->spec().fitted_deg; },
                              "per joint, the angles the identification saw ([lo, hi] deg); empty when unknown")
       .def(

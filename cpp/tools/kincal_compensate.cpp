@@ -218,6 +218,8 @@ int main(int argc, char** argv) {
     const kincal::Robot robot = robot_with_convention(model, joint_convention);
     if (opt.instrument_frame && !robot.identified())
       throw kincal::InputError(model + ": --frame instrument needs an identified model (kincal identify)");
+    const std::string tcp = kincal::tcp_warning(robot, model);  // a model whose TCP was not measured
+    if (!tcp.empty()) std::fprintf(stderr, "kincal-compensate: warning: %s\n", tcp.c_str());
     if (stream) {
       kincal::StreamCompensator sc(robot, opt);
       std::string line;

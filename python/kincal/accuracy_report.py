@@ -280,6 +280,9 @@ def run_iso9283(data: str, out: str, distance: Optional[str] = None, model: Opti
     runs = acc.read_runs(data)
     if model is not None:
         runs = acc.to_base(runs, model)
+        from ._core import Robot
+        from .tool_frame import warn_nominal_tcp
+        warn_nominal_tcp(Robot.load(model), model, "kincal accuracy")  # a TCP not measured: one line
     elif frame_label is not None:
         runs["frame"] = frame_label
     res = acc.iso9283(runs, names)

@@ -5,6 +5,7 @@ by the C++ core (the same code as kincal-compensate)."""
 from __future__ import annotations
 
 from . import _core
+from .tool_frame import warn_nominal_tcp
 
 FORMATS = ["krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"]
 
@@ -63,7 +64,8 @@ def _frame(text, option: str) -> list:
 
 def compensate(robot, args, comp_kwargs: dict) -> dict:
     """Compensates args.program into args.out in the chosen language; returns the result dict (with
-    `files`, the files written)."""
+    `files`, the files written). A model whose TCP is nominal (not measured) gets one warning line."""
+    warn_nominal_tcp(robot, args.model, "kincal compensate")
     return _core.compensate_to_controller(robot, str(args.program), str(args.out), **comp_kwargs,
                                           format=args.format, targets=args.targets, name=args.name,
                                           speed=args.speed, zone=args.zone,

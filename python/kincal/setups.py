@@ -125,13 +125,16 @@ def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[
     ``before_mean_deg``, ``before_max_deg``), the same per setup under ``setups`` when the data have several, and
     ``rows``, ``after_rms_mm``, ``after_max_mm`` (the names of earlier versions)."""
     ea, eb = np.asarray(after), np.asarray(before)
+    # the orientation errors are those of the 6-D rows (reflector rows among them have NaN a, b, c)
+    six_d = (~np.isnan(np.asarray(data["abc"], dtype=float)[:, 0]) if "abc" in data
+             else np.ones(len(ea), dtype=bool))
 
     def figures(mask: np.ndarray) -> dict:
         out = {"points": int(mask.sum()), "rms_mm": _rms(ea[mask]), "mean_mm": float(np.mean(ea[mask])),
                "max_mm": float(np.max(ea[mask])), "before_rms_mm": _rms(eb[mask]),
                "before_mean_mm": float(np.mean(eb[mask])), "before_max_mm": float(np.max(eb[mask]))}
-        if o_after is not None and o_before is not None:
-            oa, ob = np.asarray(o_after)[mask], np.asarray(o_before)[mask]
+        if o_after is not None and o_before is not None and np.any(mask[six_d]):
+            oa, ob = np.asarray(o_after)[mask[six_d]], np.asarray(o_before)[mask[six_d]]
             out.update(rms_deg=_rms(oa), mean_deg=float(np.mean(oa)), max_deg=float(np.max(oa)),
                        before_rms_deg=_rms(ob), before_mean_deg=float(np.mean(ob)), before_max_deg=float(np.max(ob)))
         return out

@@ -1,9 +1,12 @@
-"""The tool frame (TCP) placed from known target offsets after an identification."""
+"""The tool frame (TCP) placed from known target offsets after an identification, and what a model
+records of where its TCP comes from (the model file's top-level "tcp": "measured" by 6-D rows,
+"tool-targets", or "nominal" when reflectors alone could not place it)."""
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import sys
 
 import numpy as np
 
@@ -41,6 +44,7 @@ def tool_from_targets(result: Identification, known: np.ndarray) -> Identificati
     new_r, new_t = m_r @ r, m_t + m_r @ t
     tool["xyz_mm"] = new_t.tolist()
     tool["abc_deg"] = _abc_of(new_r)
+    doc["tcp"] = "tool-targets"
     robot = Robot.from_json(strict_json.dumps(doc), "<identified>")
     return dataclasses.replace(result, robot=robot, targets=known.copy())
 
@@ -48,3 +52,27 @@ def tool_from_targets(result: Identification, known: np.ndarray) -> Identificati
 def _abc_of(r: np.ndarray) -> list:
     """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c) (the core's, exact at the pole)."""
     return [float(v) for v in _core.rotation_to_abc(np.asarray(r, dtype=float))]
+
+
+#: the summary's line on the TCP, by the model's "tcp"
+_TCP_LINES = {
+    "measured": "TCP: measured (the frame the 6-D rows measure is the tool frame, identified with the rest)",
+    "tool-targets": "TCP: placed by --tool-targets (the targets' known offsets in the tool frame)",
+    "nominal": "TCP: nominal (reflectors only place themselves, not the tool frame; --tool-targets or a 6-D row "
+               "measures it)",
+}
+
+
+def tcp_summary_line(robot: Robot) -> list:
+    """The identification summary's line on where the TCP comes from (none when not recorded)."""
+    line = _TCP_LINES.get(robot.tcp)
+    return [line] if line else []
+
+
+def warn_nominal_tcp(robot: Robot, source: str, program: str = "kincal") -> None:
+    """One warning line on stderr for a model whose TCP is nominal (not measured); nothing otherwise
+    (the TCP measured or placed, or a model that does not record it: older files, built-in robots,
+    URDFs)."""
+    w = robot.tcp_warning(str(source))
+    if w:
+        print(f"{program}: warning: {w}", file=sys.stderr)

@@ -203,6 +203,96 @@ TEST(Identify, SixDimensionalPosesDetermineTheToolOrientation) {
   EXPECT_GT(orientation_rms_deg(Model(r3.calibrated)), 3 * noise_deg);
 }
 
+TEST(Identify, NoiseFreeSixDimensionalPosesIdentifyTheToolFrame) {
+  // truth: kr500 with ~1 mm / 0.05 deg geometric errors (tool frame included), no compliance, seen
+  // from the instrument; one target at the tool frame's origin measured as a full pose
+  // (no noise, position or orientation), 300 poses to fit, 100 other poses held out. The frame a 6-D
+  // row measures is the tool frame: its target is held at zero, the tool frame is identified (free),
+  // and the model alone (fk, no target offset) reproduces the held-out poses.
+  const Model truth(truth_spec(61, 0.0));
+  SimulationOptions so;
+  so.poses = 300;
+  so.noise_mm = 0;
+  so.orientation_noise_deg = 0;
+  so.targets = {Vec3::Zero()};
+  const auto [fit, held] = fit_and_held(truth, so, 31, 32);
+  ASSERT_TRUE(fit.orientation);
+  const Model nominal(kr500_spec());
+  IdentifyOptions opt;
+  opt.loss = "none";
+  const IdentifyResult r = identify(nominal, fit, opt);
+  const ParamLayout& L = r.layout;
+  for (int i = L.tool; i < L.tool + 6; ++i) EXPECT_FALSE(r.fixed[i]) << L.names[i] << ": " << r.fixed_reason[i];
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(r.fixed[L.targets + k]);
+    EXPECT_EQ(r.x[L.targets + k], 0.0);
+  }
+  EXPECT_EQ(r.calibrated.tcp, "measured");
+  const Model cal(r.calibrated);
+  const std::vector<double> ep = point_errors(cal, {Vec3::Zero()}, held);  // the tool frame's origin
+  EXPECT_LT(*std::max_element(ep.begin(), ep.end()), 1e-4) << r.termination;
+  const std::vector<double> eo = orientation_errors(cal, held);
+  ASSERT_EQ(eo.size(), held.rows.size());
+  EXPECT_LT(*std::max_element(eo.begin(), eo.end()), 1e-6);
+  // the nominal geometry (its base and tool frames fitted) is off by more than 1 mm RMS
+  EXPECT_GT(rms(point_errors(Model(r.nominal_fitted), {Vec3::Zero()}, held)), 1.0);
+}
+
+TEST(Identify, SixDimensionalRowsWithReflectorsKeepTheReflectorsOffsetsInTheToolFrame) {
+  // truth as above (seed 62); the first target measured as a full pose (the tool frame), the two
+  // others (120, 0, 30) and (0, 150, -20) mm as points in the same file; no noise, 200 poses. The
+  // tool frame is identified, the reflectors' offsets come out in it (to 1e-6 mm), and held-out
+  // poses and points are reproduced.
+  const Model truth(truth_spec(62, 0.0));
+  SimulationOptions so;
+  so.poses = 200;
+  so.noise_mm = 0;
+  so.orientation_noise_deg = 0;
+  so.targets = kTargets;
+  const auto [fit, held] = fit_and_held(truth, so, 33, 34);
+  int six_d = 0;
+  for (const auto& row : fit.rows) six_d += row.has_abc, EXPECT_EQ(row.has_abc, row.target == 0);
+  ASSERT_EQ(six_d, 200);
+  IdentifyOptions opt;
+  opt.loss = "none";
+  const IdentifyResult r = identify(Model(kr500_spec()), fit, opt);
+  EXPECT_EQ(r.calibrated.tcp, "measured");
+  ASSERT_EQ(r.targets.size(), 3u);
+  for (int t = 0; t < 3; ++t) EXPECT_LT((r.targets[t] - kTargets[t]).norm(), 1e-6) << t;
+  const Model cal(r.calibrated);
+  const std::vector<double> e = point_errors(cal, r.targets, held);
+  EXPECT_LT(*std::max_element(e.begin(), e.end()), 1e-4);
+  const std::vector<double> eo = orientation_errors(cal, held);
+  EXPECT_EQ(eo.size(), 200u);  // the 6-D rows only
+  EXPECT_LT(*std::max_element(eo.begin(), eo.end()), 1e-6);
+  // 6-D rows of two targets claim two tool frames: an error naming both
+  MeasurementSet two = fit;
+  two.rows[1].has_abc = true;
+  try {
+    identify(Model(kr500_spec()), two, opt);
+    ADD_FAILURE() << "6-D rows of two targets accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("6-D rows of target 0 and of target 1"), std::string::npos) << err.what();
+  }
+}
+
+TEST(Identify, ReflectorsAloneLeaveTheTcpNominal) {
+  // truth as above (seed 63), three reflectors measured as points, 60 poses, no noise: the tool frame
+  // stays at its start value (redundant with the offsets) and the model records it
+  const Model truth(truth_spec(63, 0.0));
+  SimulationOptions so;
+  so.poses = 60;
+  so.noise_mm = 0;
+  so.targets = kTargets;
+  so.seed = 35;
+  IdentifyOptions opt;
+  opt.compliance = false;
+  opt.loss = "none";
+  const IdentifyResult r = identify(Model(kr500_spec()), simulate(truth, so), opt);
+  EXPECT_EQ(r.calibrated.tcp, "nominal");
+  for (int i = r.layout.tool; i < r.layout.tool + 6; ++i) EXPECT_TRUE(r.fixed[i]) << r.layout.names[i];
+}
+
 TEST(Identify, GravityWithoutAMassTablePredictsAsTheTrueMasses) {
   // truth: kr500 (its masses and 300 kg head), 1 mm / 0.05 deg geometric errors, compliance
   // 0.003 deg/kNm x U(0.5, 1.5) on the loaded joints, noise 0.02 mm per coordinate; 100 poses with

@@ -91,12 +91,14 @@ std::vector<int> preference_order(const ParamLayout& L, bool orientation) {
   for (int i = L.effects; i < L.size; ++i) order.push_back(i);
   for (int j = 1; j < L.dof; ++j)
     for (int k = 0; k < 4; ++k) order.push_back(4 * j + k);
-  // with measured orientations the tool's rotation is seen: keep it, hold the base's gauge instead
+  // with measured orientations the tool frame itself is measured (the 6-D rows' target is held at
+  // zero): keep it, hold the base's gauge instead
   if (orientation)
-    for (int i = L.tool + 3; i < L.tool + 6; ++i) order.push_back(i);
+    for (int i = L.tool; i < L.tool + 6; ++i) order.push_back(i);
   for (int i = L.base; i < L.targets; ++i) order.push_back(i);  // every setup's
   for (int k = 0; k < 4; ++k) order.push_back(k);
-  for (int i = L.tool; i < L.tool + (orientation ? 3 : 6); ++i) order.push_back(i);
+  if (!orientation)  // reflectors alone: the tool frame is redundant with their offsets
+    for (int i = L.tool; i < L.tool + 6; ++i) order.push_back(i);
   return order;
 }
 
@@ -150,6 +152,8 @@ void select_independent(const Eigen::MatrixXd& J, const std::vector<int>& order,
 MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data) {
   const int dof = nominal.dof();
   const std::vector<bool> measured = measured_targets(data);
+  std::vector<bool> six_d(data.n_targets, false);  // the target of the 6-D rows (the tool frame)
+  for (const auto& r : data.rows) six_d[r.target] = six_d[r.target] || (data.orientation && r.has_abc);
   MeasurementSet generic;
   generic.n_targets = data.n_targets;
   generic.orientation = data.orientation;
@@ -170,9 +174,8 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
     row.temperature_c = like.temperature_c;
     row.time_s = like.time_s;
     row.setup = like.setup;
-    row.has_abc = data.orientation;
     for (int t = 0; t < data.n_targets; ++t)
-      if (measured[t]) row.target = t, generic.rows.push_back(row);
+      if (measured[t]) row.target = t, row.has_abc = six_d[t], generic.rows.push_back(row);
   }
   return generic;
 }
@@ -301,6 +304,23 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
   for (int t = 0; t < data.n_targets; ++t)
     if (!measured[t])
       for (int k = 0; k < 3; ++k) res.fix(L.targets + 3 * t + k, "target never measured");
+  // a 6-D row measures the tool frame itself: its target has no offset (the tool frame is identified
+  // instead); reflector rows keep theirs, in that frame. One measured frame: 6-D rows of one target.
+  int six_d = -1;
+  for (const auto& r : data.rows) {
+    if (!data.orientation || !r.has_abc || r.target == six_d) continue;
+    if (six_d >= 0)
+      throw InputError(data.source + (r.line ? ":" + std::to_string(r.line) : "") + ": 6-D rows of target " +
+                       std::to_string(six_d) + " and of target " + std::to_string(r.target) +
+                       ": the frame a 6-D row measures is the tool frame (the TCP), one target; measure the other "
+                       "targets as points (a, b, c empty)");
+    six_d = r.target;
+  }
+  if (six_d >= 0)
+    for (int k = 0; k < 3; ++k) {
+      res.start[L.targets + 3 * six_d + k] = 0;
+      res.fix(L.targets + 3 * six_d + k, "the frame a 6-D row measures is the tool frame (no offset)");
+    }
   std::vector<bool> placed(static_cast<size_t>(L.n_setups), false);
   for (const auto& r : data.rows)
     if (r.setup >= 0 && r.setup < L.n_setups) placed[static_cast<size_t>(r.setup)] = true;

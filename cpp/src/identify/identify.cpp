@@ -274,9 +274,10 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
                 std::vector<double>& x, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
   std::vector<int> frames;
-  // with measured orientations the probe's mounting (the tool frame's rotation) is a frame too
+  // with measured orientations the frame measured is the tool frame (its target held at zero): the
+  // probe's mounting, position and rotation, is a frame too
   if (data.orientation)
-    for (int i = L.tool + 3; i < L.tool + 6; ++i) frames.push_back(i);
+    for (int i = L.tool; i < L.tool + 6; ++i) frames.push_back(i);
   for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
     if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != "setup never measured")) frames.push_back(i);
   if (L.drift >= 0)  // the instrument's own motion belongs to the frames
@@ -316,7 +317,8 @@ std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResul
   size_t unconstrained = 0;
   for (int i = 0; i < res.layout.size; ++i)
     if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
-  const size_t nres = residual_size(residual_kind(data)) * data.rows.size();
+  size_t nres = 0;  // a reflector row among 6-D rows gives 3 equations
+  for (const auto& r : data.rows) nres += data.orientation && r.has_abc ? 6 : 3;
   const std::string points = data.source + ": " + std::to_string(data.rows.size()) + " measured points";
   if (unconstrained == free_idx.size() && nres <= free_idx.size())
     throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
@@ -336,6 +338,9 @@ void store_solution(PointModel& pm, const Model& nominal, const MeasurementSet& 
   pm.set_params(x);
   res.calibrated = pm.spec();
   res.calibrated.name = nominal.spec().name + "-calibrated";
+  // 6-D rows measured the tool frame; reflectors alone leave it where it started (redundant with
+  // their offsets): every pose then carries the tool's error
+  res.calibrated.tcp = data.orientation ? "measured" : "nominal";
   for (int t = 0; t < data.n_targets; ++t) res.targets.push_back(target_of(L, x, t));
   res.t_ref = L.t_ref;
   res.t_mean_s = L.t_mean;

@@ -330,6 +330,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   if (drift) drift_columns(tau, dw, rb * x, jac, ang ? jac_rot : nullptr);
   J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
   if (frames_only_) {
+    J.block<3, 3>(0, layout_.tool) = scale * rbn;  // with measured orientations the tool frame is a frame
     J.block<3, 3>(0, layout_.tool + 3) = -scale * rbn * rm_ * so3::skew(tkv) * jrm_;
     if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
     return y;
@@ -427,14 +428,19 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
 int row_residuals(const PointModel& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
                   double* J) {
   const int P = pm.layout().size;
-  const bool orientation = kind == ResidualKind::pose;
+  // a reflector row among 6-D rows: its orientation rows are zero (no equation), the layout stays
+  const bool orientation = kind == ResidualKind::pose && m.has_abc;
   Mat3 rot;
   thread_local std::vector<double> jw;
   if (J && orientation) jw.resize(3 * static_cast<size_t>(P));
   const Vec3 y = pm.predict(m, J, orientation ? &rot : nullptr, (J && orientation) ? jw.data() : nullptr);
   for (int k = 0; k < 3; ++k) r[k] = y[k] - m.xyz[k];
+  if (kind == ResidualKind::pose && !orientation) {
+    for (int k = 3; k < 6; ++k) r[k] = 0;
+    if (J) std::fill_n(J + 3 * static_cast<size_t>(P), 3 * static_cast<size_t>(P), 0.0);
+    return 6;
+  }
   if (!orientation) return 3;
-  if (!m.has_abc) throw InputError("a row without a measured orientation in a 6-D measurement set");
   const Vec3 e = so3::log(abc_to_rotation(m.abc).transpose() * rot);
   for (int k = 0; k < 3; ++k) r[3 + k] = orientation_weight * e[k];
   if (J) {

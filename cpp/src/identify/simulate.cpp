@@ -125,8 +125,11 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
       row.target = t;
       row.xyz = simulate_point(truth, row, opt.targets[t]);
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
-      if (opt.orientation_noise_deg >= 0) {
-        // the measured tool frame (a 6-D probe): truth orientation, then a small random rotation
+      row.has_abc = false;  // the row of the pose's previous target may have been the 6-D one
+      row.abc = Vec3::Zero();
+      if (opt.orientation_noise_deg >= 0 && t == 0) {
+        // the measured frame (a 6-D probe, the first target; the others are reflectors, points): the
+        // tool frame moved by that target's offset, truth orientation, then a small random rotation
         const Mat3 r = drifted(truth, truth.base_in_instrument(), row.time_s).linear() *
                        fk_model(truth, row.q_deg * kDeg, row_context(row)).linear();
         const Vec3 e = Vec3(nd(rng), nd(rng), nd(rng)) * opt.orientation_noise_deg * kDeg;
@@ -171,7 +174,7 @@ std::vector<double> orientation_errors(const Model& model, const MeasurementSet&
   std::vector<double> e;
   e.reserve(data.rows.size());
   for (const auto& r : data.rows) {
-    if (!r.has_abc) throw InputError(data.source + ":" + std::to_string(r.line) + ": no measured orientation (a, b, c)");
+    if (!r.has_abc) continue;  // a reflector row among 6-D rows
     const Model& m = payload_model(model, r.payload_kg, variants);
     const Mat3 rot = drifted(m, row_frame(frames, data, r), r.time_s).linear() *
                      fk_model(m, r.q_deg * kDeg, row_context(r)).linear();

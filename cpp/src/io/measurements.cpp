@@ -49,7 +49,6 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
   const bool abc = ca >= 0 && cb >= 0 && cc >= 0;
   if (!abc && (ca >= 0 || cb >= 0 || cc >= 0))
     throw InputError(source + ":1: an orientation needs all three columns a, b, c");
-  m.orientation = abc;
   const int ctarget = t.find("target"), cpay = t.find("payload_kg"), ctemp = t.find("temperature_c");
   const int ctime = t.find("time_s"), cconfig = t.find("config"), csetup = t.find("setup");
   std::vector<int> cdir;
@@ -65,8 +64,17 @@ MeasurementSet measurements_from_table(const CsvTable& t, int dof) {
     for (int j = 0; j < dof; ++j) row.q_deg[j] = t.number(r, cq[j]);
     row.xyz = Vec3(t.number(r, cx), t.number(r, cy), t.number(r, cz));
     if (abc) {
-      row.has_abc = true;
-      row.abc = Vec3(t.number(r, ca), t.number(r, cb), t.number(r, cc));
+      // a reflector row in a file of 6-D rows leaves a, b, c empty (a point, its offset in the tool frame)
+      const int empty = static_cast<int>(t.cells[r][static_cast<size_t>(ca)].empty()) +
+                        static_cast<int>(t.cells[r][static_cast<size_t>(cb)].empty()) +
+                        static_cast<int>(t.cells[r][static_cast<size_t>(cc)].empty());
+      if (empty == 0) {
+        row.has_abc = true;
+        row.abc = Vec3(t.number(r, ca), t.number(r, cb), t.number(r, cc));
+        m.orientation = true;
+      } else if (empty < 3) {
+        throw InputError(t.where(r) + ": an orientation needs all three of a, b, c (a point leaves all three empty)");
+      }
     }
     if (ctarget >= 0) {
       const double tv = t.number(r, ctarget);
@@ -131,7 +139,7 @@ std::string format_measurements(const MeasurementSet& m, int dof) {
     for (int j = 0; j < dof; ++j) s += "," + fmt(r.q_deg[j]);
     for (int k = 0; k < 3; ++k) s += "," + fmt(r.xyz[k]);
     if (m.orientation)
-      for (int k = 0; k < 3; ++k) s += "," + fmt(r.abc[k]);
+      for (int k = 0; k < 3; ++k) s += r.has_abc ? "," + fmt(r.abc[k]) : ",";
     s += "," + std::to_string(r.target);
     if (pay) s += "," + fmt(r.payload_kg);
     if (temp) s += "," + fmt(r.temperature_c);

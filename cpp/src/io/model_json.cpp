@@ -250,7 +250,14 @@ std::string robot_to_json(const Robot& robot) {
   json o{{"format", "kincal-model"}, {"version", 2}, {"nominal", spec_json(robot.nominal->spec())}};
   if (robot.identified()) o["calibrated"] = spec_json(robot.calibrated->spec());
   if (!robot.nominal->spec().joint_convention.empty()) o["joint_convention"] = robot.nominal->spec().joint_convention;
+  if (!robot.calibrated->spec().tcp.empty()) o["tcp"] = robot.calibrated->spec().tcp;
   return o.dump(2) + "\n";
+}
+
+std::string tcp_warning(const Robot& robot, const std::string& source) {
+  if (robot.calibrated->spec().tcp != "nominal") return "";
+  return source + ": the TCP is nominal (not measured): every pose carries the tool's error; identify with "
+                  "--tool-targets or 6-D rows";
 }
 
 Robot robot_from_json(const std::string& text, const std::string& source) {
@@ -285,11 +292,24 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
     if (!o["joint_convention"].is_string()) throw InputError(source + ": joint_convention: not a string");
     convention = o["joint_convention"].get<std::string>();
   }
+  std::string tcp;  // where the calibrated model's tool frame comes from (ModelSpec::tcp)
+  if (o.contains("tcp")) {
+    const json& t = o["tcp"];
+    if (!t.is_string() || (t != "nominal" && t != "measured" && t != "tool-targets"))
+      throw InputError(source + ": tcp: " + t.dump() + " is not one of \"nominal\", \"measured\", \"tool-targets\"");
+    tcp = t.get<std::string>();
+  }
   try {
-    nominal = std::make_shared<Model>(with_joint_convention(r.spec(r.at(o, "nominal", "model"), "nominal"), convention));
-    calibrated = o.contains("calibrated")
-                     ? std::make_shared<Model>(with_joint_convention(r.spec(o["calibrated"], "calibrated"), convention))
-                     : nominal;
+    ModelSpec ns = with_joint_convention(r.spec(r.at(o, "nominal", "model"), "nominal"), convention);
+    if (!o.contains("calibrated")) ns.tcp = tcp;  // one model: the key is its
+    nominal = std::make_shared<Model>(ns);
+    if (o.contains("calibrated")) {
+      ModelSpec cs = with_joint_convention(r.spec(o["calibrated"], "calibrated"), convention);
+      cs.tcp = tcp;
+      calibrated = std::make_shared<Model>(cs);
+    } else {
+      calibrated = nominal;
+    }
   } catch (const InputError& e) {
     const std::string m = e.what();
     if (m.rfind(source, 0) == 0) throw;

@@ -13,7 +13,9 @@
 
 namespace kincal {
 
-/// Fix what the options and the measured poses rule out: targets never measured, compliances not
+/// Fix what the options and the measured poses rule out: targets never measured, the target of the
+/// 6-D rows (at zero offset: the frame they measure is the tool frame; InputError when 6-D rows
+/// measure several targets), compliances not
 /// asked for (opt.compliance, opt.compliance_joints) or of a joint with less than
 /// opt.min_torque_share of the largest gravity torque over the poses (with masses), and the
 /// parameters named in opt.fix (InputError for an unknown name). With the gravity fitted, the first

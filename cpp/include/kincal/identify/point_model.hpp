@@ -40,7 +40,9 @@
 // masses. The payload's mass stays the model's (a constant payload is absorbed by the moments; only
 // several payloads in the data fix the absolute scale, and then the scale is not held).
 // Rows with a measured orientation (a, b, c) add 3 residuals: the weighted rotation vector from the
-// measured to the predicted tool frame.
+// measured to the predicted tool frame. Such a row measures the tool frame itself (its target's offset
+// is held at zero: identify() then identifies the tool frame); a reflector row among them keeps its
+// 3 orientation residuals at zero.
 #pragma once
 
 #include "kincal/io/measurements.hpp"
@@ -187,7 +189,8 @@ inline ResidualKind residual_kind(const MeasurementSet& data) {
 }
 
 /// The residual of one row (3 position components in mm; for a pose 3 more: orientation_weight
-/// times the rotation vector log(R_measured^T R_model)) and, when J is not null, its Jacobian
+/// times the rotation vector log(R_measured^T R_model), zero for a row without one) and, when J is
+/// not null, its Jacobian
 /// (row-major, rows x size; J must hold 6 x size). Returns the number of residuals.
 int row_residuals(const PointModel& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
                   double* J);

@@ -22,7 +22,10 @@ struct SimulationOptions {
   std::vector<EffectValue> effects;  ///< effects hidden in the truth (besides its compliance)
   double t_ref = 20.0;             ///< reference temperature of thermal_expansion
   double t_min = 18.0, t_max = 30.0;  ///< the temperature drifts through this range over the campaign
-  double orientation_noise_deg = -1;  ///< >= 0: the tool frame's orientation is measured too (6-D)
+  /// >= 0: the first target's rows are 6-D poses (the tool frame moved by that target's offset, its
+  /// orientation measured too, with this noise per axis); the other targets' rows stay points
+  /// (reflectors among the 6-D rows)
+  double orientation_noise_deg = -1;
   /// > 0: every row gets time_s, the campaign running from 0 to duration_s in pose order (a hidden
   /// drift without it: 3 h). A drift hidden in a truth that has none is centred on the mean time.
   double duration_s = 0;
@@ -55,8 +58,9 @@ ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& e
 /// each row seen from its setup's placement, the model's drift at the row's time) with the given
 /// targets.
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data);
-/// Orientation errors (deg) of every row of a 6-D set: the angle between the measured tool frame
-/// and the model's (every effect acting, seen from the row's placement at its time).
+/// Orientation errors (deg) of every 6-D row of a set, in order (rows without a measured orientation
+/// are left out): the angle between the measured tool frame and the model's (every effect acting,
+/// seen from the row's placement at its time).
 std::vector<double> orientation_errors(const Model& model, const MeasurementSet& data);
 
 }  // namespace kincal

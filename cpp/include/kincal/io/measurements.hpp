@@ -35,7 +35,9 @@ struct MeasurementSet {
   std::string source;
   std::vector<Measurement> rows;
   int n_targets = 1;
-  bool orientation = false;  ///< every row carries a measured orientation (a, b, c columns)
+  /// some row carries a measured orientation (a, b, c columns; a reflector row among 6-D rows leaves
+  /// them empty: has_abc false)
+  bool orientation = false;
   std::vector<std::string> config_names;  ///< the config values by code (empty: no config column)
   std::vector<std::string> setup_names;   ///< the setup values by code (empty: no setup column)
   /// Number of instrument placements (1 without a setup column).

@@ -14,5 +14,9 @@ Robot robot_from_json(const std::string& text, const std::string& source);
 /// A built-in name or a model JSON file path (URDF files are read by the Python layer).
 Robot load_robot(const std::string& name_or_path);
 std::string spec_to_json(const ModelSpec& spec);
+/// The one warning line for a model whose TCP the identification could not place ("tcp": "nominal":
+/// reflectors only, no --tool-targets), naming source (the model file); "" for any other model (the
+/// TCP measured or placed, or not recorded: older files, built-in robots, URDFs).
+std::string tcp_warning(const Robot& robot, const std::string& source);
 
 }  // namespace kincal

@@ -76,6 +76,12 @@ struct ModelSpec {
   /// Per joint, the angles the identification saw (coverage.hpp); empty when unknown (a nominal model,
   /// a model written before they were recorded)
   std::vector<JointRange> fitted_deg;
+  /// Where the tool frame (TCP) comes from, as the identification knows it: "measured" (6-D rows
+  /// measured the tool frame itself), "tool-targets" (placed from known target offsets), "nominal"
+  /// (reflectors only: the tool frame stayed at its start value, its error in every pose); "" when
+  /// not recorded (a nominal model, a model file written before the key). The model file's top-level
+  /// "tcp", the calibrated model's.
+  std::string tcp;
 };
 
 class Model {

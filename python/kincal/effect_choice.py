@@ -26,7 +26,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core, grouping
+from . import _core
 from . import stepwise as engine
 from ._core import Robot
 from .fitting import FitOptions, folds as grouped_folds, gravity_fitted, point_errors, subset
@@ -194,15 +194,12 @@ def _key(p) -> tuple:
     return (p.kind, p.joint, p.target, p.name)
 
 
-def evaluate(res, data: dict, extra: Sequence, fit_gravity: bool = False, compliance: Optional[dict] = None) -> tuple:
+def evaluate(res, data: dict, extra: Sequence) -> tuple:
     """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
     parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
-    parameter index of each of them that is the fit's, by index). ``fit_gravity``: the layout with
-    the gravity's mass moments (at zero); ``compliance``: the compliances set (joint from 1 -> value,
-    the others zero), instead of the fit's."""
+    parameter index of each of them that is the fit's, by index)."""
     layout = res.layout
-    pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True,
-                          fit_gravity=fit_gravity)
+    pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True)
     new = pm.layout.parameters
     old = {_key(p): p.index for p in layout.parameters}
     # the fit's parameters by name, not by place: the calibrated model may carry one the fit's did not
@@ -222,8 +219,6 @@ def evaluate(res, data: dict, extra: Sequence, fit_gravity: bool = False, compli
         # targets and effect values are absolute
         if p.kind not in ("joint_geometry", "tool", "base") and p.index in fit_of:
             x[p.index] = fit_x[fit_of[p.index]]
-        if compliance is not None and p.kind == "compliance":
-            x[p.index] = compliance.get(p.joint, 0.0)
     r, J = pm.residuals(list(x), data, True)
     J = np.asarray(J)
     fixed = np.asarray(res.fixed)
@@ -237,7 +232,7 @@ def fitted_compliance_columns(res, data: dict, spec: "Spec") -> np.ndarray:
     columns are taken at that fit: each joint's deflection under the torques of the fitted moments.
     The deflection is bilinear in the compliances and the moments, so at the fit it lies in the span
     of these columns (the linearisation at zero moments sees no torque at all). Each column scaled to
-    unit norm."""
+    unit norm. (The calibrated model of that fit carries the fitted moments as its masses.)"""
     with_it = spec.with_(JointCompliance("fit")).fit(data)
     _, _, J, new, _ = evaluate(with_it, data, [])
     idx = [p.index for p in new if p.kind == "compliance"]
@@ -295,6 +290,7 @@ class _Linearised:
         self.r_now: Optional[np.ndarray] = None  # the residual after them (unweighted; None: the fit's)
         self.scale: Optional[float] = None  # where the candidates' scores bend (from the residual's spread)
         self.w: Optional[np.ndarray] = None
+        self._stacked: Optional[tuple] = None  # (the fit's columns, them with the added ones)
 
     def raw(self, cand) -> tuple:
         """The unweighted residual, current columns and candidate columns at the fit."""
@@ -321,8 +317,10 @@ class _Linearised:
         r, cur, R = self.raw(cand)
         if self.r_now is not None:
             r = self.r_now
-        if self.added:
-            cur = np.hstack([cur] + self.added)
+        if self.added:  # one array per linearisation: the search's basis of it is made once
+            if self._stacked is None or self._stacked[0] is not cur:
+                self._stacked = (cur, np.hstack([cur] + self.added))
+            cur = self._stacked[1]
         if self.w is None:
             self.w = self._weights(r, cur.shape[1])
         return r * self.w, cur, R
@@ -349,6 +347,7 @@ class _Linearised:
         out = _Linearised.__new__(_Linearised)
         out.__dict__.update(self.__dict__)
         out.added = self.added + [R]
+        out._stacked = None
         out.r_now = r - A @ delta
         out.scale = None  # from the new residual's spread, as the refit's would be
         out.w = None
@@ -522,12 +521,3 @@ def check_data(effects: Sequence, data: dict, robot: Robot) -> None:
             raise ValueError(f"{src}: {e.label} needs the temperature_c column")
         if need == "time_s" and "time_s" not in data:
             raise ValueError(f"{src}: {e.label} needs the time_s column (when each point was measured, s)")
-
-
-def configurations(data: dict) -> int:
-    return grouping.configurations(data).count
-
-
-def rms(e: np.ndarray) -> float:
-    e = np.asarray(e, dtype=float)
-    return math.sqrt(float(np.mean(e ** 2))) if len(e) else math.nan

@@ -315,14 +315,16 @@ def choice_lines(ch: dict) -> list:
     of the geometry beside the chosen model's."""
     lines = [f"effects chosen by the data (--effects auto; {ch['rule']}):"]
     if ch["tried"]:
-        lines.append(f"  {'candidate':<42}{'F':>10}{'p':>10}{'CV gain':>9}{'CV RMS (mm)':>13}")
+        lines.append(f"  {'candidate':<42}{'F':>10}{'p':>10}{'CV gain':>9}{'on ranges':>11}{'CV RMS (mm)':>13}")
         for t in ch["tried"]:
             p = "<1e-16" if t["p_value"] < 1e-16 else f"{t['p_value']:.2g}"
             rms = "-" if t["cv_rms_linear_mm"] is None else f"{t['cv_rms_linear_mm']:.4f}"
-            lines.append(f"  {t['candidate']:<42}{t['F']:>10.3g}{p:>10}{t['cv_gain']:>9.1%}{rms:>13}"
+            ext = "" if t.get("extrapolation_cv_gain") is None else f"{t['extrapolation_cv_gain']:.1%}"
+            lines.append(f"  {t['candidate']:<42}{t['F']:>10.3g}{p:>10}{t['cv_gain']:>9.1%}{ext:>11}{rms:>13}"
                          + (f"   kept (step {t['step']})" if t["kept"] else ""))
         lines.append("  (CV RMS: the model of its round with the candidate, linearised at that round's fit, on the "
-                     "same folds)")
+                     "same folds; on ranges: a periodic effect's gain holding out ranges of its angle, the gain it "
+                     "is credited with when less)")
     for n in ch["notes"]:
         lines.append(f"  note: {n}")
     kept = ", ".join(ch["kept"]) or "none: the geometry alone"
@@ -539,6 +541,7 @@ def _choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val
         for c in h.get("candidates", []):
             label = _label_of(c)
             tried[label] = {"candidate": label, "F": c["F"], "p_value": c["p_value"], "cv_gain": c["cv_gain"],
+                            "extrapolation_cv_gain": c.get("extrapolation_cv_gain"),
                             "cv_rms_linear_mm": c.get("cv_rms_linear_mm"), "parameters": c.get("parameters", 0),
                             "round": i + 1, "kept": False}
     kept = [x.label for x in top.effects]

@@ -286,7 +286,7 @@ class Identification:
                          ", ".join(f"joint {j} {ranges[j - 1][0]:.0f}..{ranges[j - 1][1]:.0f} deg" for j in periodic))
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}"
                      " (what the data determine)")
-        from .tool_frame import tcp_summary_line  # noqa: E402 (tool_frame imports this module)
+        from .tool_frame import tcp_summary_line  # here: tool_frame imports this module
         lines += tcp_summary_line(self.robot)
         if self.fit_info:
             lines += priors.summary_lines(f, self.fit_info, self.worst)

@@ -251,7 +251,10 @@ TEST(Identify, SixDimensionalRowsWithReflectorsKeepTheReflectorsOffsetsInTheTool
   so.targets = kTargets;
   const auto [fit, held] = fit_and_held(truth, so, 33, 34);
   int six_d = 0;
-  for (const auto& row : fit.rows) six_d += row.has_abc, EXPECT_EQ(row.has_abc, row.target == 0);
+  for (const auto& row : fit.rows) {
+    six_d += row.has_abc;
+    EXPECT_EQ(row.has_abc, row.target == 0);
+  }
   ASSERT_EQ(six_d, 200);
   IdentifyOptions opt;
   opt.loss = "none";

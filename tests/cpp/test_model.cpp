@@ -36,6 +36,33 @@ TEST(Model, JsonRoundTripIsExact) {
   EXPECT_EQ(back.calibrated->spec().tool.abc, cal->spec().tool.abc);
 }
 
+TEST(Model, TcpKeyRoundTripsAndWarnsOnlyWhenNominal) {
+  // the model file's top-level "tcp" (where the calibrated tool frame comes from) is read and written
+  // back; only "nominal" gives kincal-compensate's warning; a model without the key says nothing
+  auto nom = std::make_shared<Model>(kr500_spec());
+  for (const std::string tcp : {"nominal", "measured", "tool-targets"}) {
+    ModelSpec s = perturbed_spec(kr500_spec(), 3, 1.0, 0.05, 0.003);
+    s.tcp = tcp;
+    const std::string a = robot_to_json(Robot{nom, std::make_shared<Model>(s)});
+    EXPECT_NE(a.find("\"tcp\": \"" + tcp + "\""), std::string::npos);
+    const Robot back = robot_from_json(a, "m.json");
+    EXPECT_EQ(back.calibrated->spec().tcp, tcp);
+    EXPECT_EQ(robot_to_json(back), a);
+    EXPECT_EQ(tcp_warning(back, "m.json").empty(), tcp != "nominal");
+  }
+  const Robot plain{nom, nom};
+  EXPECT_EQ(robot_to_json(plain).find("\"tcp\""), std::string::npos);
+  EXPECT_EQ(tcp_warning(plain, "kr500"), "");
+  std::string bad = robot_to_json(plain);
+  bad.insert(bad.find('{') + 1, "\"tcp\": \"guessed\",");
+  try {
+    robot_from_json(bad, "bad.json");
+    ADD_FAILURE() << "an unknown tcp accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.json: tcp: \"guessed\" is not one of"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Model, ErrorsNameTheSourceAndCause) {
   try {
     load_robot("kr9000");

@@ -278,7 +278,8 @@ class Identification:
             "condition_number": f.condition_number,
             "observability_index": f.observability_index,
             "correlations": [{"a": a, "b": b, "r": r} for a, b, r in f.correlations],
-            "iterations": f.iterations, "gravity": _gravity.report(f),
+            "iterations": f.iterations, "converged": bool(f.converged), "stop_reason": f.stop_reason,
+            "gravity": _gravity.report(f),
             "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f.rms_mm, "max_mm": f.max_mm,
                     "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
@@ -296,6 +297,11 @@ class Identification:
         lines = [f"identified {int(np.sum(~np.asarray(f.fixed)))} of {f.layout.size} parameters "
                  f"({', '.join(['geometry'] + self.effect_labels())}) in {f.iterations} iterations",
                  _gravity.summary_line(f), ""]
+        if not f.converged:  # the parameters are where the solver stopped, not a least-squares optimum
+            lines[1:1] = [f"did not converge: {f.stop_reason}. The parameters are where the solver stopped, not "
+                          "the best fit: check the held-out figures against the geometry alone, and measure more "
+                          "configurations, identify fewer effects (--effects) or raise the iteration cap "
+                          "(max_iterations)"]
         lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
                      f"{'mean after':>12}{'max before':>12}{'max after':>12}")
         lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}{'-':>12}{'-':>12}"
@@ -413,7 +419,8 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
              fold_progress: Optional[Callable[[int, int], None]] = None,
-             penalties: Sequence = (), hold_out_setups: bool = False, gravity: str = "auto") -> Identification:
+             penalties: Sequence = (), hold_out_setups: bool = False, gravity: str = "auto",
+             max_iterations: int = 100) -> Identification:
     """Identify the robot's parameters from measurements.
 
     ``loss_scale_mm``: where the robust loss bends (None: from the residuals' robust spread).
@@ -433,7 +440,7 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     ``penalties``: ridge penalties (parameter name, weight in mm per unit of the parameter).
     ``hold_out_setups``: the validation holds out each setup (instrument placement) whole instead:
     the model fitted on the other setups, the held setup's placement and targets refitted on it as
-    validate() does."""
+    validate() does. ``max_iterations``: each Levenberg-Marquardt pass's cap (the result says whether it converged)."""
     effects = check_effects(effects, robot, harmonics)
     check_data_for(effects, data, robot)
     if loss not in ("none", "huber", "cauchy"):
@@ -446,7 +453,8 @@ def identify(robot: Robot, data: dict, *, effects=("joint_compliance",), loss: s
     auto = prior_scale is None or prior_scale == "auto"
     opts, cv_opts = (options(effects, loss=loss, loss_scale_mm=loss_scale_mm or 0.0, covariance=cov,
                              orientation_weight=orientation_weight, penalties=penalties, prior_sd=prior_sd,
-                             prior_scale=1.0 if auto else float(prior_scale), gravity=gravity)
+                             prior_scale=1.0 if auto else float(prior_scale), gravity=gravity,
+                             max_iterations=max_iterations)
                      for cov in (True, False))
     fit = priors.Fitter(robot, prior_model, auto_scale=auto, seed=seed)
     every_row = np.ones(len(data["pose"]), dtype=bool)

@@ -381,6 +381,11 @@ void define_identify(py::module_& m) {
                              },
                              "(name a, name b, r) above the threshold")
       .def_property_readonly("termination", [](const PyIdentifyResult& r) { return r.r.termination; })
+      .def_property_readonly("converged", [](const PyIdentifyResult& r) { return r.r.converged; },
+                             "every Levenberg-Marquardt pass stopped on a tolerance (none at its iteration cap)")
+      .def_property_readonly("stop_reason", [](const PyIdentifyResult& r) { return r.r.stop_reason; },
+                             "the solver's reason: termination type and message (of the first pass that did "
+                             "not converge, if one did not)")
       .def(
           "__getitem__",
           [](py::object self, const std::string& key) -> py::object {

@@ -236,7 +236,8 @@ class Identification:
             "condition_number": f.condition_number,
             "observability_index": f.observability_index,
             "correlations": [{"a": a, "b": b, "r": r} for a, b, r in f.correlations],
-            "iterations": f.iterations, "gravity": _gravity.report(f),
+            "iterations": f.iterations, "converged": bool(f.converged), "stop_reason": f.stop_reason,
+            "gravity": _gravity.report(f),
             "fit": {"rows": int(self.validation.get("fit_rows", 0)), "rms_mm": f.rms_mm, "max_mm": f.max_mm,
                     "nominal_rms_mm": f.nominal_rms_mm, "nominal_max_mm": f.nominal_max_mm},
             "validation": self.validation,
@@ -254,6 +255,11 @@ class Identification:
         lines = [f"identified {int(np.sum(~np.asarray(f.fixed)))} of {f.layout.size} parameters "
                  f"({', '.join(['geometry'] + self.effect_labels())}) in {f.iterations} iterations",
                  _gravity.summary_line(f), ""]
+        if not f.converged:  # the parameters are where the solver stopped, not a least-squares optimum
+            lines[1:1] = [f"did not converge: {f.stop_reason}. The parameters are where the solver stopped, not "
+                          "the best fit: check the held-out figures against the geometry alone, and measure more "
+                          "configurations, identify fewer effects (--effects) or raise the iteration cap "
+                          "(--max-iterations)"]
         lines.append(f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
                      f"{'mean after':>12}{'max before':>12}{'max after':>12}")
         lines.append(f"{'fitted poses':<28}{f.nominal_rms_mm:>12.4f}{f.rms_mm:>12.4f}{'-':>12}{'-':>12}"
@@ -450,7 +456,8 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
     ``penalties``: ridge penalties (parameter name, weight in mm per unit of the parameter).
     ``hold_out_setups``: the validation holds out each setup (instrument placement) whole instead:
     the model fitted on the other setups, the held setup's placement and targets refitted on it as
-    validate() does."""
+    validate() does. ``max_iterations``: each Levenberg-Marquardt pass's cap (the result says whether it
+    converged)."""
     fit = _fit_options(fit, loss=loss, loss_scale_mm=loss_scale_mm, prior_sd=prior_sd, prior_scale=prior_scale,
                        prior_model=prior_model, gravity=gravity, orientation_weight=orientation_weight,
                        max_iterations=max_iterations)

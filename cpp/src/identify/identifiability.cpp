@@ -218,6 +218,45 @@ void at_prior(const Linearization& lin, const IdentifyResult& generic, const std
   }
 }
 
+/// With the gravity fitted, at the moments the data show (xs): a free compliance is seen only through
+/// compliance x moment of the links from its joint on, and its ratio to the held one only as far as
+/// the held joint's torque shows those moments apart. Where the poses leave that ratio undetermined
+/// (its linearized estimate with every free parameter less than 3 standard deviations from zero) the
+/// points still see the product, but the solve would crawl along the valley compliance x moment =
+/// const, out to a huge compliance on a vanishing moment (hundreds of iterations, a worse prediction):
+/// the compliance is held at the held one's value instead (the moments carry the product).
+void hold_undetermined_ratios(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt,
+                              IdentifyResult& res, const std::vector<double>& xs) {
+  const ParamLayout& L = res.layout;
+  const Linearization lin = linearize(pm, data, xs, opt.orientation_weight);
+  std::vector<int> cols;
+  for (int i = 0; i < L.size; ++i)
+    if (!res.fixed[i]) cols.push_back(i);
+  Eigen::MatrixXd A(lin.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
+  Eigen::VectorXd nrm(A.cols());
+  for (size_t c = 0; c < cols.size(); ++c) {
+    nrm[c] = lin.jacobian.col(cols[c]).norm();
+    A.col(c) = lin.jacobian.col(cols[c]) / (nrm[c] > 0 ? nrm[c] : 1.0);
+  }
+  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  const Eigen::VectorXd step = -cod.solve(r);
+  const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
+  const double s2 = (r + A * step).squaredNorm() / dofres;
+  const Eigen::MatrixXd cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  for (size_t c = 0; c < cols.size(); ++c) {
+    const int i = cols[c];
+    if (i < L.compliance || i >= L.moments || !(nrm[c] > 0)) continue;
+    const double est = xs[i] + step[c] / nrm[c], sd = std::sqrt(std::max(0.0, cov(c, c))) / nrm[c];
+    if (std::abs(est) >= 3 * sd) continue;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "its ratio to the held compliance not determined by these poses (%.2g +- %.2g "
+                  "deg/kNm): held at the held one's value", est, sd);
+    res.start[i] = xs[i];
+    res.fix(i, buf);
+  }
+}
+
 /// With the gravity fitted: the moments the data show at x (one Gauss-Newton step of every free
 /// parameter but the compliances, each of those at the held one's value: the moments are linear
 /// then), and, as fix_unloaded_compliances does with masses, the compliance of a joint whose torque
@@ -292,7 +331,22 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
     res.fix(c, buf);
     xs[c] = x[c];
   }
+  if (seen > 0) hold_undetermined_ratios(pm, data, opt, res, xs);
   return xs;
+}
+
+/// With the gravity fitted, the solve starts where the columns were judged (xp: the moments the data
+/// show, every free compliance at the held one's value) rather than at zero moments, where no
+/// compliance has an effect and the bilinear compliance x moment problem is at its saddle; what the
+/// analysis held keeps its start value. x becomes that start; returns the data's linearization there.
+Linearization start_at(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, const IdentifyResult& res,
+                       std::vector<double> xp, std::vector<double>& x, const Linearization& lin_xp) {
+  if (xp == x) return lin_xp;
+  const ParamLayout& L = res.layout;
+  for (int i = 0; i < L.size; ++i)  // a compliance held at the held one's value: its start (hold_undetermined_ratios)
+    if (res.fixed[i]) xp[i] = i >= L.compliance && i < L.moments ? res.start[i] : x[i];
+  x = xp;
+  return linearize(pm, data, x, opt.orientation_weight);
 }
 
 }  // namespace
@@ -346,7 +400,7 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
 }
 
 Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
-                                 const std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
+                                 std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
                                  const std::vector<double>& prior_sd) {
   const ParamLayout& L = res.layout;
   // penalised parameters (a ridge determines them where the data do not) are left out of the
@@ -359,7 +413,7 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
   }
   // what the generic campaign determines but the data do not means the data are too few or too alike
   // with the gravity fitted, judged at the moments the data show (fitted_moments)
-  const std::vector<double> xp = res.layout.fit_gravity ? fitted_moments(pm, data, x, opt, res) : x;
+  std::vector<double> xp = res.layout.fit_gravity ? fitted_moments(pm, data, x, opt, res) : x;
   IdentifyResult generic = res;
   select_independent(linearize(pm, generic_campaign(nominal, data), xp, opt.orientation_weight).jacobian, order, opt,
                      generic);
@@ -367,11 +421,10 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
   res.at_prior.assign(L.size, false);
   if (std::any_of(prior_sd.begin(), prior_sd.end(), [](double s) { return std::isfinite(s); })) {
     at_prior(lin, generic, order, opt, prior_sd, res);
-    if (xp != x) lin = linearize(pm, data, x, opt.orientation_weight);
-    return lin;
+    return start_at(pm, data, opt, res, xp, x, lin);
   }
   select_independent(lin.jacobian, order, opt, res);
-  if (xp != x) lin = linearize(pm, data, x, opt.orientation_weight);
+  lin = start_at(pm, data, opt, res, xp, x, lin);
   std::string missing;
   int n_missing = 0;
   // only what the data make exactly redundant counts (near the weak threshold the two may differ)

@@ -410,6 +410,29 @@ class Stage2 {
     kincal::solve(*problem_, *all_, loss_.get(), opt_, summary, Report::progress, terms);
     if (first_) initial_cost = summary.initial_cost, first_ = false;
     iterations += static_cast<int>(summary.iterations.size()) - 1;
+    ++passes_;
+    // the first pass that did not converge is what the result reports (a later one converging from
+    // a point it left unfinished does not make the whole fit converged)
+    if (!unconverged_.empty()) return;
+    if (summary.termination_type != ceres::CONVERGENCE) {
+      unconverged_pass_ = passes_;
+      unconverged_ = ceres::TerminationTypeToString(summary.termination_type);
+      max_iterations_ = opt_.max_iterations;
+      message_ = summary.message;
+    }
+  }
+  /// Every pass converged; the reason of the final pass or of the first one that did not (n: the
+  /// number of passes run).
+  bool converged() const { return passes_ > 0 && unconverged_.empty(); }
+  std::string stop_reason() const {
+    if (converged()) return std::string(ceres::TerminationTypeToString(summary.termination_type)) + ": " + summary.message;
+    if (passes_ == 0) return "NO_CONVERGENCE: no solve ran";
+    std::string which = passes_ > 1 ? "pass " + std::to_string(unconverged_pass_) + " of " + std::to_string(passes_) : "the fit";
+    const bool cap = unconverged_ == std::string("NO_CONVERGENCE") &&
+                     message_.find("Maximum number of iterations") != std::string::npos;
+    if (cap) return unconverged_ + ": " + which + " stopped at its cap of " + std::to_string(max_iterations_) +
+                    " iterations (" + message_ + ")";
+    return unconverged_ + ": " + which + " stopped: " + message_;
   }
   /// The robust noise of the residuals at the solution, p parameters determined by the data.
   double noise(size_t p) {
@@ -440,6 +463,8 @@ class Stage2 {
   std::vector<int> free_;
   double scale_ = 0;
   bool first_ = true;
+  int passes_ = 0, unconverged_pass_ = 0, max_iterations_ = 0;
+  std::string unconverged_, message_;  // the first pass that did not converge: its termination, message
 };
 
 }  // namespace
@@ -495,6 +520,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   res.initial_cost = s2.initial_cost;
   res.final_cost = s2.summary.final_cost;
   res.termination = s2.summary.BriefReport();
+  res.converged = s2.converged();
+  res.stop_reason = s2.stop_reason();
   store_solution(pm, nominal, data, x, res);
   observability(pm, data, opt, res);
   if (s2.free() == free_idx) covariance(s2.problem(), s2.rows(), s2.summary, free_idx, opt, res);

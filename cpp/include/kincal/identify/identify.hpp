@@ -87,7 +87,14 @@ struct IdentifyResult {
     double r;
   };
   std::vector<Correlation> correlations;
-  std::string termination;
+  std::string termination;                ///< Ceres's brief report of the final stage-2 pass
+  /// whether the fit converged: every stage-2 pass stopped on a Ceres tolerance (CONVERGENCE), none
+  /// at its iteration cap (NO_CONVERGENCE) or on a failure
+  bool converged = false;
+  /// why it stopped: the Ceres termination type and message of the final pass, or of the first pass
+  /// that did not converge (which pass of how many, e.g. "NO_CONVERGENCE: robust pass 1 of 2 stopped
+  /// at its cap of 100 iterations (Maximum number of iterations reached. ...)")
+  std::string stop_reason;
   /// Hold parameter i at its start value, for that reason.
   void fix(int i, std::string reason) {
     fixed[i] = true;

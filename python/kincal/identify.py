@@ -539,14 +539,18 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
 
 
 def _choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val: dict) -> dict:
-    """What `--effects auto` tried and kept: every candidate with its F-test, its linear
-    cross-validated gain and RMS where it was last scored (kept: the step that took it), how many of
+    """What `--effects auto` tried and kept: each candidate with its F-test, its linear
+    cross-validated gain and RMS in the last round (kept: in the step that took it), how many of
     the validation's training folds kept each effect, and the held-out RMS of the starting model
     (the geometry) beside the chosen one's."""
     tried: dict = {}
+    kept_labels = {x.label for x in top.effects}
+    last = len(top.search.history) - 1
     for i, h in enumerate(top.search.history):
         for c in h.get("candidates", []):
             label = _label_of(c)
+            if i < last and label not in kept_labels:
+                continue  # as the last round scored it (one scored early and covered since is not listed)
             tried[label] = {"candidate": label, "F": c["F"], "p_value": c["p_value"], "cv_gain": c["cv_gain"],
                             "extrapolation_cv_gain": c.get("extrapolation_cv_gain"),
                             "cv_rms_linear_mm": c.get("cv_rms_linear_mm"), "parameters": c.get("parameters", 0),

@@ -218,6 +218,31 @@ void at_prior(const Linearization& lin, const IdentifyResult& generic, const std
   }
 }
 
+/// One Gauss-Newton step of the columns `cols` of a linearization, each column scaled to unit norm:
+/// the step (scaled units: divide by `nrm` for the parameters'), the columns' norms and the step's
+/// covariance (the residual's variance after the step times the pseudo-inverse of the normal matrix).
+struct ScaledStep {
+  Eigen::VectorXd step, nrm;
+  Eigen::MatrixXd cov;
+};
+
+ScaledStep scaled_step(const Linearization& lin, const std::vector<int>& cols) {
+  Eigen::MatrixXd A(lin.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
+  ScaledStep g;
+  g.nrm.resize(A.cols());
+  for (size_t c = 0; c < cols.size(); ++c) {
+    g.nrm[c] = lin.jacobian.col(cols[c]).norm();
+    A.col(c) = lin.jacobian.col(cols[c]) / (g.nrm[c] > 0 ? g.nrm[c] : 1.0);
+  }
+  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  g.step = -cod.solve(r);
+  const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
+  const double s2 = (r + A * g.step).squaredNorm() / dofres;
+  g.cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  return g;
+}
+
 /// With the gravity fitted, at the moments the data show (xs): a free compliance is seen only through
 /// compliance x moment of the links from its joint on, and its ratio to the held one only as far as
 /// the held joint's torque shows those moments apart. Where the poses leave that ratio undetermined
@@ -232,18 +257,9 @@ void hold_undetermined_ratios(PointModel& pm, const MeasurementSet& data, const 
   std::vector<int> cols;
   for (int i = 0; i < L.size; ++i)
     if (!res.fixed[i]) cols.push_back(i);
-  Eigen::MatrixXd A(lin.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
-  Eigen::VectorXd nrm(A.cols());
-  for (size_t c = 0; c < cols.size(); ++c) {
-    nrm[c] = lin.jacobian.col(cols[c]).norm();
-    A.col(c) = lin.jacobian.col(cols[c]) / (nrm[c] > 0 ? nrm[c] : 1.0);
-  }
-  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
-  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
-  const Eigen::VectorXd step = -cod.solve(r);
-  const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
-  const double s2 = (r + A * step).squaredNorm() / dofres;
-  const Eigen::MatrixXd cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  const ScaledStep g = scaled_step(lin, cols);
+  const Eigen::VectorXd &step = g.step, &nrm = g.nrm;
+  const Eigen::MatrixXd& cov = g.cov;
   for (size_t c = 0; c < cols.size(); ++c) {
     const int i = cols[c];
     if (i < L.compliance || i >= L.moments || !(nrm[c] > 0)) continue;
@@ -272,21 +288,12 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
   std::vector<int> cols;
   for (int i = 0; i < L.size; ++i)
     if (!res.fixed[i] && (i < L.compliance || i >= L.moments)) cols.push_back(i);
-  Eigen::MatrixXd A(lin.jacobian.rows(), static_cast<Eigen::Index>(cols.size()));
-  Eigen::VectorXd nrm(A.cols());
-  for (size_t c = 0; c < cols.size(); ++c) {
-    nrm[c] = lin.jacobian.col(cols[c]).norm();
-    A.col(c) = lin.jacobian.col(cols[c]) / (nrm[c] > 0 ? nrm[c] : 1.0);
-  }
-  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(lin.residuals.data(), A.rows());
-  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
-  const Eigen::VectorXd step = -cod.solve(r);
   // a link's pair of moments is seen when it stands out of its noise: chi-square (2 degrees of
   // freedom) of the pair with the step's covariance above its 99% quantile; the others are held at
   // zero (the bilinear form is flat along a compliance whose moments vanish)
-  const double dofres = std::max<double>(1.0, static_cast<double>(A.rows() - cod.rank()));
-  const double s2 = (r + A * step).squaredNorm() / dofres;
-  const Eigen::MatrixXd cov = s2 * (A.transpose() * A).completeOrthogonalDecomposition().pseudoInverse();
+  const ScaledStep g = scaled_step(lin, cols);
+  const Eigen::VectorXd &step = g.step, &nrm = g.nrm;
+  const Eigen::MatrixXd& cov = g.cov;
   int seen = 0;
   for (size_t c = 0; c + 1 < cols.size(); ++c) {
     const int i = cols[c];

@@ -53,7 +53,7 @@ def test_a_fit_stopped_at_its_cap_says_so(robots):
     assert r.fit.stop_reason.startswith("NO_CONVERGENCE") and "cap of 2 iterations" in r.fit.stop_reason
     lines = r.summary().splitlines()
     flagged = [ln for ln in lines if ln.startswith("did not converge: ")]
-    assert len(flagged) == 1 and "NO_CONVERGENCE" in flagged[0] and "max_iterations" in flagged[0]
+    assert len(flagged) == 1 and "NO_CONVERGENCE" in flagged[0] and "--max-iterations" in flagged[0]
     doc = json.loads(r.model_json())["identification"]
     assert doc["converged"] is False and doc["stop_reason"] == r.fit.stop_reason
 

@@ -6,12 +6,13 @@ refitting only the tracker placement and the probe offset.
 
 Issue 29 asks for A <= 0.46, C <= 0.56, D <= 0.38 mm (3-D RMS; 5% better than the better start of
 the session before: geometry 0.512 / 0.591 / 0.449, compliance 0.482 / 0.675 / 0.398). Measured on
-2026-11-25: A 0.463, C 0.500, D 0.384 mm: C met, A and D NOT met (by 0.003 and 0.004 mm). The
-diagnosis names joint compliance (every loaded joint, the model's masses) and a smooth joint_map of
-joint 1 (order 6, chosen holding out ranges of joint 1's angle). This test holds that ground: each
-series within 2% of those figures and far below the nominal model, the effects named, and the warning
-where a series leaves the angles they were fitted on (C runs joint 1 at -308..-180 deg, B at
--180..-45)."""
+2026-11-25: A 0.495, C 0.509, D 0.406 mm: C met, A and D NOT met (with --loss-scale 0.1: 0.463,
+0.500, 0.384; BENCHMARKS.md says why the data's bend stays the default). The diagnosis names joint
+compliance (every loaded joint, the model's masses) and a smooth joint_map of joint 1 (order 6), a
+periodic effect credited with what it gains on held-out ranges of its angle. This test holds that
+ground: each series within 2% of those figures and far below the nominal model, the effects named,
+and the warning where a series leaves the angles they were fitted on (C runs joint 1 at -308..-180
+deg, B at -180..-45)."""
 
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ BASE = SHARED / "data" / "ipa-robot-accuracy"
 FILES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",
          "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
 #: the 3-D RMS (mm) this path measured on 2026-11-25
-MEASURED = {"A": 0.463, "C": 0.500, "D": 0.384}
+MEASURED = {"A": 0.495, "C": 0.509, "D": 0.406}
 
 
 def test_ur10_diagnose_on_b_validate_on_the_others(tmp_path):

@@ -53,7 +53,8 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
     and cosine amplitudes and backlash's offset per direction sign, 1/degC for thermal_expansion about
     t_ref). Every row gets dir1..dirN and
     temperature_c (drifting from 18 to 30 C over the campaign). With ``orientation_noise_deg`` the
-    tool frame's orientation is measured too (a 6-D probe): columns a, b, c. With ``duration_h`` the
+    first target's rows are 6-D (a probe measuring the tool frame moved by that target's offset:
+    columns a, b, c), the other targets' stay reflector rows. With ``duration_h`` the
     rows get time_s, the campaign running from 0 to that many hours in pose order; a hidden drift
     (mm/h and rad/h) without it gets a 3 h campaign, the drift centred on its mean time."""
     if poses < 1:
@@ -373,8 +374,10 @@ def _errors(r: "_core.IdentifyResult", h: dict) -> dict:
     nominal geometry, frames fitted) and after (the identified model r)."""
     out = {"ea": _core.point_errors(r.robot, r.targets, h), "eb": _core.point_errors(r.nominal_fitted,
                                                                                      r.nominal_targets, h)}
-    if "abc" in h:
-        out.update(oa=orientation_errors_deg(r.robot, h), ob=orientation_errors_deg(r.nominal_fitted, h))
+    if "abc" in h:  # the 6-D rows only (a mixed file's reflector rows have none)
+        oa = orientation_errors_deg(r.robot, h)
+        if len(oa):
+            out.update(oa=oa, ob=orientation_errors_deg(r.nominal_fitted, h))
     return out
 
 
@@ -401,7 +404,8 @@ def _fold_errors(model_of: Callable, data: dict, held_masks, progress: Optional[
         if choice is not None:  # the starting model fitted on the same rows: its held-out figure, for free
             part["e0"] = effect_choice.point_errors(effect_choice.start_fit(choice), subset(data, held))
         parts.append(part)
-    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}, choices
+    keys = dict.fromkeys(k for p in parts for k in p)  # a fold of reflector rows only has no orientation
+    return {k: np.concatenate([p[k] for p in parts if k in p]) for k in keys}, choices
 
 
 def _setup_refit(loss: str, loss_scale_mm: float) -> Callable:

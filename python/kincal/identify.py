@@ -341,8 +341,10 @@ def choice_lines(ch: dict) -> list:
         folds = f" (chosen again in each of the {ch['folds']} training folds: {per or 'none kept in any'})"
     lines.append(f"  kept: {kept}{folds}")
     if ch.get("start_cv_rms_mm") is not None and ch.get("chosen_cv_rms_mm") is not None:
+        how = ("nested: the choice made inside each training fold" if ch["nested"] else
+               "the choice made on the fitted rows only")
         lines.append(f"  held-out RMS: geometry alone {ch['start_cv_rms_mm']:.4f} mm, the chosen model "
-                     f"{ch['chosen_cv_rms_mm']:.4f} mm (nested: the choice made inside each training fold)")
+                     f"{ch['chosen_cv_rms_mm']:.4f} mm ({how})")
     return lines
 
 

@@ -12,10 +12,12 @@ report an honest figure, makes the same choice again inside every training fold 
 and confirming the cross-validated RMS at every step, then scores what remains against every
 variable.
 
-Joint compliance is a candidate in the form ``--gravity`` gives: per joint with the model's link
-masses (``masses``, or ``auto`` on a model that has masses), or as one candidate for every
-gravity-loaded joint with the torques' mass moments fitted (``fit``, or ``auto`` without masses:
-its columns are those of every compliance x moment product, the linearisation of the fitted torque).
+Joint compliance is one candidate for every gravity-loaded joint (JointCompliance), in the form
+``--gravity`` gives: the torques from the model's link masses (``masses``, or ``auto`` on a model
+that has masses), or from mass moments fitted with it (``fit``, or ``auto`` without masses: its
+columns are the compliance columns at its own fit, where the bilinear deflection lies in their span).
+A periodic effect of a joint angle is credited with the smaller of its gain and its gain on held-out
+ranges of that angle. Candidates are scored on the robust pseudo-residual (robust_weights).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ MAX_MAP_ORDER = 8
 MAP_SMOOTHING = (1e-1, 1e-2, 1e-3)
 #: joint_map's variant (order, smoothing) is chosen leaving out each of this many ranges of its angle
 VARIANT_BLOCKS = 5
-#: periodic errors of a joint angle: scored holding out ranges of that angle (SerialProblem.score_folds)
+#: periodic errors of a joint angle: also scored holding out ranges of that angle (SerialProblem.score_folds)
 PERIODIC = ("transmission_error", "joint_map")
 #: the significance rule of a step (the diagnosis's): F-test p below ALPHA and a linear
 #: cross-validated gain above MIN_GAIN

@@ -108,7 +108,7 @@ def test_named_effect_reaches_the_robot(tmp_path, kind, case):
     poses = kincal.fk(geometry_truth, _path(robot), frame="instrument")
     _write_csv(tmp_path / "path.csv", ["x", "y", "z", "a", "b", "c"], poses)
     r = run("kincal", "identify", "--robot", robot_arg, "--data", str(tmp_path / "m.csv"), "--out",
-            str(tmp_path / "ident.json"), "--tool-targets", str(tmp_path / "t.csv"))
+            str(tmp_path / "ident.json"), "--tool-targets", str(tmp_path / "t.csv"), "--effects", "joint_compliance")
     assert r.returncode == 0, r.stderr
     e_diag = _program_error(truth, model, tmp_path / "path.csv", tmp_path, "diag")
     e_ident = _program_error(truth, tmp_path / "ident.json", tmp_path / "path.csv", tmp_path, "ident")

@@ -368,6 +368,8 @@ class SerialProblem:
         self.fits: list = []
         self.dims = 6 if "abc" in data else 3
         self.point_dims = 3
+        #: a residual below this (mm per coordinate) is the computation's, not the data's: noise-free data
+        self.resolution = 1e-6
 
     def spec(self, effects: Sequence) -> Spec:
         pen = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]

@@ -232,12 +232,14 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
     variants = getattr(problem, "variants", None)
     covered = getattr(problem, "covered", None)
     score_folds = getattr(problem, "score_folds", None)
+    r_floor = getattr(problem, "resolution", None)  # a residual below it (per coordinate) explains nothing
     admits = getattr(problem, "admits", None)
     chosen = getattr(problem, "chosen", None)
     for _ in range(max_steps):
         if regressors is None:
             regressors = problem.linearise(effects)
         scored = []
+        r_rms = None
         basis: tuple = (None, None)  # the current model's columns and their orthonormal basis
         for c in candidates:
             if any(e.name == c.name and e.joint == c.joint for e in effects):
@@ -245,6 +247,8 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             if admits and not admits(effects, c):  # more parameters than the data can fit
                 continue
             r, Jc, R = regressors(c)
+            if r_rms is None:
+                r_rms = float(np.sqrt(np.mean(np.asarray(r) ** 2))) if len(r) else 0.0
             if basis[0] is not Jc:
                 basis = (Jc, _basis(Jc))
             order: dict = {}
@@ -278,6 +282,8 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
         history[-1]["candidates"] = [{k: v for k, v in s.items() if not k.startswith(("_", "variant"))}
                                      for s in scored[:listed]]
         sig = [s for s in scored if s["p_value"] < alpha and _credited(s) > min_gain]
+        if r_floor is not None and r_rms is not None and r_rms < r_floor:
+            sig = []  # nothing left to explain: the residual is at the computation's resolution (noise-free data)
         if not sig:
             break
         best = sig[0]

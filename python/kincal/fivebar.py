@@ -9,7 +9,6 @@ and the nonlinear fit run in the C++ core; the minimax fit is a sequence of line
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path

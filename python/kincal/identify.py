@@ -18,70 +18,18 @@ import numpy as np
 from . import _core, effect_choice, gravity as _gravity, grouping, priors
 from . import strict_json
 from ._core import Robot
+from .choice_report import choice_lines, choice_report
 from .effect_choice import applicable_joints, check_data as check_data_for  # noqa: F401  (as before)
 from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, options, subset  # noqa: F401  (options: as before)
 from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
 from .setups import _refit_placements, _rms, validate  # noqa: F401  (kincal.identify.validate, as before)
+from .simulation import (DEFAULT_HARMONICS, DEFAULT_INSTRUMENT, DEFAULT_TARGETS,  # noqa: F401  (as before)
+                         default_truth, parse_hidden_effect, simulate)
 
-#: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
-DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
-#: where the simulated laser tracker sees the robot base: x, y, z (mm), a, b, c (deg)
-DEFAULT_INSTRUMENT = (3500.0, -1500.0, -400.0, 35.0, 1.5, -0.8)
-#: harmonic orders of transmission_error unless --harmonics says otherwise
-DEFAULT_HARMONICS = (1, 2)
 #: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
 DEFAULT_MAP_ORDER = 4
 #: folds of whole configurations on which `--effects auto` scores its candidates (inside each training set)
 CHOICE_FOLDS = 5
-
-
-def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
-                  compliance: float = 0.003) -> Robot:
-    """A simulated true robot: realistic geometric errors and joint compliance, seen by an
-    instrument at DEFAULT_INSTRUMENT."""
-    return robot.with_calibrated(seed, sigma_mm, sigma_deg, compliance, DEFAULT_INSTRUMENT)
-
-
-def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
-             outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence = (),
-             t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None,
-             duration_h: Optional[float] = None) -> dict:
-    """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
-    model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
-    ``effects`` hides more effects in the truth: (Effect, values) or (name, joint from 1 or 0, values),
-    the values in the registry's core units (``Effect.units``: radians for transmission_error's sine
-    and cosine amplitudes and backlash's offset per direction sign, 1/degC for thermal_expansion about
-    t_ref). Every row gets dir1..dirN and
-    temperature_c (drifting from 18 to 30 C over the campaign). With ``orientation_noise_deg`` the
-    first target's rows are 6-D (a probe measuring the tool frame moved by that target's offset:
-    columns a, b, c), the other targets' stay reflector rows. With ``duration_h`` the
-    rows get time_s, the campaign running from 0 to that many hours in pose order; a hidden drift
-    (mm/h and rad/h) without it gets a 3 h campaign, the drift centred on its mean time."""
-    if poses < 1:
-        raise ValueError(f"the number of poses must be positive, not {poses}")
-    if not 1 <= targets <= len(DEFAULT_TARGETS):
-        raise ValueError(f"--targets must be 1..{len(DEFAULT_TARGETS)}, not {targets}")
-    if noise_mm < 0 or not math.isfinite(noise_mm):
-        raise ValueError(f"the noise must be a finite non-negative number, not {noise_mm}")
-    if not 0.0 <= outlier_fraction <= 1.0:
-        raise ValueError(f"the outlier fraction must be in 0..1, not {outlier_fraction}")
-    if duration_h is not None and not (duration_h > 0 and math.isfinite(duration_h)):
-        raise ValueError(f"the campaign's duration must be a positive number of hours, not {duration_h}")
-    return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets], 0.9,
-                          [_effect_value(e) for e in effects], t_ref,
-                          -1.0 if orientation_noise_deg is None else float(orientation_noise_deg),
-                          0.0 if duration_h is None else 3600.0 * float(duration_h))
-
-
-def _effect_value(e: Sequence) -> tuple:
-    """(Effect, values) from (Effect, values) or (name, joint from 1 or 0, values)."""
-    if len(e) == 2 and isinstance(e[0], _core.Effect):
-        return e[0], [float(v) for v in e[1]]
-    name, joint, vals = e
-    vals = [float(v) for v in vals]
-    if name == "joint_map":  # its order from the number of values: a sine and a cosine per order
-        return _core.Effect("joint_map", int(joint), order=max(1, len(vals) // 2)), vals
-    return _core.Effect(str(name), int(joint)), vals
 
 
 def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS,
@@ -139,39 +87,6 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
             if e not in out:
                 out.append(e)
     return out
-
-
-def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> tuple:
-    """NAME:JOINT:V1,V2.. of `kincal simulate --hide`: (Effect, values in core units). The values are
-    in the model file's units (degrees for angles, 1/C for thermal_expansion: joint 0); their number
-    comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order;
-    joint_map: its order is half their number)."""
-    parts = text.split(":")
-    if len(parts) != 3:
-        raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
-    name, joint, vals = parts[0], parts[1], parts[2]
-    kinds = [k for k in _core.effect_kinds() if k.domain == "serial" and k.name != "joint_compliance"]
-    kind = next((k for k in kinds if k.name == name), None)
-    if kind is None:
-        raise ValueError(f"--hide {text}: unknown effect '{name}' ({', '.join(k.name for k in kinds)})")
-    try:
-        j = int(joint)
-        v = [float(x) for x in vals.split(",")]
-    except ValueError:
-        raise ValueError(f"--hide {text}: joint and values must be numbers") from None
-    if kind.concerns == "joint" and not 1 <= j <= dof:
-        raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
-    if name == "joint_map":
-        if len(v) < 2 or len(v) % 2 or len(v) > 128:
-            raise ValueError(f"--hide {text}: joint_map takes a sine and a cosine amplitude (deg) per order "
-                             "1..K: an even number of values, 2 to 128")
-        e = _core.Effect(name, j, order=len(v) // 2)
-    else:
-        e = _core.Effect(name, j if kind.concerns == "joint" else 0, list(harmonics))
-    if len(v) != e.size or not all(math.isfinite(x) for x in v):
-        raise ValueError(f"--hide {text}: {e.label} takes {e.size} finite value(s) "
-                         f"({', '.join(f'{n} ({u})' for n, u in zip(e.parameter_names, e.file_units))})")
-    return e, [x / sc for x, sc in zip(v, e.file_scale)]
 
 
 def read_measurements(path: str, robot: Robot) -> dict:
@@ -314,38 +229,6 @@ class Identification:
                 sd = "" if p["stddev"] is None else f" +- {p['stddev']:.3g}"
                 lines.append(f"  {p['name']:<22} {p['value']:+.6g}{sd} {p['unit']}")
         return "\n".join(lines)
-
-
-def choice_lines(ch: dict) -> list:
-    """The summary's lines on `--effects auto`: every candidate tried, with its test and its
-    cross-validated RMS, what was kept, how often the training folds kept it, and the held-out RMS
-    of the geometry beside the chosen model's."""
-    lines = [f"effects chosen by the data (--effects auto; {ch['rule']}):"]
-    if ch["tried"]:
-        lines.append(f"  {'candidate':<42}{'F':>10}{'p':>10}{'CV gain':>9}{'on ranges':>11}{'CV RMS (mm)':>13}")
-        for t in ch["tried"]:
-            p = "<1e-16" if t["p_value"] < 1e-16 else f"{t['p_value']:.2g}"
-            rms = "-" if t["cv_rms_linear_mm"] is None else f"{t['cv_rms_linear_mm']:.4f}"
-            ext = "" if t.get("extrapolation_cv_gain") is None else f"{t['extrapolation_cv_gain']:.1%}"
-            lines.append(f"  {t['candidate']:<42}{t['F']:>10.3g}{p:>10}{t['cv_gain']:>9.1%}{ext:>11}{rms:>13}"
-                         + (f"   kept (step {t['step']})" if t["kept"] else ""))
-        lines.append("  (CV RMS: the model of its round with the candidate, linearised at that round's fit, on the "
-                     "same folds; on ranges: a periodic effect's gain holding out ranges of its angle, the gain it "
-                     "is credited with when less)")
-    for n in ch["notes"]:
-        lines.append(f"  note: {n}")
-    kept = ", ".join(ch["kept"]) or "none: the geometry alone"
-    folds = ""
-    if ch["folds"]:
-        per = ", ".join(f"{k} in {v}" for k, v in ch["folds_kept"].items())
-        folds = f" (chosen again in each of the {ch['folds']} training folds: {per or 'none kept in any'})"
-    lines.append(f"  kept: {kept}{folds}")
-    if ch.get("start_cv_rms_mm") is not None and ch.get("chosen_cv_rms_mm") is not None:
-        how = ("nested: the choice made inside each training fold" if ch["nested"] else
-               "the choice made on the fitted rows only")
-        lines.append(f"  held-out RMS: geometry alone {ch['start_cv_rms_mm']:.4f} mm, the chosen model "
-                     f"{ch['chosen_cv_rms_mm']:.4f} mm ({how})")
-    return lines
 
 
 def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
@@ -537,58 +420,11 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
     info = priors.report(r, fit.loss, fit.loss_scale_mm, choice)
     info["priors"]["centred_on"] = "the prior model's calibrated geometry" if fit.prior_model else "the starting model"
     if top is not None:
-        info["effect_choice"] = _choice_report(top, fold_choices, e, val)
+        info["effect_choice"] = choice_report(top, fold_choices, e, val, CHOICE_FOLDS)
     # the model records the angles its fit saw: where its periodic effects were measured
     calibrated = r.robot.with_fitted_ranges(_core.joint_ranges(data["q_deg"][fit_mask]))
     return Identification(robot=calibrated, targets=np.asarray(r.targets), fit=r, effects=list(core_effects),
                           validation=val, fit_info=info, worst=priors.down_weighted(r, train))
-
-
-def _choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val: dict) -> dict:
-    """What `--effects auto` tried and kept: each candidate with its F-test, its linear
-    cross-validated gain and RMS in the last round (kept: in the step that took it), how many of
-    the validation's training folds kept each effect, and the held-out RMS of the starting model
-    (the geometry) beside the chosen one's."""
-    tried: dict = {}
-    kept_labels = {x.label for x in top.effects}
-    last = len(top.search.history) - 1
-    for i, h in enumerate(top.search.history):
-        for c in h.get("candidates", []):
-            label = _label_of(c)
-            if i < last and label not in kept_labels:
-                continue  # as the last round scored it (one scored early and covered since is not listed)
-            tried[label] = {"candidate": label, "F": c["F"], "p_value": c["p_value"], "cv_gain": c["cv_gain"],
-                            "extrapolation_cv_gain": c.get("extrapolation_cv_gain"),
-                            "cv_rms_linear_mm": c.get("cv_rms_linear_mm"), "parameters": c.get("parameters", 0),
-                            "round": i + 1, "kept": False}
-    kept = [x.label for x in top.effects]
-    for k, label in enumerate(kept):
-        if label in tried:
-            tried[label]["kept"] = True
-            tried[label]["step"] = k + 1
-    counts: dict = {}
-    for ch in fold_choices:
-        for x in (ch.effects if ch is not None else []):
-            counts[x.label] = counts.get(x.label, 0) + 1
-    out = {"mode": "auto", "rule": f"F-test p < {effect_choice.ALPHA:g} and linear cross-validated gain > "
-                                   f"{effect_choice.MIN_GAIN:.0%} (the diagnosis's), on {CHOICE_FOLDS} folds of "
-                                   "whole configurations",
-           "kept": kept, "tried": sorted(tried.values(), key=lambda t: (not t["kept"], t.get("step", 0), -t["cv_gain"])),
-           "notes": list(top.notes), "nested": bool(fold_choices),
-           "folds_kept": counts, "folds": len(fold_choices)}
-    if "e0" in e:
-        out["start_cv_rms_mm"] = _rms(e["e0"])
-        out["chosen_cv_rms_mm"] = val.get("after_rms_mm")
-    return out
-
-
-def _label_of(c: dict) -> str:
-    """A scored candidate's label (as _core.Effect.label names it)."""
-    if c.get("gravity"):
-        return effect_choice.JointCompliance(c["gravity"]).label
-    if c["effect"] == "joint_map":
-        return _core.Effect("joint_map", c["joint"], order=c["order"]).label
-    return _core.Effect(c["effect"], c["joint"] or 0).label
 
 
 def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:

@@ -8,7 +8,6 @@ all the data, and the files of the command.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Callable, Optional, Sequence, Union
 

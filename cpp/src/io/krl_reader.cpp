@@ -60,7 +60,10 @@ Pose6 parse_aggregate(const std::string& agg, const std::string& at) {
 }  // namespace
 
 
-NativeProgram read_krl_program(const std::string& src_path) {
+Declarations read_krl_declarations(const std::vector<std::string>&) { return {}; }  // (being written)
+
+NativeProgram read_krl_program(const std::vector<std::string>& src_paths, const Declarations&) {
+  const std::string& src_path = src_paths[0];
   NativeProgram p;
   p.format = ControllerFormat::Krl;
   add_program_file(p, src_path);

@@ -13,8 +13,10 @@
 
 namespace kincal {
 
-NativeProgram read_krl_program(const std::string& src_path);
-NativeProgram read_rapid_program(const std::string& path);
+NativeProgram read_krl_program(const std::vector<std::string>& src_paths, const Declarations& context);
+NativeProgram read_rapid_program(const std::vector<std::string>& paths, const Declarations& context);
+Declarations read_krl_declarations(const std::vector<std::string>& paths);
+Declarations read_rapid_declarations(const std::vector<std::string>& paths);
 std::string krl_aggregate(const std::string& old, const Pose6& pose, const ControllerTarget& t, bool is_frame);
 std::string rapid_robtarget(const std::string& old, const Pose6& pose, const ControllerTarget& t);
 NativeProgram read_ls_program(const std::string& path);
@@ -27,12 +29,31 @@ std::string ls_joint_position(const std::string& old, const Vec6& q_deg);
 std::string urscript_joints(const Vec6& q_deg);
 std::string ls_renumbered(const std::string& text);
 
-NativeProgram read_native_program(const std::string& path, ControllerFormat format) {
-  if (format == ControllerFormat::Krl) return read_krl_program(path);
-  if (format == ControllerFormat::Rapid) return read_rapid_program(path);
-  if (format == ControllerFormat::FanucLs) return read_ls_program(path);
-  if (format == ControllerFormat::UrScript) return read_urscript_program(path);
-  throw InputError(path + ": not a native program (" + format_name(format) + ")");
+NativeProgram read_native_programs(const std::vector<std::string>& paths, ControllerFormat format,
+                                   const Declarations& context) {
+  if (paths.empty()) throw InputError("no program to read");
+  if (format == ControllerFormat::Krl) return read_krl_program(paths, context);
+  if (format == ControllerFormat::Rapid) return read_rapid_program(paths, context);
+  if (paths.size() > 1)
+    throw InputError(paths[1] + ": a " + std::string(format_name(format)) + " program is read by itself");
+  if (format == ControllerFormat::FanucLs) return read_ls_program(paths[0]);
+  if (format == ControllerFormat::UrScript) return read_urscript_program(paths[0]);
+  throw InputError(paths[0] + ": not a native program (" + format_name(format) + ")");
+}
+
+NativeProgram read_native_program(const std::string& path, ControllerFormat format, const Declarations& context) {
+  return read_native_programs({path}, format, context);
+}
+
+const Declaration* Declarations::find(const std::string& name) const {
+  const auto it = named.find(upper_case(name));
+  return it == named.end() ? nullptr : &it->second;
+}
+
+Declarations read_declarations(const std::vector<std::string>& paths, ControllerFormat format) {
+  if (format == ControllerFormat::Krl) return read_krl_declarations(paths);
+  if (format == ControllerFormat::Rapid) return read_rapid_declarations(paths);
+  return {};  // LS and URScript programs declare their own positions (the controller holds frames and registers)
 }
 
 namespace {

@@ -58,7 +58,10 @@ Pose6 parse_robtarget(const std::string& v, const std::string& at) {
 
 }  // namespace
 
-NativeProgram read_rapid_program(const std::string& path) {
+Declarations read_rapid_declarations(const std::vector<std::string>&) { return {}; }  // (being written)
+
+NativeProgram read_rapid_program(const std::vector<std::string>& paths, const Declarations&) {
+  const std::string& path = paths[0];
   NativeProgram p;
   p.format = ControllerFormat::Rapid;
   add_program_file(p, path);

@@ -9,6 +9,10 @@
 #include "kincal/core/types.hpp"
 #include "kincal/io/controllers.hpp"
 
+#include <array>
+#include <limits>
+#include <map>
+#include <optional>
 #include <regex>
 #include <string>
 #include <utility>
@@ -34,6 +38,27 @@ struct NativeTarget {
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();  ///< the program's frame in the robot base
   std::string name;                    ///< declared name, or "" when inline
   int uframe = -1, utool = -1;         ///< FANUC LS: the position's UF and UT numbers (-1: other languages)
+  /// The motion's TCP in the controller's tool 0 frame (its flange): KRL TOOL_DATA[n] of the motion's
+  /// TOOL_NO / $TOOL, RAPID the tframe of the statement's tooldata; identity for tool 0 (tool0 / $NULLFRAME),
+  /// which --program-tool places in the model's tool frame. (`frame` above is the motion's base in base 0:
+  /// KRL BASE_DATA[n], RAPID the work object's uframe * oframe; base 0 is --program-base.)
+  Eigen::Isometry3d tool = Eigen::Isometry3d::Identity();
+  /// The frames' names as the program gives them, for messages ("TOOL_DATA[2], BASE_DATA[1]", "tool1,
+  /// wobj2"); "" for tool 0 and base 0.
+  std::string frames_named;
+  /// The branch data as taught (KRL S and T, RAPID confdata, LS CONFIG with its turns): only the branch
+  /// fields are set. None when the target carries none (a KRL target without S/T).
+  std::optional<ControllerTarget> taught;
+  /// The external axes as written, E1..E6 (RAPID eax_a..eax_f, LS E1..E3); NaN where none (RAPID 9E9).
+  std::array<double, 6> external{{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                  std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                  std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()}};
+  /// A declared target that motions use in a second tool or base: this target is a copy, declared on a new
+  /// line after target copy_of's declaration (the same line with `name` for the original's name and this
+  /// target's value), and `edits` rename the motions' references to it. -1: not a copy.
+  int copy_of = -1;
+  /// Changes made whatever the target is written as (a copy's name at the motions that use it).
+  std::vector<NativeEdit> edits;
   /// Whether it can be written as a joint target: every motion to it interpolates in joints (KRL PTP /
   /// SPTP, RAPID MoveJ, LS J, URScript movej) and nothing else in the program names it.
   bool joint_motion = false;
@@ -46,7 +71,8 @@ struct NativeTarget {
 /// One motion statement of a native program, in the order of the file (a circular motion: two, its
 /// via and its end point). --tolerance follows the path from each motion's target to the next.
 struct NativeMotion {
-  int line = 0;         ///< its line in the program's first file (1-based)
+  int file = 0;         ///< the file it stands in (index into NativeProgram::paths)
+  int line = 0;         ///< its line in that file (1-based)
   int target = -1;      ///< its target in NativeProgram::targets; -1: one kincal does not compensate
   /// 'J' joint interpolation, 'L' a straight line (KRL LIN / SLIN, RAPID MoveL, LS L, URScript movel),
   /// 'C' an arc, 'O' another motion (RAPID MoveLDO, MoveJSync, ..., URScript movep; not followed)
@@ -56,11 +82,35 @@ struct NativeMotion {
   std::string indent, head, tail;
 };
 
-/// A target the program computes at run time: not compensated.
+/// A motion whose target kincal does not compensate: one the program computes at run time, one declared
+/// nowhere, or a motion kincal names but cannot follow.
 struct UnresolvedTarget {
   std::string where;  ///< "file:line"
   std::string text;   ///< the motion statement
+  std::string why;    ///< e.g. "computed at run time", "declared nowhere", "a relative motion (SLIN_REL)"
 };
+
+/// One declaration of a controller backup's files (or of --declarations files), which programs may name
+/// without declaring it themselves: KRL the data lists (.dat, $config.dat), RAPID every module's data.
+struct Declaration {
+  std::string type;        ///< upper case as written: E6POS, POS, FRAME, E6AXIS, AXIS, FDAT, ...; ROBTARGET, TOOLDATA, WOBJDATA, ...
+  std::string name;        ///< as written
+  std::string path;        ///< the file that declares it
+  int line = 0;            ///< the 1-based line where its value starts (its declaration's line)
+  std::string value;       ///< the value's text, "" when declared without one
+  bool run_time = false;   ///< set at run time (KRL: assigned in a program; RAPID: VAR, or assigned)
+};
+
+/// The declarations of a set of files, by upper-case name. KRL frame arrays by element:
+/// "TOOL_DATA[3]", "BASE_DATA[2]" (written $TOOL_DATA[3] or TOOL_DATA[3] in $config.dat).
+struct Declarations {
+  std::map<std::string, Declaration> named;
+  const Declaration* find(const std::string& name) const;  ///< by name, any case; nullptr when none
+};
+
+/// Every declaration in the files (KRL .dat and $config.dat; RAPID .mod/.modx/.sys), InputError "file:line:
+/// cause" on a malformed one. A name declared twice keeps its first declaration (RAPID: LOCAL ones are not read).
+Declarations read_declarations(const std::vector<std::string>& paths, ControllerFormat format);
 
 struct NativeProgram {
   ControllerFormat format = ControllerFormat::Krl;
@@ -73,8 +123,15 @@ struct NativeProgram {
 };
 
 /// Reads a KRL program (path: the .src; its .dat beside it when present), a RAPID module, a FANUC LS
-/// program or a URScript program.
-NativeProgram read_native_program(const std::string& path, ControllerFormat format);
+/// program or a URScript program. Names the program does not declare are looked up in `context` (the
+/// backup's other files): a Cartesian target declared there is compensated in that file, which then joins
+/// the program's files (p.paths).
+NativeProgram read_native_program(const std::string& path, ControllerFormat format, const Declarations& context = {});
+
+/// Several programs read as one (KRL: several .src, each with its .dat; RAPID: the modules of one task):
+/// motions in each, targets declared in any of them or in `context`. LS and URScript: one path.
+NativeProgram read_native_programs(const std::vector<std::string>& paths, ControllerFormat format,
+                                   const Declarations& context = {});
 
 /// A target --tolerance inserts before a straight-line motion: a copy of that motion (indentation,
 /// instruction, speed, zone, tool, ... as written) to an inline filtered target; LS: a new P[n] in /POS.

@@ -1,0 +1,6 @@
+// FANUC LS and URScript programs read in: the constructs of the controller's manual (issue 30).
+#include "kincal/io/native.hpp"
+
+#include "test_files.hpp"
+
+#include <gtest/gtest.h>

@@ -1,10 +1,12 @@
 // _core bindings of program compensation: compensate_poses, compensate_program, stream_lines.
 #include "common.hpp"
 
+#include "kincal/compensation/backup.hpp"
 #include "kincal/compensation/controller_program.hpp"
 #include "kincal/compensation/program.hpp"
 #include "kincal/compensation/stream.hpp"
 
+#include <memory>
 #include <optional>
 
 using namespace kincal;
@@ -44,6 +46,28 @@ py::dict result_dict(const ProgramResult& r) {
   d["dir"] = dir;
   d["warnings"] = r.warnings;
   return d;
+}
+
+NativeOptions native_options(const std::vector<double>& program_tool, const std::vector<double>& program_base,
+                             bool skip_unresolved, std::optional<double> tolerance, const std::vector<std::string>& uframes,
+                             const std::vector<std::string>& utools, bool allow_branch_change,
+                             const std::vector<std::string>& tracks) {
+  NativeOptions n;
+  for (const auto& u : uframes) add_numbered_frame(n.user_frames, u, "--uframe");
+  for (const auto& u : utools) add_numbered_frame(n.user_tools, u, "--utool");
+  for (const auto& t : tracks) add_track_axis(n.track, t);
+  if (tolerance) n.tolerance_mm = *tolerance;
+  for (const auto* v : {&program_tool, &program_base})
+    if (!v->empty() && v->size() != 6) throw InputError("--program-tool / --program-base: X,Y,Z,A,B,C (6 numbers)");
+  if (!program_tool.empty())
+    n.program_tool = Pose6{Vec3(program_tool[0], program_tool[1], program_tool[2]),
+                           Vec3(program_tool[3], program_tool[4], program_tool[5])};
+  if (!program_base.empty())
+    n.program_base = Pose6{Vec3(program_base[0], program_base[1], program_base[2]),
+                           Vec3(program_base[3], program_base[4], program_base[5])};
+  n.skip_unresolved = skip_unresolved;
+  n.allow_branch_change = allow_branch_change;
+  return n;
 }
 
 }  // namespace
@@ -95,25 +119,16 @@ void define_compensation(py::module_& m) {
       "Compensates a pose program file (CSV or G-code) into a joint program file, atomically");
   m.def(
       "compensate_to_controller",
-      [](const Robot& r, const std::string& in, const std::string& out, KINCAL_COMP_PARAMS,
+      [](const Robot& r, const std::vector<std::string>& in, const std::string& out, KINCAL_COMP_PARAMS,
          std::optional<std::string> format, const std::string& targets, const std::string& name,
          std::optional<double> speed, std::optional<double> zone, int max_per_file,
          const std::vector<double>& program_tool, const std::vector<double>& program_base, bool skip_unresolved,
          std::optional<double> tolerance, const std::vector<std::string>& uframes,
-         const std::vector<std::string>& utools) {
-        NativeOptions n;
-        for (const auto& u : uframes) add_numbered_frame(n.user_frames, u, "--uframe");
-        for (const auto& u : utools) add_numbered_frame(n.user_tools, u, "--utool");
-        if (tolerance) n.tolerance_mm = *tolerance;
-        for (const auto* v : {&program_tool, &program_base})
-          if (!v->empty() && v->size() != 6) throw InputError("--program-tool / --program-base: X,Y,Z,A,B,C (6 numbers)");
-        if (!program_tool.empty())
-          n.program_tool = Pose6{Vec3(program_tool[0], program_tool[1], program_tool[2]),
-                                 Vec3(program_tool[3], program_tool[4], program_tool[5])};
-        if (!program_base.empty())
-          n.program_base = Pose6{Vec3(program_base[0], program_base[1], program_base[2]),
-                                 Vec3(program_base[3], program_base[4], program_base[5])};
-        n.skip_unresolved = skip_unresolved;
+         const std::vector<std::string>& utools, const std::vector<std::string>& declarations,
+         bool allow_branch_change, const std::vector<std::string>& tracks, int threads, py::object progress) {
+        NativeOptions n = native_options(program_tool, program_base, skip_unresolved, tolerance, uframes, utools,
+                                         allow_branch_change, tracks);
+        if (in.empty()) throw InputError("--program: no input");
         WriterOptions w;
         w.format = format ? controller_format_named(*format) : controller_format_of_path(out);
         if (targets != "joints" && targets != "filtered")
@@ -124,10 +139,44 @@ void define_compensation(py::module_& m) {
         if (zone) w.zone = *zone;
         w.max_targets_per_file = max_per_file;
         const ProgramOptions o = KINCAL_COMP_OPTIONS;
+        if (in.size() > 1 || is_folder(in[0])) {  // a controller backup: the same tree under out
+          if (format) throw InputError("--format: a backup's programs are written in their own languages");
+          BackupOptions b;
+          b.declarations = declarations;
+          b.threads = threads;
+          if (!progress.is_none())
+            b.progress = [progress](size_t done, size_t all) {
+              py::gil_scoped_acquire gil;
+              progress(done, all);
+            };
+          BackupResult res;
+          {
+            py::gil_scoped_release release;
+            res = compensate_backup(r, in, out, o, w, n, b);
+          }
+          py::list programs;
+          for (const BackupProgram& p : res.programs) {
+            py::dict d = result_dict(p.result.result);
+            d["inputs"] = p.inputs;
+            d["files"] = p.result.files;
+            d["error"] = p.error;
+            d["targets_note"] = p.result.targets_note;
+            programs.append(d);
+          }
+          py::dict d;
+          d["programs"] = programs;
+          d["copied"] = res.copied;
+          d["failed"] = res.failed;
+          return d;
+        }
+        if (!declarations.empty()) {
+          const ControllerFormat f = controller_format_of_path(in[0]);
+          n.context = std::make_shared<const Declarations>(read_declarations(declarations, f));
+        }
         ControllerProgramResult res;
         {
           py::gil_scoped_release release;
-          res = compensate_to_controller(r, in, out, o, w, n);
+          res = compensate_to_controller(r, in[0], out, o, w, n);
         }
         py::dict d = result_dict(res.result);
         d["files"] = res.files;
@@ -142,11 +191,15 @@ void define_compensation(py::module_& m) {
       py::arg("max_targets_per_file") = 0, py::arg("program_tool") = std::vector<double>{},
       py::arg("program_base") = std::vector<double>{}, py::arg("skip_unresolved") = false,
       py::arg("tolerance") = py::none(), py::arg("uframes") = std::vector<std::string>{},
-      py::arg("utools") = std::vector<std::string>{},
-      "Compensates a pose program file into a program in a controller's language (format: krl, rapid, fanuc-ls, "
-      "urscript, gcode, csv; None: by the output's extension), every file written or none; tolerance (mm): targets "
-      "inserted where the path between two targets leaves the desired segment by more (path_before_mm, "
-      "path_after_mm, inserted); uframes, utools: FANUC LS user frames and tools, 'N=X,Y,Z,A,B,C' each");
+      py::arg("utools") = std::vector<std::string>{}, py::arg("declarations") = std::vector<std::string>{},
+      py::arg("allow_branch_change") = false, py::arg("tracks") = std::vector<std::string>{}, py::arg("threads") = 0,
+      py::arg("progress") = py::none(),
+      "Compensates a program into a program in a controller's language (format: krl, rapid, fanuc-ls, urscript, gcode, "
+      "csv; None: by the output's extension), every file written or none; tolerance (mm): targets inserted where the "
+      "path between two targets leaves the desired segment by more (path_before_mm, path_after_mm, inserted); uframes, "
+      "utools: FANUC LS user frames and tools, 'N=X,Y,Z,A,B,C' each; tracks: 'E1=X,Y,Z' linear tracks. program: one "
+      "file, or several files and folders (a controller backup: out is a folder with the same tree; the result lists "
+      "each program with its error or files, the files copied, and how many failed; progress(done, all))");
   m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,

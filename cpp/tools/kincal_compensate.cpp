@@ -9,6 +9,7 @@
 // `kincal compensate` (both run this library). Errors: one line "file:line: cause", exit 1, and no
 // output file.
 #include "kincal/fivebar/fivebar.hpp"
+#include "kincal/compensation/backup.hpp"
 #include "kincal/compensation/controller_program.hpp"
 #include "kincal/compensation/program.hpp"
 #include "kincal/compensation/stream.hpp"
@@ -137,7 +138,10 @@ std::vector<double> parse_directions(const std::string& text) {
 
 int main(int argc, char** argv) {
   CLI::App app{"kincal-compensate: Newton compensation of pose programs into joint programs"};
-  std::string model, program, out, frame = "base";
+  std::string model, out, frame = "base";
+  std::vector<std::string> programs, declarations, tracks;
+  bool allow_branch_change = false;
+  int jobs = 0;
   bool stream = false, fd = false, nominal = false, keep_branch = false, paper_start = false;
   double eps = 1e-15, delta = 1e-8;
   std::optional<double> temperature;
@@ -155,7 +159,16 @@ int main(int argc, char** argv) {
   app.add_option("--model", model, "built-in robot name or model JSON");
   app.add_option("--fivebar", fivebar, "five-bar hidden robot: FIT.json of kincal hidden-robot fit");
   app.add_option("--matrix", matrix, "five-bar: MATRIX.json of kincal hidden-robot matrix");
-  app.add_option("--program", program, "pose program: CSV (x,y,z,a,b,c) or G-code (X Y Z A B C)");
+  app.add_option("--program", programs,
+                 "pose program (CSV x,y,z,a,b,c or G-code X Y Z A B C) or a controller's program (.src with its .dat, "
+                 ".mod, .ls, .script); several files or a folder: a controller backup (--out: a folder, the same tree)");
+  app.add_option("--declarations", declarations, "more files whose declarations the programs may name (KRL .dat, "
+                                                 "$config.dat; RAPID modules)");
+  app.add_flag("--allow-branch-change", allow_branch_change, "a taught target the calibrated robot cannot reach on "
+                                                             "its taught solution is written on another branch (a warning)");
+  app.add_option("--track", tracks, "a linear track that carries the robot: AXIS=X,Y,Z (E1..E6; mm per unit of the "
+                                    "axis, in the program's base frame)");
+  app.add_option("--jobs", jobs, "a backup's programs filtered at once (default: every core)");
   app.add_option("--out", out,
                  "the program written: .csv (q1..q6), G-code (A1=..), KRL .src (+ .dat), RAPID .mod, FANUC .ls, "
                  "URScript .script");
@@ -201,6 +214,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
+    if (programs.size() > 1 && !fivebar.empty()) throw kincal::InputError("--fivebar: one --program");
+    const std::string program = programs.empty() ? std::string() : programs[0];
     if (!fivebar.empty()) return run_fivebar(fivebar, matrix, program, out, stream);
     if (model.empty()) throw kincal::InputError("--model (a serial robot) or --fivebar (a hidden robot) is needed");
     kincal::ProgramOptions opt;
@@ -255,7 +270,34 @@ int main(int argc, char** argv) {
     for (const auto& u : uframes) kincal::add_numbered_frame(n.user_frames, u, "--uframe");
     for (const auto& u : utools) kincal::add_numbered_frame(n.user_tools, u, "--utool");
     n.skip_unresolved = skip_unresolved;
+    n.allow_branch_change = allow_branch_change;
+    for (const auto& t : tracks) kincal::add_track_axis(n.track, t);
     if (tolerance) n.tolerance_mm = *tolerance;
+    if (programs.size() > 1 || kincal::is_folder(program)) {  // a controller backup
+      if (!format.empty()) throw kincal::InputError("--format: a backup's programs are written in their own languages");
+      kincal::BackupOptions b;
+      b.declarations = declarations;
+      b.threads = jobs;
+      const auto br = kincal::compensate_backup(robot, programs, out, opt, w, n, b);
+      size_t filtered = 0;
+      for (const auto& p : br.programs) {
+        for (const auto& m : p.result.result.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", m.c_str());
+        if (!p.error.empty() || p.result.files.empty()) continue;
+        ++filtered;
+        std::string files;
+        for (const auto& f : p.result.files) files += (files.empty() ? "" : ", ") + f;
+        std::fprintf(stderr, "%s: %zu target(s) compensated; %s\n", files.c_str(), p.result.result.q_deg.size(),
+                     p.result.targets_note.c_str());
+      }
+      std::fprintf(stderr, "%s: %zu program(s) filtered, %zu file(s) copied unchanged, %d program(s) failed\n",
+                   out.c_str(), filtered, br.copied.size(), br.failed);
+      for (const auto& p : br.programs)
+        if (!p.error.empty()) std::fprintf(stderr, "kincal-compensate: error: %s\n", p.error.c_str());
+      return br.failed ? 1 : 0;
+    }
+    if (!declarations.empty())
+      n.context = std::make_shared<const kincal::Declarations>(
+          kincal::read_declarations(declarations, kincal::controller_format_of_path(program)));
     const auto cr = kincal::compensate_to_controller(robot, program, out, opt, w, n);
     const auto& res = cr.result;
     for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());

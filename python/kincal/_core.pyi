@@ -137,7 +137,7 @@ def compensate_program(robot: Robot, program: str, out: str, compensate: bool = 
                        max_iterations: int = ..., corrected_start: bool = ..., residual: str = ...,
                        temperature_c: Optional[float] = ..., initial_direction: Sequence[float] = ...,
                        keep_branch: bool = ...) -> dict[str, Any]: ...
-def compensate_to_controller(robot: Robot, program: str, out: str, compensate: bool = ..., instrument: bool = ...,
+def compensate_to_controller(robot: Robot, program: Sequence[str], out: str, compensate: bool = ..., instrument: bool = ...,
                              finite_difference: bool = ..., delta: float = ..., epsilon: float = ...,
                              max_iterations: int = ..., corrected_start: bool = ..., residual: str = ...,
                              temperature_c: Optional[float] = ..., initial_direction: Sequence[float] = ...,
@@ -146,7 +146,9 @@ def compensate_to_controller(robot: Robot, program: str, out: str, compensate: b
                              max_targets_per_file: int = ..., program_tool: Sequence[float] = ...,
                              program_base: Sequence[float] = ..., skip_unresolved: bool = ...,
                              tolerance: Optional[float] = ..., uframes: Sequence[str] = ...,
-                             utools: Sequence[str] = ...) -> dict[str, Any]: ...
+                             utools: Sequence[str] = ..., declarations: Sequence[str] = ...,
+                             allow_branch_change: bool = ..., tracks: Sequence[str] = ..., threads: int = ...,
+                             progress: Optional[Callable[[int, int], None]] = ...) -> dict[str, Any]: ...
 def controller_targets(robot: Robot, q_deg: np.ndarray, targets: str = ..., format: str = ...) -> list[dict[str, Any]]: ...
 def branch_data(robot: Robot, q_deg: np.ndarray) -> dict[str, Any]: ...
 def joints_to_controller(robot: Robot, q_deg: np.ndarray) -> np.ndarray: ...

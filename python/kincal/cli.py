@@ -70,6 +70,9 @@ def cmd_compensate(args) -> None:
     robot = load_robot(args.model, joint_convention=args.joint_convention)
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
+    if len(args.program) > 1 or Path(args.program[0]).is_dir():
+        _compensate_backup(robot, args)
+        return
     res = programs.compensate(robot, args, _comp_kwargs(args))
     for w in res["warnings"]:
         print(f"kincal compensate: warning: {w}", file=sys.stderr)
@@ -79,6 +82,40 @@ def cmd_compensate(args) -> None:
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
     for line in programs.summary(res):
         print(f"{written}: {line}", file=sys.stderr)
+
+
+def _compensate_backup(robot, args) -> None:
+    """A controller backup (folders, several files): every program filtered into the same tree under --out;
+    a program that fails is listed (file:line: cause) and the exit status is 1, the others are written."""
+    bar = _count_bar("kincal compensate: programs")
+    res = programs.compensate(robot, args, _comp_kwargs(args), progress=bar)
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    for p in res["programs"]:
+        for w in p["warnings"]:
+            print(f"kincal compensate: warning: {w}", file=sys.stderr)
+    written = [p for p in res["programs"] if not p["error"]]
+    for p in written:
+        if p["files"]:
+            n = len(p["iterations"])
+            print(f"{', '.join(p['files'])}: {n} target(s) compensated"
+                  + (f"; {p['targets_note']}" if p["targets_note"] else ""), file=sys.stderr)
+    print(f"{args.out}: {len([p for p in written if p['files']])} program(s) filtered, {len(res['copied'])} file(s) "
+          f"copied unchanged, {res['failed']} program(s) failed", file=sys.stderr)
+    if res["failed"]:
+        lines = [f"{', '.join(p['inputs'])}:\n    " + p["error"].replace("\n", "\n    ")
+                 for p in res["programs"] if p["error"]]
+        raise ValueError(f"{res['failed']} program(s) not written (the others are):\n  " + "\n  ".join(lines))
+
+
+def _count_bar(label: str):
+    """A progress report of done/all items on stderr (quiet when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(done: int, total: int) -> None:
+        print(f"\r{label}: {done}/{total}   ", end="", file=sys.stderr, flush=True)
+    return report
 
 
 def _progress(label: str):
@@ -338,9 +375,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     sp = sub.add_parser("compensate", help="Newton compensation of a pose program into a joint program")
     sp.add_argument("--model", required=True, help="built-in name, URDF file or model JSON")
-    sp.add_argument("--program", required=True, help="pose program: CSV x,y,z,a,b,c or G-code X Y Z A B C")
+    sp.add_argument("--program", required=True, nargs="+",
+                    help="pose program (CSV x,y,z,a,b,c or G-code X Y Z A B C) or a controller's program (.src with its "
+                         ".dat, .mod, .ls, .script); several files or a folder: a controller backup, every program in "
+                         "it filtered (--out is then a folder with the same tree)")
     sp.add_argument("--out", required=True, help="the program: .csv (q1..q6), G-code (A1=..), .src (KRL), .mod "
-                                                 "(RAPID), .ls (FANUC LS), .script (URScript)")
+                                                 "(RAPID), .ls (FANUC LS), .script (URScript); a folder for a backup")
     sp.add_argument("--frame", choices=["base", "instrument"], default="base")
     programs.add_options(sp)
     sp.add_argument("--finite-difference", action="store_true", help="the paper's finite-difference Jacobian")

@@ -35,8 +35,21 @@ def add_options(sp) -> None:
                     help="a FANUC LS program's tool N in the model's tool frame (repeat for each UT its positions "
                          "use; one UT alone may use --program-tool)")
     sp.add_argument("--skip-unresolved", action="store_true",
-                    help="pass targets computed at run time (RelTool, Offs, CRobT, geometric operators) through "
-                         "unchanged with a warning (default: an error listing them)")
+                    help="pass motions whose targets kincal does not compensate (computed at run time: RelTool, Offs, "
+                         "CRobT, geometric operators, _REL motions, offsets; declared nowhere) through unchanged with a "
+                         "warning (default: an error listing every one, file:line)")
+    sp.add_argument("--declarations", nargs="+", default=[], metavar="FILE",
+                    help="more files whose declarations the programs may name (a KRL $config.dat or .dat, RAPID "
+                         "modules): targets, tools, bases, work objects")
+    sp.add_argument("--allow-branch-change", action="store_true",
+                    help="a taught target (KUKA S/T, ABB confdata, FANUC configuration) that the calibrated robot "
+                         "cannot reach on its taught solution is written on another branch with a warning (default: "
+                         "an error naming it)")
+    sp.add_argument("--track", action="append", default=[], metavar="AXIS=X,Y,Z",
+                    help="a linear track that carries the robot: external axis AXIS (E1..E6) moves the robot's base "
+                         "by X,Y,Z (mm per unit of the axis) in the program's base frame")
+    sp.add_argument("--jobs", type=int, default=0,
+                    help="a backup's programs filtered at once (default: every core)")
     sp.add_argument("--tolerance", type=float, metavar="MM",
                     help="insert targets where the real robot's path between two targets (joint interpolation; "
                          "for filtered targets the controller's straight line) leaves the desired segment by more "
@@ -62,18 +75,22 @@ def _frame(text, option: str) -> list:
     return v
 
 
-def compensate(robot, args, comp_kwargs: dict) -> dict:
-    """Compensates args.program into args.out in the chosen language; returns the result dict (with
-    `files`, the files written). A model whose TCP is nominal (not measured) gets one warning line."""
+def compensate(robot, args, comp_kwargs: dict, progress=None) -> dict:
+    """Compensates args.program (a file, or several files and folders: a controller backup) into args.out
+    in the chosen language; returns the result dict (with `files`, the files written; a backup: `programs`,
+    `copied`, `failed`). A model whose TCP is nominal (not measured) gets one warning line."""
     warn_nominal_tcp(robot, args.model, "kincal compensate")
-    return _core.compensate_to_controller(robot, str(args.program), str(args.out), **comp_kwargs,
+    return _core.compensate_to_controller(robot, [str(p) for p in args.program], str(args.out), **comp_kwargs,
                                           format=args.format, targets=args.targets, name=args.name,
                                           speed=args.speed, zone=args.zone,
                                           max_targets_per_file=args.max_targets_per_file,
                                           program_tool=_frame(args.program_tool, "--program-tool"),
                                           program_base=_frame(args.program_base, "--program-base"),
                                           skip_unresolved=args.skip_unresolved, tolerance=args.tolerance,
-                                          uframes=args.uframe, utools=args.utool)
+                                          uframes=args.uframe, utools=args.utool,
+                                          declarations=[str(d) for d in args.declarations],
+                                          allow_branch_change=args.allow_branch_change, tracks=args.track,
+                                          threads=args.jobs, progress=progress)
 
 
 def summary(res: dict) -> list[str]:

@@ -3,7 +3,9 @@
 #include "kincal/ik/ik.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 
 namespace kincal {
 
@@ -111,6 +113,51 @@ std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const 
   }
   if (!found && why) *why = "no solution has the target's branch data";
   return found;
+}
+
+std::string branch_text(ControllerFormat f, const ControllerTarget& t) {
+  if (f == ControllerFormat::Krl) return "S " + std::to_string(t.kuka_s) + ", T " + std::to_string(t.kuka_t);
+  if (f == ControllerFormat::Rapid)
+    return "cfx " + std::to_string(t.abb_conf[3]) + ", cf1 " + std::to_string(t.abb_conf[0]) + ", cf4 " +
+           std::to_string(t.abb_conf[1]) + ", cf6 " + std::to_string(t.abb_conf[2]);
+  return t.fanuc_config;
+}
+
+BranchDifference branch_difference(const Robot& robot, ControllerFormat f, const ControllerTarget& taught,
+                                   const Vec6& q_deg) {
+  ControllerTarget c;
+  c.q_deg = q_deg;
+  set_branch_data(robot, c);
+  BranchDifference d;
+  if (f == ControllerFormat::Krl) {
+    d.arm = c.kuka_s != taught.kuka_s;
+    for (int j = 0; j < 6; ++j)
+      if (((c.kuka_t ^ taught.kuka_t) >> j) & 1) d.turns.push_back(j);
+  } else if (f == ControllerFormat::Rapid) {
+    d.arm = c.abb_conf[3] != taught.abb_conf[3];
+    const int joint[3] = {0, 3, 5};
+    for (size_t k = 0; k < 3; ++k)
+      if (c.abb_conf[k] != taught.abb_conf[k]) d.turns.push_back(joint[k]);
+  } else {
+    const auto letters = [](const std::string& s) {
+      std::string out;
+      for (char ch : s.substr(0, s.find(',')))
+        if (ch != ' ') out += ch;
+      return out;
+    };
+    const auto turns = [](const std::string& s) {
+      int t[3] = {0, 0, 0};
+      const size_t comma = s.find(',');
+      if (comma != std::string::npos) std::sscanf(s.c_str() + comma + 1, "%d , %d , %d", &t[0], &t[1], &t[2]);
+      return std::array<int, 3>{{t[0], t[1], t[2]}};
+    };
+    d.arm = letters(c.fanuc_config) != letters(taught.fanuc_config);
+    const auto a = turns(c.fanuc_config), b = turns(taught.fanuc_config);
+    const int joint[3] = {0, 3, 5};
+    for (size_t k = 0; k < 3; ++k)
+      if (a[k] != b[k]) d.turns.push_back(joint[k]);
+  }
+  return d;
 }
 
 }  // namespace kincal

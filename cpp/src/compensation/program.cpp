@@ -205,7 +205,8 @@ ProgramCursor::ProgramCursor(const Robot& robot, const ProgramOptions& opt, cons
 }
 
 PoseSolution next_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, ProgramCursor& cur) {
-  PoseSolution s = solve_pose(robot, opt, pose, cur.prev, cur.ctx);
+  const Vec6 ref = cur.reference ? *cur.reference : cur.prev;
+  PoseSolution s = solve_pose(robot, opt, pose, ref, cur.ctx);
   if (!s.ok()) return s;
   if (!cur.first && opt.compensate && robot.calibrated->needs_dir()) {
     VecQ turned = cur.ctx.dir;
@@ -218,7 +219,7 @@ PoseSolution next_pose(const Robot& robot, const ProgramOptions& opt, const Pose
     if (any) {
       EffectContext c2 = cur.ctx;
       c2.dir = turned;
-      PoseSolution s2 = solve_pose(robot, opt, pose, cur.prev, c2);
+      PoseSolution s2 = solve_pose(robot, opt, pose, ref, c2);
       if (!s2.ok()) return s2;
       if (s.branch_changed() && !s2.branch_changed()) {
         s2.status = PoseStatus::BranchChanged;
@@ -232,7 +233,7 @@ PoseSolution next_pose(const Robot& robot, const ProgramOptions& opt, const Pose
       }
     }
   }
-  if (cur.first && s.branch_changed()) s.status = PoseStatus::Solved;  // no previous pose's branch to keep
+  if (cur.first && !cur.reference && s.branch_changed()) s.status = PoseStatus::Solved;  // no branch to keep
   cur.prev = s.q_deg;
   cur.first = false;
   return s;
@@ -244,7 +245,8 @@ std::string branch_change_message(const std::string& cause) {
 
 ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& poses,
                                const std::vector<std::string>& where_of, const ProgramOptions& opt,
-                               const std::vector<double>& temperature_c) {
+                               const std::vector<double>& temperature_c,
+                               const std::vector<std::optional<Vec6>>& references) {
   const Model& cal = *robot.calibrated;
   auto where_i = [&](size_t i) { return i < where_of.size() ? where_of[i] : "pose " + std::to_string(i); };
   const bool needs_dir = opt.compensate && cal.needs_dir();
@@ -260,9 +262,12 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
     ProgramCursor cur(robot, opt, dir0);
     for (size_t i = 0; i < poses.size(); ++i) {
       cur.ctx.temperature_c = temps[i];
+      cur.reference = i < references.size() ? references[i] : std::nullopt;
       const PoseSolution s = next_pose(robot, opt, poses[i], cur);
       if (!s.ok()) throw InputError(where_i(i) + ": " + s.error);
-      if (s.branch_changed()) {
+      if (s.branch_changed() && cur.reference) {
+        res.warnings.push_back(where_i(i) + ": off the taught branch: " + s.error);  // (checked by the caller)
+      } else if (s.branch_changed()) {
         const std::string w = where_i(i) + ": " + branch_change_message(s.error);
         if (opt.keep_branch) throw InputError(w + " (--keep-branch)");
         res.warnings.push_back(w);

@@ -79,7 +79,8 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
 ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
                                           const std::vector<std::string>& where, const ProgramOptions& opt,
                                           const std::vector<double>& temperature_c, double tol,
-                                          const std::vector<PathKind>& segment_kinds) {
+                                          const std::vector<PathKind>& segment_kinds,
+                                          const std::vector<std::optional<Vec6>>& references) {
   if (!(tol > 0)) throw InputError("--tolerance must be a positive length in mm");
   std::vector<PathKind> kinds = segment_kinds;
   kinds.resize(poses.empty() ? 0 : poses.size() - 1, PathKind::Unchecked);
@@ -98,7 +99,11 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
                                                          : Eigen::Isometry3d::Identity();
   constexpr int kMaxRounds = 20;
   for (int round = 0;; ++round) {
-    r.result = compensate_poses(robot, r.poses, r.where, opt, temps);
+    std::vector<std::optional<Vec6>> refs(r.poses.size());  // an input pose's reference; none for inserted ones
+    for (size_t i = 0; i < refs.size(); ++i)
+      if (r.original[i] >= 0 && static_cast<size_t>(r.original[i]) < references.size())
+        refs[i] = references[static_cast<size_t>(r.original[i])];
+    r.result = compensate_poses(robot, r.poses, r.where, opt, temps, refs);
     const auto& q = r.result.q_deg;
     std::vector<char> split(r.poses.size(), 0);
     double worst = 0;

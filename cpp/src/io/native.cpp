@@ -70,9 +70,10 @@ std::string old_value(const NativeProgram& p, const NativeTarget& nt) {
 // The lines of the program's first file with each inserted target's motion before the motion it precedes
 // (LS: the new positions P[n] before /END, numbered after the largest in the program).
 void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTarget>& inserted,
-                           std::vector<std::string>& lines) {
+                           std::vector<std::vector<std::string>>& files) {
   if (inserted.empty()) return;
-  std::map<int, std::string> before;  // per line: the motions inserted before it
+  std::map<std::pair<int, int>, std::string> before;  // per file and line: the motions inserted before it
+  std::vector<std::string>& lines = files[static_cast<size_t>(p.motions[inserted[0].motion].file)];  // (LS: one file)
   const std::string eol = !lines.empty() && !lines[0].empty() && lines[0].back() == '\r' ? "\r\n" : "\n";
   std::string positions;
   int next_p = 0;
@@ -98,9 +99,9 @@ void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTar
       value = "P[" + std::to_string(++next_p) + "]";
       positions += value + "{" + eol + "   GP1:" + eol + ls_position(old, ins.pose, ins.target) + eol + "};" + eol;
     }
-    before[mo.line] += mo.indent + mo.head + value + mo.tail + eol;
+    before[{mo.file, mo.line}] += mo.indent + mo.head + value + mo.tail + eol;
   }
-  for (const auto& [line, text] : before) lines[static_cast<size_t>(line - 1)].insert(0, text);
+  for (const auto& [at, text] : before) files[static_cast<size_t>(at.first)][static_cast<size_t>(at.second - 1)].insert(0, text);
   if (positions.empty()) return;
   for (std::string& l : lines)
     if (l.compare(0, 4, "/END") == 0) l.insert(0, positions);
@@ -109,25 +110,27 @@ void with_inserted_targets(const NativeProgram& p, const std::vector<InsertedTar
 // A module written to a file of another name takes that name where the controller ties the two: KRL
 // (the .src's first DEF or DEFFCT, the .dat's DEFDAT) and RAPID (MODULE). A name the controller would
 // not take is refused, naming --out and the rule. Names are compared as the controllers do, ignoring case.
-void rename_module(const NativeProgram& p, std::vector<std::vector<std::string>>& lines, const std::string& out_path) {
+void rename_module(const NativeProgram& p, std::vector<std::vector<std::string>>& lines,
+                   const std::vector<std::string>& out_paths) {
   const bool krl = p.format == ControllerFormat::Krl, ls = p.format == ControllerFormat::FanucLs;
-  if (!krl && !ls && p.format != ControllerFormat::Rapid) return;
-  // an LS program's /PROG name is upper case on the controller (its file name is the same name)
-  const std::string name = ls ? upper_case(ctl::stem_of(out_path)) : ctl::stem_of(out_path);
-  const size_t max_len = krl ? 24 : ls ? 36 : 32;
-  const char* language = krl ? "KRL" : ls ? "FANUC LS" : "RAPID";
+  if (!krl && !ls) return;  // (a RAPID module's name is not its file's)
+  const size_t max_len = krl ? 24 : 36;
+  const char* language = krl ? "KRL" : "FANUC LS";
   static const std::regex def_re(R"(^(\s*(?:GLOBAL\s+)?DEF\s+)(\w+))", std::regex::icase),
       fct_re(R"(^(\s*(?:GLOBAL\s+)?DEFFCT\s+\w+(?:\s*\[\s*\d*\s*\])?\s+)(\w+))", std::regex::icase),
-      dat_re(R"(^(\s*DEFDAT\s+)(\w+))", std::regex::icase), mod_re(R"(^(\s*MODULE\s+)(\w+))", std::regex::icase),
-      prog_re(R"(^(\s*/PROG\s+)(\w+))", std::regex::icase);
+      dat_re(R"(^(\s*DEFDAT\s+)(\w+))", std::regex::icase), prog_re(R"(^(\s*/PROG\s+)(\w+))", std::regex::icase);
   for (size_t f = 0; f < lines.size(); ++f) {
+    const std::string& out_path = out_paths[f];
+    // an LS program's /PROG name is upper case on the controller (its file name is the same name)
+    const std::string name = ls ? upper_case(ctl::stem_of(out_path)) : ctl::stem_of(out_path);
+    if (upper_case(name) == upper_case(ctl::stem_of(p.paths[f]))) continue;  // written under its own name
+    const bool dat = upper_case(p.paths[f]).size() >= 4 && upper_case(p.paths[f]).substr(p.paths[f].size() - 4) == ".DAT";
     for (std::string& l : lines[f]) {
-      const std::string code = ls ? l : code_before(l, krl ? ';' : '!');
+      const std::string code = ls ? l : code_before(l, ';');
       std::smatch m;
       const bool found = ls     ? std::regex_search(code, m, prog_re)
-                         : !krl ? std::regex_search(code, m, mod_re)
-                         : f == 0 ? std::regex_search(code, m, def_re) || std::regex_search(code, m, fct_re)
-                                  : std::regex_search(code, m, dat_re);
+                         : !dat ? std::regex_search(code, m, def_re) || std::regex_search(code, m, fct_re)
+                                : std::regex_search(code, m, dat_re);
       if (!found) continue;
       if (upper_case(m[2].str()) != upper_case(name)) {
         bool valid = !name.empty() && name.size() <= max_len && std::isalpha(static_cast<unsigned char>(name[0]));
@@ -149,7 +152,9 @@ void rename_module(const NativeProgram& p, std::vector<std::vector<std::string>>
 
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
                                              const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
-                                             const std::string& out_path, const std::vector<InsertedTarget>& inserted) {
+                                             const std::vector<std::string>& out_paths,
+                                             const std::vector<InsertedTarget>& inserted) {
+  if (out_paths.size() != p.paths.size()) throw InputError(p.paths[0] + ": an output path for every file read is needed");
   std::vector<std::vector<std::string>> lines = p.lines;
   struct Replacement {
     size_t begin, end;
@@ -162,6 +167,8 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
     const bool as_joints = k < joints.size() && joints[k];
     if (as_joints)
       for (const NativeEdit& e : nt.joint_edits) by_line[{e.file, e.line}].push_back({e.begin, e.end, e.text});
+    for (const NativeEdit& e : nt.edits) by_line[{e.file, e.line}].push_back({e.begin, e.end, e.text});
+    if (nt.copy_of >= 0) continue;  // declared on a line of its own, below
     auto& f = lines[static_cast<size_t>(nt.file)];
     if (nt.last_line <= nt.line) {
       const std::string& l = f[static_cast<size_t>(nt.line - 1)];
@@ -202,8 +209,44 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
     std::string& l = lines[static_cast<size_t>(key.first)][static_cast<size_t>(key.second - 1)];
     for (const Replacement& r : reps) l.replace(r.begin, r.end - r.begin, r.text);
   }
-  with_inserted_targets(p, inserted, lines[0]);
-  rename_module(p, lines, out_path);
+  // each copy on a new line after its original's declaration: the original's lines as read, with the copy's
+  // name and value (added to the end of the declaration's last line, so that no line number moves)
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    const NativeTarget& nt = p.targets[k];
+    if (nt.copy_of < 0) continue;
+    const NativeTarget& orig = p.targets[static_cast<size_t>(nt.copy_of)];
+    const auto& f = p.lines[static_cast<size_t>(orig.file)];
+    const int last = std::max(orig.line, orig.last_line);
+    std::string decl;
+    for (int l = orig.line; l <= last; ++l) decl += f[static_cast<size_t>(l - 1)] + (l < last ? "\n" : "");
+    const size_t end = decl.size() - f[static_cast<size_t>(last - 1)].size() + orig.end;
+    const std::string old = decl.substr(orig.begin, end - orig.begin);
+    const bool as_joints = k < joints.size() && joints[k];
+    std::string now;
+    if (p.format == ControllerFormat::Krl)
+      now = as_joints ? krl_axis(old, t[k].q_deg)
+                      : krl_aggregate(old, pose[k], t[k], upper_case(decl.substr(0, orig.begin)).find("FRAME") != std::string::npos);
+    else if (p.format == ControllerFormat::Rapid)
+      now = as_joints ? rapid_jointtarget(old, t[k].q_deg) : rapid_robtarget(old, pose[k], t[k]);
+    else
+      throw InputError(where(p.paths[static_cast<size_t>(orig.file)], orig.line) + ": a copy of a " +
+                       format_name(p.format) + " target is not written");
+    decl.replace(orig.begin, end - orig.begin, now);
+    // the name: its first whole word before the value
+    const std::string head = upper_case(decl.substr(0, orig.begin)), name = upper_case(orig.name);
+    size_t at = std::string::npos;
+    for (size_t i = head.find(name); i != std::string::npos; i = head.find(name, i + 1)) {
+      const auto word = [&](size_t c) { return c < head.size() && (std::isalnum(static_cast<unsigned char>(head[c])) || head[c] == '_'); };
+      if ((i == 0 || !word(i - 1)) && !word(i + name.size())) { at = i; break; }
+    }
+    if (at == std::string::npos)
+      throw InputError(where(p.paths[static_cast<size_t>(orig.file)], orig.line) + ": " + orig.name +
+                       "'s declaration does not name it");
+    decl.replace(at, name.size(), nt.name);
+    lines[static_cast<size_t>(orig.file)][static_cast<size_t>(last - 1)] += "\n" + decl;
+  }
+  with_inserted_targets(p, inserted, lines);
+  rename_module(p, lines, out_paths);
   std::vector<OutputFile> out;
   for (size_t f = 0; f < lines.size(); ++f) {
     std::string text;
@@ -212,8 +255,7 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
       if (i + 1 < lines[f].size() || p.final_newline[f]) text += '\n';
     }
     if (p.format == ControllerFormat::FanucLs && !inserted.empty()) text = ls_renumbered(text);
-    const std::string path = p.format == ControllerFormat::Krl ? ctl::with_ext(out_path, f == 0 ? ".src" : ".dat") : out_path;
-    out.push_back({path, text});
+    out.push_back({out_paths[f], text});
   }
   return out;
 }

@@ -23,6 +23,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace kincal {
 
@@ -45,5 +46,18 @@ void set_branch_data(const Robot& robot, ControllerTarget& t);
 /// when none or several different ones match.
 std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const ControllerTarget& t,
                                   std::string* why = nullptr);
+
+/// How joints q_deg sit against a taught target's branch data in format f (Krl, Rapid, FanucLs): `arm`
+/// when the arm, elbow and wrist choice differs (KUKA S, ABB cfx, FANUC F/N U/D T/B); `turns` the joints
+/// (0-based) whose turn differs (KUKA T bit, ABB cf1/cf4/cf6, FANUC turn numbers).
+struct BranchDifference {
+  bool arm = false;
+  std::vector<int> turns;
+};
+/// A target's branch data as the controller writes them: "S 6, T 50", "cfx 1, cf1 0, cf4 -1, cf6 0", "N U T, 0, 0, 0".
+std::string branch_text(ControllerFormat f, const ControllerTarget& t);
+
+BranchDifference branch_difference(const Robot& robot, ControllerFormat f, const ControllerTarget& taught,
+                                   const Vec6& q_deg);
 
 }  // namespace kincal

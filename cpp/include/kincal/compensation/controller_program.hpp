@@ -5,9 +5,12 @@
 
 #include "kincal/compensation/program.hpp"
 #include "kincal/io/controllers.hpp"
+#include "kincal/io/native.hpp"
 
+#include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,6 +31,15 @@ struct NativeOptions {
   /// one UF and one UT may use program_base / program_tool instead.
   std::map<int, Pose6> user_frames, user_tools;
   bool skip_unresolved = false;  ///< pass run-time targets through with a warning (else an error)
+  /// A taught target (with branch data) compensated off its taught solution (another arm, elbow or wrist
+  /// choice, or another turn that is not the compensation moving a joint across its border) is a warning,
+  /// not an error (--allow-branch-change).
+  bool allow_branch_change = false;
+  /// --track AXIS=X,Y,Z: external axis j (0-based, E1 = 0) is a linear track; one unit of it moves the robot's
+  /// base by this vector in the program's base frame (mm per mm). An external axis that varies without one is an error.
+  std::map<int, Vec3> track;
+  /// declarations the program may name without declaring them (a backup's other files, --declarations)
+  std::shared_ptr<const Declarations> context;
   /// --tolerance: targets inserted where the real robot's path between two targets leaves the desired
   /// segment by more (mm; kincal/compensation/tolerance.hpp); NaN: none inserted
   double tolerance_mm = std::numeric_limits<double>::quiet_NaN();
@@ -35,6 +47,9 @@ struct NativeOptions {
 
 /// Adds "N=X,Y,Z,A,B,C" (mm, deg) of `option` (--uframe, --utool) to `frames`, else InputError naming it.
 void add_numbered_frame(std::map<int, Pose6>& frames, const std::string& text, const std::string& option);
+
+/// Adds "--track AXIS=X,Y,Z" (AXIS: E1..E6) to `track`, else InputError naming it.
+void add_track_axis(std::map<int, Vec3>& track, const std::string& text);
 
 /// Reads a pose program (CSV or G-code; a KRL or RAPID program: see NativeOptions), compensates it and writes it in w.format (every file, or
 /// none when anything fails). A G-code program written as G-code joints keeps its other lines.
@@ -50,6 +65,13 @@ struct ControllerProgramResult {
   /// a native program: how many targets were written as joints and how many as filtered poses ("" otherwise)
   std::string targets_note;
 };
+/// A native program read (read_native_programs) compensated and written: file f of p.paths to out_of(f), every
+/// file or none. Its taught targets stay on their taught branch (NativeOptions::allow_branch_change).
+ControllerProgramResult compensate_native_program(const Robot& robot, const NativeProgram& p,
+                                                  const std::function<std::string(const std::string&)>& out_of,
+                                                  const ProgramOptions& opt, const WriterOptions& w,
+                                                  const NativeOptions& native);
+
 ControllerProgramResult compensate_to_controller(const Robot& robot, const std::string& in_path,
                                                  const std::string& out_path, const ProgramOptions& opt,
                                                  const WriterOptions& w, const NativeOptions& native = {});

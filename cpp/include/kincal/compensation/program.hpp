@@ -11,6 +11,7 @@
 #include "kincal/model/model.hpp"
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,8 @@ struct ProgramCursor {
   Vec6 prev;
   EffectContext ctx;
   bool first = true;
+  /// the next pose's reference when it is not prev (a taught target: its taught branch's nominal solution)
+  std::optional<Vec6> reference;
 };
 
 /// The next pose of a program (ctx.temperature_c set by the caller): solved with the directions the
@@ -105,13 +108,15 @@ inline constexpr const char* kNeedsTemperature =
     "the model has thermal expansion: give the temperature (--temperature C, or a temperature_c column)";
 
 /// IK + compensation of every pose in order, keeping the branch continuous (each pose starts from
-/// the IK solution nearest the previous result; the first from the robot's home). Backlash: every
+/// the IK solution nearest the previous result; the first from the robot's home; a pose with a reference
+/// in `references` from the solution nearest it: a taught target's branch). Backlash: every
 /// pose is compensated with the directions its own commanded motion has (motion_directions);
 /// thermal expansion: temperature_c per pose (or opt.temperature_c). The first pose that fails
 /// throws an InputError naming where[i] and the cause.
 ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& poses,
                                const std::vector<std::string>& where, const ProgramOptions& opt,
-                               const std::vector<double>& temperature_c = {});
+                               const std::vector<double>& temperature_c = {},
+                               const std::vector<std::optional<Vec6>>& references = {});
 
 /// Reads a pose program, compensates it and writes the joint program (CSV or G-code by the output
 /// file's extension). Nothing is written when any pose fails.

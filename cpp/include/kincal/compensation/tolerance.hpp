@@ -50,7 +50,8 @@ struct ToleranceResult {
 ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
                                           const std::vector<std::string>& where, const ProgramOptions& opt,
                                           const std::vector<double>& temperature_c, double tolerance_mm,
-                                          const std::vector<PathKind>& kinds);
+                                          const std::vector<PathKind>& kinds,
+                                          const std::vector<std::optional<Vec6>>& references = {});
 /// The same with one kind for every segment.
 ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<Pose6>& poses,
                                           const std::vector<std::string>& where, const ProgramOptions& opt,

@@ -144,11 +144,13 @@ struct InsertedTarget {
 /// The program with target k's value replaced: when joints[k], by the joints t[k].q_deg (KRL E6AXIS /
 /// AXIS, RAPID jointtarget, LS J1..J6, URScript [q1..q6] in rad; external axes kept) with the target's
 /// joint_edits; otherwise by pose[k] (in the program's frame) with the branch data of t[k] (KRL S and T,
-/// RAPID confdata, LS CONFIG). Every other byte unchanged but for the inserted targets' lines (an LS
-/// program's /MN lines are then renumbered, and its LINE_COUNT). Files go to out_path (KRL: its .src and .dat).
+/// RAPID confdata, LS CONFIG); a copy (copy_of) declared on a new line after its original's declaration;
+/// every target's `edits`. Every other byte unchanged but for the inserted targets' lines (an LS program's
+/// /MN lines are then renumbered, and its LINE_COUNT). File f of p.paths goes to out_paths[f]; a KRL module and
+/// an LS program take the name of their output file (the controller ties the two; RAPID does not).
 std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::vector<Pose6>& pose,
                                              const std::vector<ControllerTarget>& t, const std::vector<bool>& joints,
-                                             const std::string& out_path,
+                                             const std::vector<std::string>& out_paths,
                                              const std::vector<InsertedTarget>& inserted = {});
 
 /// Appends the file at path to p: its path, its lines (without the '\n') and whether it ends in '\n'.

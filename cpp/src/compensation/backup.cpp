@@ -1,0 +1,249 @@
+#include "kincal/compensation/backup.hpp"
+
+#include "kincal/io/file.hpp"
+#include "kincal/io/native.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <numeric>
+#include <set>
+#include <thread>
+
+namespace kincal {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string ext_of(const fs::path& p) { return lower(p.extension().string()); }
+
+// the language of a program file by its extension; Csv for a file kincal copies
+ControllerFormat language_of(const fs::path& p) {
+  const std::string e = ext_of(p);
+  if (e == ".src" || e == ".dat") return ControllerFormat::Krl;
+  if (e == ".mod" || e == ".modx" || e == ".sys") return ControllerFormat::Rapid;
+  if (e == ".ls") return ControllerFormat::FanucLs;
+  if (e == ".script") return ControllerFormat::UrScript;
+  return ControllerFormat::Csv;
+}
+
+// a RAPID module's task: the folder it stands in, or the one above a PROGMOD / SYSMOD folder
+std::string task_of(const fs::path& p) {
+  fs::path dir = p.parent_path();
+  const std::string name = lower(dir.filename().string());
+  if (name == "progmod" || name == "sysmod") dir = dir.parent_path();
+  return dir.string();
+}
+
+struct Input {
+  std::string path;  // as found
+  std::string rel;   // its path under out_dir
+};
+
+// every file under the inputs, with its place in the output tree
+std::vector<Input> files_of(const std::vector<std::string>& inputs, const std::string& out_dir) {
+  std::vector<Input> out;
+  const fs::path out_abs = fs::weakly_canonical(fs::path(out_dir));
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(in, ec);
+    if (ec || !fs::exists(st)) throw InputError(in + ": no such file or folder");
+    if (!fs::is_directory(st)) {
+      out.push_back({in, fs::path(in).filename().string()});
+      continue;
+    }
+    const fs::path root = fs::weakly_canonical(fs::path(in));
+    const std::string out_rel = fs::relative(out_abs, root).string();
+    if (!out_rel.empty() && out_rel.rfind("..", 0) != 0)
+      throw InputError("--out " + out_dir + ": inside the input folder " + in + " (give a folder beside it)");
+    const std::string prefix = inputs.size() == 1 ? "" : fs::path(in).lexically_normal().filename().string();
+    std::vector<Input> found;
+    for (auto it = fs::recursive_directory_iterator(in, fs::directory_options::none, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+      if (!it->is_regular_file()) continue;
+      const fs::path rel = fs::relative(it->path(), in);
+      found.push_back({it->path().string(), (prefix.empty() ? rel : fs::path(prefix) / rel).string()});
+    }
+    if (ec) throw InputError(in + ": " + ec.message());
+    std::sort(found.begin(), found.end(), [](const Input& a, const Input& b) { return a.rel < b.rel; });
+    out.insert(out.end(), found.begin(), found.end());
+  }
+  std::set<std::string> rels;
+  for (const Input& f : out)
+    if (!rels.insert(f.rel).second) throw InputError(f.path + ": two inputs give the output file " + f.rel);
+  return out;
+}
+
+struct UnionFind {
+  std::vector<size_t> parent;
+  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), size_t{0}); }
+  size_t find(size_t i) { return parent[i] == i ? i : parent[i] = find(parent[i]); }
+  void join(size_t a, size_t b) { parent[find(a)] = find(b); }
+};
+
+// runs f(i) for i in [0, n) on `threads` threads (0: every core); f catches its own errors
+void parallel_for(size_t n, int threads, const std::function<void(size_t)>& f) {
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const size_t k = std::min(n, static_cast<size_t>(threads > 0 ? static_cast<unsigned>(threads) : hw));
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i = next++; i < n; i = next++) f(i);
+  };
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < k; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+}  // namespace
+
+bool is_folder(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
+BackupResult compensate_backup(const Robot& robot, const std::vector<std::string>& inputs, const std::string& out_dir,
+                               const ProgramOptions& opt, const WriterOptions& w, const NativeOptions& native,
+                               const BackupOptions& b) {
+  if (inputs.empty()) throw InputError("--program: no input");
+  const std::vector<Input> files = files_of(inputs, out_dir);
+  std::map<std::string, std::string> rel_of;  // input path -> output path under out_dir
+  std::set<std::string> paths;
+  for (const Input& f : files) rel_of[f.path] = (fs::path(out_dir) / f.rel).string(), paths.insert(f.path);
+  // the declarations: KRL from every .dat, RAPID per task; plus --declarations
+  std::map<std::string, std::vector<std::string>> decl_files;  // "krl" or the RAPID task -> files
+  for (const Input& f : files) {
+    const ControllerFormat l = language_of(f.path);
+    if (l == ControllerFormat::Krl && ext_of(f.path) == ".dat") decl_files["krl"].push_back(f.path);
+    if (l == ControllerFormat::Rapid) decl_files["rapid:" + task_of(f.path)].push_back(f.path);
+  }
+  std::vector<std::string> extra_krl, extra_rapid;
+  for (const std::string& d : b.declarations) {
+    const ControllerFormat l = language_of(d);
+    if (l == ControllerFormat::Krl) extra_krl.push_back(d);
+    else if (l == ControllerFormat::Rapid) extra_rapid.push_back(d);
+    else throw InputError("--declarations " + d + ": a KRL .dat or a RAPID module (.mod, .modx, .sys)");
+  }
+  std::map<std::string, std::shared_ptr<const Declarations>> contexts;
+  for (auto& [key, list] : decl_files) {
+    const bool krl = key == "krl";
+    std::vector<std::string> all = krl ? extra_krl : extra_rapid;  // --declarations first: they win
+    all.insert(all.end(), list.begin(), list.end());
+    contexts[key] = std::make_shared<const Declarations>(
+        read_declarations(all, krl ? ControllerFormat::Krl : ControllerFormat::Rapid));
+  }
+  const auto context_of = [&](const std::string& path) -> std::shared_ptr<const Declarations> {
+    const ControllerFormat l = language_of(path);
+    const auto it = contexts.find(l == ControllerFormat::Krl ? "krl" : "rapid:" + task_of(path));
+    return it == contexts.end() ? nullptr : it->second;
+  };
+  // the programs: each program file alone first
+  std::vector<std::string> programs;
+  for (const Input& f : files) {
+    const ControllerFormat l = language_of(f.path);
+    if (l == ControllerFormat::Csv) continue;
+    if (l == ControllerFormat::Krl && ext_of(f.path) == ".dat") continue;  // read with its .src, or a data list
+    programs.push_back(f.path);
+  }
+  struct Read {
+    NativeProgram p;
+    std::string error;
+  };
+  std::vector<Read> alone(programs.size());
+  const auto read = [&](const std::vector<std::string>& ps) {
+    const auto ctx = context_of(ps[0]);
+    return read_native_programs(ps, language_of(ps[0]), ctx ? *ctx : Declarations());
+  };
+  parallel_for(programs.size(), b.threads, [&](size_t i) {
+    try {
+      alone[i].p = read({programs[i]});
+    } catch (const std::exception& e) {
+      alone[i].error = e.what();
+    }
+  });
+  // programs that write the same file (targets declared in a shared module) are read and written as one
+  std::map<std::string, size_t> owner;
+  UnionFind uf(programs.size());
+  for (size_t i = 0; i < programs.size(); ++i)
+    for (const std::string& f : alone[i].p.paths) {
+      const auto [it, fresh] = owner.emplace(f, i);
+      if (!fresh) uf.join(i, it->second);
+    }
+  std::map<size_t, std::vector<size_t>> groups;
+  for (size_t i = 0; i < programs.size(); ++i) groups[uf.find(i)].push_back(i);
+  BackupResult r;
+  std::vector<std::vector<size_t>> jobs;
+  for (auto& [root, members] : groups) jobs.push_back(members);
+  std::sort(jobs.begin(), jobs.end(), [&](const auto& x, const auto& y) { return programs[x[0]] < programs[y[0]]; });
+  r.programs.resize(jobs.size());
+  std::vector<char> copy_unchanged(jobs.size(), 0);
+  std::mutex progress_mutex;
+  size_t done = 0;
+  parallel_for(jobs.size(), b.threads, [&](size_t j) {
+    BackupProgram& out = r.programs[j];
+    for (const size_t i : jobs[j]) out.inputs.push_back(programs[i]);
+    try {
+      for (const size_t i : jobs[j])
+        if (!alone[i].error.empty()) throw InputError(alone[i].error);
+      NativeProgram p = jobs[j].size() == 1 ? std::move(alone[jobs[j][0]].p) : read(out.inputs);
+      if (p.targets.empty() && (p.unresolved.empty() || native.skip_unresolved)) {
+        copy_unchanged[j] = 1;  // joints only, or nothing to move: the file as it is
+        for (const auto& u : p.unresolved)
+          out.result.result.warnings.push_back(u.where + ": " + u.why + ", passed through unchanged: " + u.text);
+      } else {
+        for (const std::string& f : p.paths)
+          if (!rel_of.count(f))
+            throw InputError(f + ": targets of " + out.inputs[0] + " are declared here, outside the backup: kincal "
+                             "writes only the backup's files");
+        for (const std::string& f : p.paths) fs::create_directories(fs::path(rel_of.at(f)).parent_path());
+        WriterOptions wj = w;
+        wj.format = p.format;
+        out.result = compensate_native_program(robot, p, [&](const std::string& f) { return rel_of.at(f); }, opt, wj, native);
+      }
+    } catch (const std::exception& e) {
+      out.error = e.what();
+    }
+    if (b.progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      b.progress(++done, jobs.size());
+    }
+  });
+  // every other file copied unchanged: files no written program read, and programs with nothing to compensate
+  std::set<std::string> owned;
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    if (!r.programs[j].error.empty()) ++r.failed;
+    if (copy_unchanged[j]) continue;
+    for (const size_t i : jobs[j])
+      for (const std::string& f : alone[i].p.paths.empty() ? std::vector<std::string>{programs[i]} : alone[i].p.paths)
+        owned.insert(f);
+    for (const std::string& f : r.programs[j].inputs) owned.insert(f);
+    if (programs.size() && language_of(r.programs[j].inputs[0]) == ControllerFormat::Krl)
+      for (const std::string& in : r.programs[j].inputs) {  // a failed KRL program's .dat leaves no output either
+        fs::path dat = in;
+        dat.replace_extension(".dat");
+        owned.insert(dat.string());
+      }
+  }
+  for (const Input& f : files) {
+    if (owned.count(f.path)) continue;
+    const std::string to = rel_of.at(f.path);
+    fs::create_directories(fs::path(to).parent_path());
+    std::error_code ec;
+    fs::copy_file(f.path, to, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw InputError(to + ": cannot copy " + f.path + " (" + ec.message() + ")");
+    r.copied.push_back(to);
+  }
+  return r;
+}
+
+}  // namespace kincal

@@ -1,0 +1,102 @@
+"""A controller backup as the input of `kincal compensate` and `kincal-compensate` (issue 30, item 1): a folder
+of programs in every language kincal reads (tests/data/programs: tape.src + tape.dat, tape.mod, tape.ls,
+tape.script, placed in sub-folders as a backup has them) and files it does not read, filtered on the
+calibrated kr500 (conftest: 1 mm / 0.05 deg errors and compliance, seed 9). The same tree is written under
+--out: each program filtered exactly as it is filtered alone, every other file copied byte for byte. A
+program that fails (a malformed one) leaves no output of its own; the others are written, the failure is
+listed with file:line and the exit status is 1."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from conftest import run
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "programs"
+
+
+@pytest.fixture()
+def model(tmp_path, calibrated):
+    path = tmp_path / "m.json"
+    path.write_text(calibrated.to_json())
+    return path
+
+
+def _backup(root: Path) -> Path:
+    """A backup tree: KRL under KRC/R1/Program, RAPID under RAPID/TASK1/PROGMOD, LS and URScript beside, and
+    files kincal does not read (a README, a binary, a CSV of I/O names)."""
+    (root / "KRC" / "R1" / "Program").mkdir(parents=True)
+    (root / "RAPID" / "TASK1" / "PROGMOD").mkdir(parents=True)
+    (root / "fanuc").mkdir()
+    (root / "ur").mkdir()
+    for f in ("tape.src", "tape.dat"):
+        shutil.copy(DATA / f, root / "KRC" / "R1" / "Program" / f)
+    shutil.copy(DATA / "tape.mod", root / "RAPID" / "TASK1" / "PROGMOD" / "tape.mod")
+    shutil.copy(DATA / "tape.ls", root / "fanuc" / "tape.ls")
+    shutil.copy(DATA / "tape.script", root / "ur" / "tape.script")
+    (root / "README.txt").write_text("cell 4, backup of 2026-11-20\n")
+    (root / "KRC" / "R1" / "Program" / "logo.bin").write_bytes(bytes(range(256)) * 3)
+    (root / "RAPID" / "io_names.csv").write_text("name,signal\nclamp,do1\n")
+    return root
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_backup_folder_is_filtered_into_the_same_tree(tmp_path, model, tool):
+    backup = _backup(tmp_path / "backup")
+    out = tmp_path / "out"
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(backup), "--out", str(out), "--targets", "filtered",
+            "--skip-unresolved")
+    assert r.returncode == 0, r.stderr
+    assert "4 program(s) filtered, 3 file(s) copied unchanged, 0 program(s) failed" in r.stderr
+    inputs = sorted(p.relative_to(backup) for p in backup.rglob("*") if p.is_file())
+    assert sorted(p.relative_to(out) for p in out.rglob("*") if p.is_file()) == inputs
+    for rel in ("README.txt", "KRC/R1/Program/logo.bin", "RAPID/io_names.csv"):
+        assert (out / rel).read_bytes() == (backup / rel).read_bytes()
+    # each program exactly as filtered alone
+    alone = tmp_path / "alone"
+    alone.mkdir()
+    for rel in ("KRC/R1/Program/tape.src", "RAPID/TASK1/PROGMOD/tape.mod", "fanuc/tape.ls", "ur/tape.script"):
+        r1 = run(tool, *args, "--model", str(model), "--program", str(backup / rel), "--out",
+                 str(alone / Path(rel).name), "--targets", "filtered", "--skip-unresolved")
+        assert r1.returncode == 0, r1.stderr
+        assert (out / rel).read_text() == (alone / Path(rel).name).read_text(), rel
+        assert (out / rel).read_text() != (backup / rel).read_text(), rel
+    assert (out / "KRC/R1/Program/tape.dat").read_text() == (alone / "tape.dat").read_text()
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_a_failing_program_leaves_no_output_and_the_others_are_written(tmp_path, model, tool):
+    backup = _backup(tmp_path / "backup")
+    bad = backup / "RAPID" / "TASK1" / "PROGMOD" / "tape.mod"
+    bad.write_text(bad.read_text().replace("ENDMODULE", "! (ENDMODULE lost)"))
+    (backup / "fanuc" / "tape.ls").rename(backup / "fanuc" / "TAPE2.LS")  # upper-case extensions are read too
+    out = tmp_path / "out"
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(backup), "--out", str(out), "--targets", "filtered",
+            "--skip-unresolved")
+    assert r.returncode == 1
+    assert "3 program(s) filtered" in r.stderr and "1 program(s) failed" in r.stderr
+    assert f"{bad}:" in r.stderr and "MODULE is not closed by ENDMODULE" in r.stderr
+    assert not (out / "RAPID" / "TASK1" / "PROGMOD" / "tape.mod").exists()
+    for rel in ("KRC/R1/Program/tape.src", "KRC/R1/Program/tape.dat", "fanuc/TAPE2.LS", "ur/tape.script",
+                "README.txt"):
+        assert (out / rel).exists(), rel
+    assert not list(out.rglob("*.tmp*"))
+
+
+def test_several_files_and_out_inside_the_input_refused(tmp_path, model):
+    backup = _backup(tmp_path / "backup")
+    out = tmp_path / "out"
+    r = run("kincal", "compensate", "--model", str(model), "--program", str(backup / "fanuc" / "tape.ls"),
+            str(backup / "ur" / "tape.script"), "--out", str(out), "--targets", "filtered", "--skip-unresolved")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["tape.ls", "tape.script"]
+    r = run("kincal", "compensate", "--model", str(model), "--program", str(backup), "--out", str(backup / "filtered"),
+            "--targets", "filtered")
+    assert r.returncode == 1
+    assert "inside the input folder" in r.stderr
+    assert not (backup / "filtered").exists()

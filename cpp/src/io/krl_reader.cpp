@@ -63,11 +63,11 @@ int bits(const std::string& key, const std::string& val, const std::string& at) 
     char* end = nullptr;
     const std::string digits = val.substr(2, val.size() - 3);
     const long v = std::strtol(digits.c_str(), &end, radix == 'B' ? 2 : 16);
-    if ((radix == 'B' || radix == 'H') && !digits.empty() && *end == '\0') return static_cast<int>(v);
+    if ((radix == 'B' || radix == 'H') && !digits.empty() && digits.size() < 16 && *end == '\0') return static_cast<int>(v);
     throw InputError(at + ": " + key + " " + val + " is not a number");
   }
   const double v = number(key, val, at);
-  if (v != std::floor(v) || v < 0) throw InputError(at + ": " + key + " '" + val + "' is not a whole number");
+  if (v != std::floor(v) || v < 0 || v > 1e6) throw InputError(at + ": " + key + " '" + val + "' is not a whole number");
   return static_cast<int>(v);
 }
 
@@ -516,9 +516,8 @@ class KrlReader {
     FrameState s, block;  // the program's frames (tool 0, base 0 at its start); a spline block's
     std::string open;      // the spline block open, "" when none
     int open_line = 0;
-    const auto& lines = p.lines[static_cast<size_t>(f)];
-    for (size_t i = 0; i < lines.size(); ++i) {
-      const std::string code = code_of(lines[i]), w = at(f, i);
+    for (size_t i = 0; i < p.lines[static_cast<size_t>(f)].size(); ++i) {  // (a target's file may join p.lines)
+      const std::string code = code_of(p.lines[static_cast<size_t>(f)][i]), w = at(f, i);
       std::smatch m;
       if (std::regex_match(code, m, block_re)) {
         if (!open.empty()) throw InputError(w + ": " + upper_case(m[1].str()) + " inside the " + open + " block of line " + std::to_string(open_line));
@@ -570,6 +569,7 @@ class KrlReader {
     for (size_t a = 0; a < n; ++a) {
       auto [b, e] = args[a];
       std::string text = code.substr(b, e - b);
+      if (text.empty()) throw InputError(w + ": " + kw + " needs a target");
       std::smatch ap;
       const size_t brace = text[0] == '{' ? text.find('}') : 0;
       if (std::regex_search(text.cbegin() + static_cast<long>(brace == std::string::npos ? 0 : brace), text.cend(), ap, kApprox))
@@ -580,7 +580,6 @@ class KrlReader {
         if (a == 0) unresolved(w, code, "a relative motion (" + kw + "): its target depends on where the robot is");
         continue;
       }
-      if (text.empty()) throw InputError(w + ": " + kw + " needs a target");
       resolve(f, i, code, b, text, s);
     }
   }

@@ -237,7 +237,13 @@ TEST(KrlReader, KrlMissingToolDataIsAnError) {
       << e;
   const std::string b = error_of([] { read_native_program(krl("b", "$BASE = BASE_DATA[1]\nLIN {" + kPose + "}\n"), ControllerFormat::Krl); });
   EXPECT_NE(b.find("b.src:3: the motion's base BASE_DATA[1] is not declared"), std::string::npos) << b;
-  // joints need no frame
+  // an FDAT declared nowhere: the same, at the first Cartesian motion in its frames; joints need no frame
+  const std::string with = " WITH $TOOL = STOOL2(FHOME), $BASE = SBASE(FHOME.BASE_NO), $IPO_MODE = SIPO_MODE(FHOME.IPO_FRAME)\n";
+  const std::string f = error_of([&] {
+    read_native_program(krl("f", "SPTP {A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0}" + with + "SLIN {" + kPose + "}" + with),
+                        ControllerFormat::Krl);
+  });
+  EXPECT_NE(f.find("f.src:3: the FDAT FHOME is not declared: give the backup's $config.dat or --declarations"), std::string::npos) << f;
   EXPECT_NO_THROW(read_native_program(krl("j", "BAS(#TOOL,3)\nPTP {A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0}\n"), ControllerFormat::Krl));
 }
 

@@ -210,7 +210,7 @@ struct Decl {
 // A tool or base as the program sets it: key "" (tool 0 / base 0 / $NULLFRAME), "TOOL_DATA[2]", "BASE_DATA[1]"
 // or a FRAME's name; why: set at run time (kincal cannot know it).
 struct FrameRef {
-  std::string key, why;
+  std::string key, why, error;  // error: an FDAT the files do not declare (raised at a Cartesian motion)
 };
 struct FrameState {
   FrameRef tool, base;
@@ -319,16 +319,18 @@ class KrlReader {
     return true;
   }
 
-  std::map<std::string, std::string> fdat(const std::string& name, const std::string& where_) const {
+  // an FDAT's fields; none ("" for every field, missing set) when the files do not declare it
+  std::map<std::string, std::string> fdat(const std::string& name, std::string& missing) const {
     Decl d;
-    if (!lookup(name, d) || d.type != "FDAT" || d.value.empty())
-      throw InputError(where_ + ": the FDAT " + name + " is not declared: give the backup's $config.dat or --declarations");
-    return fields_of(d.value);
+    if (lookup(name, d) && d.type == "FDAT" && !d.value.empty()) return fields_of(d.value);
+    missing = "the FDAT " + name + " is not declared: give the backup's $config.dat or --declarations";
+    return {};
   }
 
-  FrameRef numbered(const std::string& kind, const std::string& n, const std::string& where_) const {
+  FrameRef numbered(const std::string& kind, const std::string& n, const std::string& where_, const std::string& missing = "") const {
+    if (!missing.empty()) return {"", "", missing};
     const int k = static_cast<int>(bits(kind + "_NO", n, where_));
-    return {k == 0 ? "" : kind + "_DATA[" + std::to_string(k) + "]", ""};
+    return {k == 0 ? "" : kind + "_DATA[" + std::to_string(k) + "]", "", ""};
   }
 
   // The frame of `$TOOL = rhs` (kind TOOL) or `$BASE = rhs` (BASE)
@@ -338,21 +340,23 @@ class KrlReader {
         sbase(R"(SBASE\s*\(\s*(\w+)\s*\.\s*BASE_NO\s*\))"), word(R"(\w+)");
     std::smatch m;
     Decl d;
+    std::string missing;
     if (rhs == "$NULLFRAME") return {};
     if (std::regex_match(rhs, m, data)) return numbered(m[1].str(), m[2].str(), where_);
-    if (std::regex_match(rhs, m, stool)) return numbered("TOOL", fdat(m[1].str(), where_)["TOOL_NO"], where_);
-    if (std::regex_match(rhs, m, sbase)) return numbered("BASE", fdat(m[1].str(), where_)["BASE_NO"], where_);
+    if (std::regex_match(rhs, m, stool)) return numbered("TOOL", fdat(m[1].str(), missing)["TOOL_NO"], where_, missing);
+    if (std::regex_match(rhs, m, sbase)) return numbered("BASE", fdat(m[1].str(), missing)["BASE_NO"], where_, missing);
     if (std::regex_match(rhs, m, word) && lookup(rhs, d) && d.type == "FRAME" && !d.value.empty() && !d.run_time)
-      return {rhs, ""};
-    return {"", "$" + kind + " = " + trim(rhs_) + " is set at run time"};
+      return {rhs, "", ""};
+    return {"", "$" + kind + " = " + trim(rhs_) + " is set at run time", ""};
   }
 
   void apply_fdat(FrameState& s, const std::string& where_) const {
     if (s.fdat.empty()) return;  // FDAT_ACT as a program before this one left it: the frames stay
-    auto f = fdat(s.fdat, where_);
-    s.tool = numbered("TOOL", f["TOOL_NO"], where_);
-    s.base = numbered("BASE", f["BASE_NO"], where_);
-    if (!f["IPO_FRAME"].empty()) s.ipo = upper_case(f["IPO_FRAME"]);
+    std::string missing;
+    auto f = fdat(s.fdat, missing);
+    s.tool = numbered("TOOL", f["TOOL_NO"], where_, missing);
+    s.base = numbered("BASE", f["BASE_NO"], where_, missing);
+    s.ipo = missing.empty() ? upper_case(f["IPO_FRAME"].empty() ? "#BASE" : f["IPO_FRAME"]) : "!" + missing;
   }
 
   void assign(FrameState& s, const std::string& lhs, const std::string& rhs, const std::string& where_) const {
@@ -362,8 +366,13 @@ class KrlReader {
     if (l == "$TOOL") s.tool = frame_of(rhs, "TOOL", where_);
     if (l == "$BASE") s.base = frame_of(rhs, "BASE", where_);
     if (l == "FDAT_ACT") s.fdat = upper_case(trim(rhs));
-    if (l == "$IPO_MODE")
-      s.ipo = std::regex_match(r, m, sipo) ? upper_case(fdat(m[1].str(), where_)["IPO_FRAME"]) : upper_case(r);
+    std::string missing;
+    if (l == "$IPO_MODE" && std::regex_match(r, m, sipo)) {
+      const std::string ipo = upper_case(fdat(m[1].str(), missing)["IPO_FRAME"]);
+      s.ipo = !missing.empty() ? "!" + missing : ipo.empty() ? "#BASE" : ipo;
+    } else if (l == "$IPO_MODE") {
+      s.ipo = upper_case(r);
+    }
   }
 
   // The assignments of a WITH list (each item up to an approximation C_SPL, C_DIS, ...)
@@ -393,6 +402,8 @@ class KrlReader {
 
   Frames frames_at(const FrameState& s, const std::string& where_) const {
     Frames fr;
+    for (const std::string& e : {s.tool.error, s.base.error, s.ipo[0] == '!' ? s.ipo.substr(1) : std::string()})
+      if (!e.empty()) throw InputError(where_ + ": " + e);
     if (!s.tool.why.empty() || !s.base.why.empty()) {
       fr.why = "its " + std::string(s.tool.why.empty() ? "base" : "tool") + " is not known before run time (" +
                (s.tool.why.empty() ? s.base.why : s.tool.why) + ")";
@@ -418,6 +429,7 @@ class KrlReader {
     const bool joint = mo.kind == 'J';
     if (top_colon(text)) return unresolved(w, code, "a geometric operator (" + text + "): computed at run time");
     if (text[0] == '{') {
+      if (text.back() != '}') throw InputError(w + ": the aggregate " + text + " is not closed by }");
       const Aggregate a = read_aggregate(text, w);
       if (a.joints) return;  // axis values: joints, as written
       if (!a.missing.empty())
@@ -592,38 +604,6 @@ NativeProgram read_krl_program(const std::vector<std::string>& src_paths, const 
   for (const std::string& src : src_paths) r.read_program(src);
   keep_named_targets_cartesian(r.p, ';', true);
   return std::move(r.p);
-}
-
-// a KRL aggregate with X..C, S and T replaced (every other field kept as written)
-std::string krl_aggregate(const std::string& old, const Pose6& pose, const ControllerTarget& t, bool is_frame) {
-  std::vector<std::string> items = split_top(old.substr(1, old.size() - 2));
-  const double v[6] = {pose.xyz[0], pose.xyz[1], pose.xyz[2], pose.abc[0], pose.abc[1], pose.abc[2]};
-  bool has_s = false, has_t = false;
-  for (std::string& item : items) {
-    size_t k = 0;
-    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
-    const std::string key = upper_case(item.substr(0, k));
-    const std::string sep = item.substr(k, item.find_first_not_of(" \t", k) - k);
-    const std::string name = item.substr(0, k);
-    for (int f = 0; f < 6; ++f)
-      if (key == std::string(1, "XYZABC"[f])) item = name + sep + ctl::fixed(v[f], f < 3 ? 4 : 6);
-    if (key == "S") item = name + sep + std::to_string(t.kuka_s), has_s = true;
-    if (key == "T") item = name + sep + std::to_string(t.kuka_t), has_t = true;
-  }
-  std::string out = "{";
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + items[i];
-  if (!is_frame && !has_s) out += ",S " + std::to_string(t.kuka_s);
-  if (!is_frame && !has_t) out += ",T " + std::to_string(t.kuka_t);
-  return out + "}";
-}
-
-// a KRL aggregate of a Cartesian target as an axis target {A1 .., .., A6 ..}, its external axes E1..E6 kept
-std::string krl_axis(const std::string& old, const Vec6& q_deg) {
-  std::string out = "{";
-  for (int j = 0; j < 6; ++j) out += std::string(j ? "," : "") + "A" + std::to_string(j + 1) + " " + ctl::fixed(q_deg[j], ctl::kJointDecimals);
-  for (const std::string& item : split_top(old.substr(1, old.size() - 2)))
-    if (std::regex_match(item, std::regex(R"(E[1-6]\b.*)", std::regex::icase))) out += "," + item;
-  return out + "}";
 }
 
 }  // namespace kincal

@@ -3,6 +3,10 @@
 // Names: up to 24 characters (letters, digits, '_'); a module's files carry its name. A program with
 // more targets than a file takes is split into NAME_1, NAME_2, ... that NAME calls in turn.
 #include "controller_writers.hpp"
+#include "kincal/io/native.hpp"
+
+#include <cctype>
+#include <regex>
 
 #include <cstdio>
 
@@ -80,3 +84,41 @@ std::vector<OutputFile> write_krl(const std::string& out, const std::vector<Cont
 }
 
 }  // namespace kincal::ctl
+
+namespace kincal {
+
+// The values of a read program written back (native.cpp): KRL aggregates.
+
+// a KRL aggregate with X..C, S and T replaced (every other field kept as written)
+std::string krl_aggregate(const std::string& old, const Pose6& pose, const ControllerTarget& t, bool is_frame) {
+  std::vector<std::string> items = split_top(old.substr(1, old.size() - 2));
+  const double v[6] = {pose.xyz[0], pose.xyz[1], pose.xyz[2], pose.abc[0], pose.abc[1], pose.abc[2]};
+  bool has_s = false, has_t = false;
+  for (std::string& item : items) {
+    size_t k = 0;
+    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
+    const std::string key = upper_case(item.substr(0, k));
+    const std::string sep = item.substr(k, item.find_first_not_of(" \t", k) - k);
+    const std::string name = item.substr(0, k);
+    for (int f = 0; f < 6; ++f)
+      if (key == std::string(1, "XYZABC"[f])) item = name + sep + ctl::fixed(v[f], f < 3 ? 4 : 6);
+    if (key == "S") item = name + sep + std::to_string(t.kuka_s), has_s = true;
+    if (key == "T") item = name + sep + std::to_string(t.kuka_t), has_t = true;
+  }
+  std::string out = "{";
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + items[i];
+  if (!is_frame && !has_s) out += ",S " + std::to_string(t.kuka_s);
+  if (!is_frame && !has_t) out += ",T " + std::to_string(t.kuka_t);
+  return out + "}";
+}
+
+// a KRL aggregate of a Cartesian target as an axis target {A1 .., .., A6 ..}, its external axes E1..E6 kept
+std::string krl_axis(const std::string& old, const Vec6& q_deg) {
+  std::string out = "{";
+  for (int j = 0; j < 6; ++j) out += std::string(j ? "," : "") + "A" + std::to_string(j + 1) + " " + ctl::fixed(q_deg[j], ctl::kJointDecimals);
+  for (const std::string& item : split_top(old.substr(1, old.size() - 2)))
+    if (std::regex_match(item, std::regex(R"(E[1-6]\b.*)", std::regex::icase))) out += "," + item;
+  return out + "}";
+}
+
+}  // namespace kincal

@@ -1,228 +1,609 @@
-// kincal: KRL programs read in (.src with its .dat): DEF/END and DEFDAT/ENDDAT checked, the POS,
-// E6POS and FRAME declarations, and the motions PTP, LIN, CIRC (and SPTP, SLIN, SCIRC) to declared
-// names or inline aggregates. A target assigned in the program, a geometric operator (A:B), a _REL
-// motion are unresolved; E6AXIS / AXIS targets are joints and stay as they are.
+// kincal: KRL programs read in: each .src with its .dat (DEF/END, DEFDAT/ENDDAT checked), names the
+// program does not declare looked up in a backup's declarations ($config.dat, other data lists' DECL
+// GLOBAL). Motions: PTP/LIN/CIRC (C_PTP, C_DIS, C_VEL, C_ORI, CA), SPTP/SLIN/SCIRC with WITH, SPLINE and
+// PTP_SPLINE blocks of SPL/SLIN/SCIRC/SPTP segments. Each motion's tool and base are followed in file order
+// (FDAT_ACT applied by BAS(#PTP_PARAMS / #CP_PARAMS / #FRAMES), BAS(#TOOL / #BASE), $TOOL=, $BASE=,
+// $IPO_MODE=, and a motion's own WITH $TOOL=STOOL2(FP1), ...); a declared target used in a second frame gets
+// a copy. Run-time targets (assigned in the program, A:B, $POS_ACT, *_REL, declared nowhere) are unresolved
+// with why; E6AXIS / AXIS targets are joints and stay as they are.
 #include "controller_writers.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/native.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <regex>
-#include <tuple>
+#include <set>
 
 namespace kincal {
 
 namespace {
 
 std::string code_of(const std::string& l) { return code_before(l, ';'); }
+std::string trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
+  return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+}
+bool is_pos(const std::string& t) { return t == "E6POS" || t == "POS" || t == "FRAME"; }
+bool is_axis(const std::string& t) { return t == "E6AXIS" || t == "AXIS"; }
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+const std::regex kDecl(R"(^\s*(?:DECL\s+)?(GLOBAL\s+)?(E6POS|POS|FRAME|E6AXIS|AXIS|FDAT|PDAT|LDAT)\s+(\w+)\s*(?:=\s*(\{.*\}))?\s*$)",
+                       std::regex::icase);
+const std::regex kElement(R"(^\s*\$?((?:TOOL|BASE)_DATA)\s*\[\s*(\d+)\s*\]\s*=\s*(\{.*\})\s*$)", std::regex::icase);
+const std::regex kAssign(R"(^\s*(\$?\w+)(\.\w+)?\s*=(?!=)\s*(.*?)\s*$)");
+const std::regex kApprox(R"(\s+C_(PTP|DIS|VEL|ORI|SPL)\b)", std::regex::icase);
+
+// The fields of an aggregate "{X 1,Y 2,S 'B110',...}" by upper-case key, values trimmed.
+std::map<std::string, std::string> fields_of(const std::string& agg) {
+  std::map<std::string, std::string> out;
+  for (const std::string& item : split_top(agg.substr(1, agg.size() - 2))) {
+    size_t k = 0;
+    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
+    out[upper_case(item.substr(0, k))] = trim(item.substr(k));
+  }
+  return out;
+}
+
+double number(const std::string& key, const std::string& val, const std::string& at) {
+  char* end = nullptr;
+  const double v = std::strtod(val.c_str(), &end);
+  if (val.empty() || end == val.c_str() || *end != '\0' || !std::isfinite(v))
+    throw InputError(at + ": " + key + " '" + val + "' is not a number");
+  return v;
+}
+
+// S and T: a number or a KRL bit / hex literal 'B110', 'H1F'
+int bits(const std::string& key, const std::string& val, const std::string& at) {
+  if (val.size() >= 3 && val.front() == '\'' && val.back() == '\'') {
+    const char radix = static_cast<char>(std::toupper(static_cast<unsigned char>(val[1])));
+    char* end = nullptr;
+    const std::string digits = val.substr(2, val.size() - 3);
+    const long v = std::strtol(digits.c_str(), &end, radix == 'B' ? 2 : 16);
+    if ((radix == 'B' || radix == 'H') && !digits.empty() && digits.size() < 16 && *end == '\0') return static_cast<int>(v);
+    throw InputError(at + ": " + key + " " + val + " is not a number");
+  }
+  const double v = number(key, val, at);
+  if (v != std::floor(v) || v < 0 || v > 1e6) throw InputError(at + ": " + key + " '" + val + "' is not a whole number");
+  return static_cast<int>(v);
+}
+
+struct Aggregate {
+  Pose6 pose;
+  std::string missing;  // the first of X..C it does not give
+  bool joints = false;  // A1..A6
+  std::optional<ControllerTarget> taught;
+  std::array<double, 6> external{{kNaN, kNaN, kNaN, kNaN, kNaN, kNaN}};
+};
+
+Aggregate read_aggregate(const std::string& agg, const std::string& at) {
+  Aggregate a;
+  bool seen[6] = {false, false, false, false, false, false};
+  int s = -1, t = -1;
+  for (const auto& [key, val] : fields_of(agg)) {
+    for (int f = 0; f < 6; ++f) {
+      if (key == std::string(1, "XYZABC"[f])) (f < 3 ? a.pose.xyz : a.pose.abc)[f % 3] = number(key, val, at), seen[f] = true;
+      if (key == "A" + std::to_string(f + 1)) a.joints = true;
+      if (key == "E" + std::to_string(f + 1)) a.external[static_cast<size_t>(f)] = number(key, val, at);
+    }
+    if (key == "S") s = bits(key, val, at);
+    if (key == "T") t = bits(key, val, at);
+  }
+  for (int f = 5; f >= 0; --f)
+    if (!seen[f]) a.missing = std::string(1, "XYZABC"[f]);
+  if (s >= 0 && t >= 0) {
+    a.taught = ControllerTarget{};
+    a.taught->kuka_s = s;
+    a.taught->kuka_t = t;
+  }
+  return a;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  std::error_code ec;
+  return std::filesystem::equivalent(a, b, ec) && !ec;
+}
+
+// The spans of the top-level comma-separated parts of code[from, to), trimmed.
+std::vector<std::pair<size_t, size_t>> top_args(const std::string& code, size_t from, size_t to) {
+  std::vector<std::pair<size_t, size_t>> out;
+  int depth = 0;
+  bool str = false;
+  size_t b = from;
+  for (size_t i = from; i <= to; ++i) {
+    const char c = i < to ? code[i] : ',';
+    if (c == '"') str = !str;
+    if (!str && (c == '{' || c == '[' || c == '(')) ++depth;
+    if (!str && (c == '}' || c == ']' || c == ')')) --depth;
+    if (str || depth != 0 || c != ',') continue;
+    size_t x = b, y = i;
+    while (x < y && std::isspace(static_cast<unsigned char>(code[x]))) ++x;
+    while (y > x && std::isspace(static_cast<unsigned char>(code[y - 1]))) --y;
+    out.emplace_back(x, y);
+    b = i + 1;
+  }
+  return out;
+}
+
+// Where the word WITH stands in code from `from` on, outside brackets and strings; npos when nowhere.
+size_t with_at(const std::string& code, size_t from) {
+  const std::string up = upper_case(code);
+  int depth = 0;
+  bool str = false;
+  auto word = [&](size_t i) { return i < up.size() && (std::isalnum(static_cast<unsigned char>(up[i])) || up[i] == '_'); };
+  for (size_t i = from; i < up.size(); ++i) {
+    if (up[i] == '"') str = !str;
+    if (!str && (up[i] == '{' || up[i] == '[' || up[i] == '(')) ++depth;
+    if (!str && (up[i] == '}' || up[i] == ']' || up[i] == ')')) --depth;
+    if (!str && depth == 0 && up.compare(i, 4, "WITH") == 0 && (i == 0 || !word(i - 1)) && !word(i + 4)) return i;
+  }
+  return std::string::npos;
+}
+
+bool top_colon(const std::string& s) {
+  int depth = 0;
+  for (char c : s) {
+    depth += (c == '{' || c == '(' || c == '[') - (c == '}' || c == ')' || c == ']');
+    if (c == ':' && depth == 0) return true;
+  }
+  return false;
+}
+
+std::string file_name(const std::string& path) { return path.substr(path.find_last_of("/\\") + 1); }
 
 }  // namespace
 
+Declarations read_krl_declarations(const std::vector<std::string>& paths) {
+  Declarations d;
+  std::vector<std::string> assigned;
+  for (const std::string& path : paths) {
+    const std::string name = upper_case(file_name(path));
+    const bool config = name == "$CONFIG.DAT", src = name.size() > 4 && name.compare(name.size() - 4, 4, ".SRC") == 0;
+    if (!src && (name.size() < 4 || name.compare(name.size() - 4, 4, ".DAT") != 0)) continue;
+    const std::string text = read_text_file(path);
+    size_t b = 0;
+    for (int line = 1; b <= text.size(); ++line) {
+      size_t e = text.find('\n', b);
+      if (e == std::string::npos) e = text.size();
+      const std::string code = code_of(text.substr(b, e - b));
+      b = e + 1;
+      std::smatch m;
+      if (src) {
+        if (std::regex_search(code, m, kAssign)) assigned.push_back(upper_case(m[1].str()));
+        continue;
+      }
+      Declaration decl;
+      decl.path = path;
+      decl.line = line;
+      if (std::regex_match(code, m, kDecl) && (config || m[1].matched)) {
+        decl.type = upper_case(m[2].str());
+        decl.name = m[3].str();
+        decl.value = m[4].str();
+      } else if (config && std::regex_match(code, m, kElement)) {
+        decl.type = "FRAME";
+        decl.name = upper_case(m[1].str()) + "[" + std::to_string(std::stoi(m[2].str())) + "]";
+        decl.value = m[3].str();
+      } else {
+        continue;
+      }
+      d.named.emplace(upper_case(decl.name), decl);  // the first declaration of a name wins
+    }
+  }
+  for (const std::string& n : assigned)
+    if (auto it = d.named.find(n); it != d.named.end()) it->second.run_time = true;
+  return d;
+}
 
 namespace {
 
 struct Decl {
-  std::string type;
-  int file = 0, line = 0;
-  size_t begin = 0, end = 0;
-  size_t type_begin = 0, type_end = 0;  // the type's span
-  bool has_value = false, assigned = false;
+  std::string type, name, value, path;  // name as written
+  int file = -1, line = 0;               // file: index in p.paths, -1 while in the context only
+  size_t begin = 0, end = 0, type_begin = 0, type_end = 0;
+  bool run_time = false;
 };
 
-// the numbers X Y Z A B C of a KRL aggregate "{X 1,Y 2,...}"
-Pose6 parse_aggregate(const std::string& agg, const std::string& at) {
-  Pose6 p;
-  bool seen[6] = {false, false, false, false, false, false};
-  for (const std::string& item : split_top(agg.substr(1, agg.size() - 2))) {
-    size_t k = 0;
-    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
-    const std::string key = upper_case(item.substr(0, k));
-    std::string val = item.substr(k);
-    val.erase(0, val.find_first_not_of(" \t"));
-    static const char* keys[6] = {"X", "Y", "Z", "A", "B", "C"};
-    for (int f = 0; f < 6; ++f) {
-      if (key != keys[f]) continue;
-      char* end = nullptr;
-      const double v = std::strtod(val.c_str(), &end);
-      if (val.empty() || end == val.c_str() || *end != '\0' || !std::isfinite(v))
-        throw InputError(at + ": " + key + " '" + val + "' is not a number");
-      (f < 3 ? p.xyz : p.abc)[f % 3] = v;
-      seen[f] = true;
+// A tool or base as the program sets it: key "" (tool 0 / base 0 / $NULLFRAME), "TOOL_DATA[2]", "BASE_DATA[1]"
+// or a FRAME's name; why: set at run time (kincal cannot know it).
+struct FrameRef {
+  std::string key, why, error;  // error: an FDAT the files do not declare (raised at a Cartesian motion)
+};
+struct FrameState {
+  FrameRef tool, base;
+  std::string ipo = "#BASE", fdat;  // $IPO_MODE; FDAT_ACT's value, applied by BAS
+};
+
+class KrlReader {
+ public:
+  explicit KrlReader(const Declarations& context) : context_(context) {
+    p.format = ControllerFormat::Krl;
+    for (const auto& [name, d] : context.named) taken_.insert(name);
+  }
+
+  void read_program(const std::string& src_path) {
+    prog_ = static_cast<int>(own_.size());
+    own_.emplace_back();
+    assigned_.emplace_back();
+    const int src = add(src_path);
+    const std::string dat_path = ctl::with_ext(src_path, ".dat");
+    if (FILE* f = std::fopen(dat_path.c_str(), "rb")) {
+      std::fclose(f);
+      scan(add(dat_path), true);
     }
+    scan(src, false);
+    motions(src);
   }
-  for (int f = 0; f < 6; ++f)
-    if (!seen[f]) throw InputError(at + ": the target has no " + std::string(1, "XYZABC"[f]) + " value");
-  return p;
-}
 
-}  // namespace
-
-
-Declarations read_krl_declarations(const std::vector<std::string>&) { return {}; }  // (being written)
-
-NativeProgram read_krl_program(const std::vector<std::string>& src_paths, const Declarations&) {
-  const std::string& src_path = src_paths[0];
   NativeProgram p;
-  p.format = ControllerFormat::Krl;
-  add_program_file(p, src_path);
-  const std::string dat_path = ctl::with_ext(src_path, ".dat");
-  if (FILE* f = std::fopen(dat_path.c_str(), "rb")) {
-    std::fclose(f);
-    add_program_file(p, dat_path);
+
+ private:
+  const Declarations& context_;
+  int prog_ = 0;
+  std::vector<std::map<std::string, Decl>> own_;     // per program: its .src's and .dat's declarations
+  std::vector<std::set<std::string>> assigned_;      // per program: the names its .src assigns
+  std::set<std::string> taken_;                      // every declared name (copies take new ones)
+  std::map<std::string, std::map<std::string, int>> uses_;  // declared target -> frame key -> target
+  std::map<std::string, Decl> located_;              // context targets placed in p
+
+  int add(const std::string& path) {
+    for (size_t f = 0; f < p.paths.size(); ++f)
+      if (same_file(p.paths[f], path)) return static_cast<int>(f);
+    add_program_file(p, path);
+    return static_cast<int>(p.paths.size() - 1);
   }
-  static const std::regex decl_re(
-      R"(^\s*(?:DECL\s+)?(?:GLOBAL\s+)?(E6POS|POS|FRAME|E6AXIS|AXIS)\s+(\w+)\s*(=\s*(\{.*\}))?\s*$)", std::regex::icase);
-  static const std::regex assign_re(R"(^\s*(\w+)(\.\w+)?\s*=)");
-  static const std::regex motion_re(R"(^\s*(PTP|LIN|CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL)\s+(.*)$)",
-                                    std::regex::icase);
-  std::map<std::string, Decl> decls;
-  // declarations and block structure, in both files
-  for (size_t f = 0; f < p.lines.size(); ++f) {
-    const char* open = f == 0 ? "DEF" : "DEFDAT";
-    const char* close = f == 0 ? "END" : "ENDDAT";
+  std::string at(int f, size_t i) const { return where(p.paths[static_cast<size_t>(f)], static_cast<int>(i + 1)); }
+
+  // A declaration on line `line` of file f, its value's and type's spans (false when the line is none).
+  bool locate(int f, int line, Decl& d) const {
+    const std::string code = code_of(p.lines[static_cast<size_t>(f)][static_cast<size_t>(line - 1)]);
+    std::smatch m;
+    if (!std::regex_match(code, m, kDecl)) return false;
+    d.type = upper_case(m[2].str());
+    d.name = m[3].str();
+    d.value = m[4].str();
+    d.file = f;
+    d.line = line;
+    d.path = p.paths[static_cast<size_t>(f)];
+    std::tie(d.type_begin, d.type_end) = span_of(m, 2);
+    if (m[4].matched) std::tie(d.begin, d.end) = span_of(m, 4);
+    return true;
+  }
+
+  // Declarations and the DEF/END (DEFDAT/ENDDAT) structure of one file; a .src's assignments.
+  void scan(int f, bool dat) {
+    const auto& lines = p.lines[static_cast<size_t>(f)];
+    const char* open = dat ? "DEFDAT" : "DEF";
+    const char* close = dat ? "ENDDAT" : "END";
+    static const std::regex global_def(R"(^\s*GLOBAL\s+DEF(FCT)?\b)", std::regex::icase);
     int open_line = 0;
     bool closed = false;
-    for (size_t i = 0; i < p.lines[f].size(); ++i) {
-      const std::string code = code_of(p.lines[f][i]);
-      const std::string at = where(p.paths[f], static_cast<int>(i + 1));
-      std::string first = upper_case(code.substr(code.find_first_not_of(" \t") == std::string::npos ? code.size() : code.find_first_not_of(" \t")));
-      first = first.substr(0, first.find_first_of(" \t(\r"));
-      if (first == "GLOBAL" && std::regex_search(upper_case(code), std::regex(R"(^\s*GLOBAL\s+DEF(FCT)?\b)")))
-        first = "DEF";
-      if (first == open || (f == 0 && first == "DEFFCT")) {
-        if (open_line && !closed && f == 1) throw InputError(at + ": DEFDAT inside DEFDAT");
+    for (size_t i = 0; i < lines.size(); ++i) {
+      const std::string code = code_of(lines[i]);
+      std::string first = upper_case(trim(code));
+      first = first.substr(0, first.find_first_of(" \t("));
+      if (first == "GLOBAL" && std::regex_search(code, global_def)) first = "DEF";
+      if (first == open || (!dat && first == "DEFFCT")) {
+        if (open_line && !closed && dat) throw InputError(at(f, i) + ": DEFDAT inside DEFDAT");
         open_line = static_cast<int>(i + 1);
         closed = false;
-      } else if (first == close || (f == 0 && first == "ENDFCT")) {
-        if (!open_line || closed) throw InputError(at + ": " + first + " without " + open);
+      } else if (first == close || (!dat && first == "ENDFCT")) {
+        if (!open_line || closed) throw InputError(at(f, i) + ": " + first + " without " + open);
         closed = true;
       }
+      Decl d;
       std::smatch m;
-      if (std::regex_match(code, m, decl_re)) {
-        Decl d;
-        d.type = upper_case(m[1].str());
-        d.file = static_cast<int>(f);
-        d.line = static_cast<int>(i + 1);
-        std::tie(d.type_begin, d.type_end) = span_of(m, 1);
-        d.has_value = m[4].matched;
-        if (d.has_value) std::tie(d.begin, d.end) = span_of(m, 4);
-        d.assigned = decls[upper_case(m[2].str())].assigned;  // (an assignment in the .src, read before its .dat)
-        decls[upper_case(m[2].str())] = d;
-      } else if (f == 0 && std::regex_search(code, m, assign_re)) {
-        const auto it = decls.find(upper_case(m[1].str()));
-        if (it != decls.end()) it->second.assigned = true;
-        else decls[upper_case(m[1].str())].assigned = true;  // declared later or elsewhere: computed at run time
+      if (locate(f, static_cast<int>(i + 1), d)) {
+        own_[static_cast<size_t>(prog_)].emplace(upper_case(d.name), d);
+        taken_.insert(upper_case(d.name));
+      } else if (!dat && std::regex_search(code, m, kAssign)) {
+        assigned_[static_cast<size_t>(prog_)].insert(upper_case(m[1].str()));
       }
     }
-    if (!open_line) throw InputError(p.paths[f] + ": no " + open + " in the file");
-    if (!closed)
-      throw InputError(where(p.paths[f], open_line) + ": " + open + " is not closed by " + close + " (end of file)");
+    if (!open_line) throw InputError(p.paths[static_cast<size_t>(f)] + ": no " + open + " in the file");
+    if (!closed) throw InputError(where(p.paths[static_cast<size_t>(f)], open_line) + ": " + open + " is not closed by " + close + " (end of file)");
   }
-  // the motions, in order
-  std::map<std::string, size_t> used;
-  for (size_t i = 0; i < p.lines[0].size(); ++i) {
-    const std::string code = code_of(p.lines[0][i]);
+
+  // A name the program declares, or else the backup's declarations do; false when none does.
+  bool lookup(const std::string& name, Decl& d) const {
+    const std::string key = upper_case(name);
+    const auto& own = own_[static_cast<size_t>(prog_)];
+    if (auto it = own.find(key); it != own.end()) return d = it->second, true;
+    if (auto it = located_.find(key); it != located_.end()) return d = it->second, true;
+    const Declaration* c = context_.find(key);
+    if (!c) return false;
+    d = Decl{c->type, c->name, c->value, c->path, -1, c->line, 0, 0, 0, 0, c->run_time};
+    return true;
+  }
+
+  // an FDAT's fields; none ("" for every field, missing set) when the files do not declare it
+  std::map<std::string, std::string> fdat(const std::string& name, std::string& missing) const {
+    Decl d;
+    if (lookup(name, d) && d.type == "FDAT" && !d.value.empty()) return fields_of(d.value);
+    missing = "the FDAT " + name + " is not declared: give the backup's $config.dat or --declarations";
+    return {};
+  }
+
+  FrameRef numbered(const std::string& kind, const std::string& n, const std::string& where_, const std::string& missing = "") const {
+    if (!missing.empty()) return {"", "", missing};
+    const int k = static_cast<int>(bits(kind + "_NO", n, where_));
+    return {k == 0 ? "" : kind + "_DATA[" + std::to_string(k) + "]", "", ""};
+  }
+
+  // The frame of `$TOOL = rhs` (kind TOOL) or `$BASE = rhs` (BASE)
+  FrameRef frame_of(const std::string& rhs_, const std::string& kind, const std::string& where_) const {
+    const std::string rhs = upper_case(trim(rhs_));
+    static const std::regex data(R"(\$?(TOOL|BASE)_DATA\s*\[\s*(\d+)\s*\])"), stool(R"(STOOL2?\s*\(\s*(\w+)\s*\))"),
+        sbase(R"(SBASE\s*\(\s*(\w+)\s*\.\s*BASE_NO\s*\))"), word(R"(\w+)");
     std::smatch m;
-    if (!std::regex_match(code, m, motion_re)) continue;
-    const std::string at = where(p.paths[0], static_cast<int>(i + 1));
-    const std::string kind = upper_case(m[1].str());
-    std::vector<std::string> args = split_top(m[2].str());
-    const size_t n_targets = kind.find("CIRC") != std::string::npos ? 2 : 1;
-    if (args.size() < n_targets) throw InputError(at + ": " + kind + " needs " + std::to_string(n_targets) + " target(s)");
-    const size_t base_pos = static_cast<size_t>(m.position(2));
-    const bool ptp = kind == "PTP" || kind == "SPTP";
-    for (size_t a = 0; a < n_targets; ++a) {
-      std::string arg = args[a];
-      arg = arg.substr(0, arg.find_first_of(" \t") == std::string::npos || arg[0] == '{' ? arg.size() : arg.find_first_of(" \t"));
-      p.motions.push_back(motion_around(code, static_cast<int>(i + 1), ptp ? 'J' : n_targets == 2 ? 'C' : 'L',
-                                        code.find(arg, base_pos), arg.size()));
-      if (kind.find("_REL") != std::string::npos || arg.find(':') != std::string::npos) {
-        p.unresolved.push_back({at, code});
-        continue;
-      }
-      if (!arg.empty() && arg[0] == '{') {
-        if (std::regex_search(arg, std::regex(R"(\{\s*A1\s)", std::regex::icase))) continue;  // joints
-        NativeTarget t;
-        t.file = 0;
-        t.line = static_cast<int>(i + 1);
-        t.begin = p.lines[0][i].find(arg, base_pos);
-        t.end = t.begin + arg.size();
-        t.pose = parse_aggregate(arg, at);
-        t.joint_motion = ptp;
-        p.motions.back().target = static_cast<int>(p.targets.size());
-        p.targets.push_back(t);
-        continue;
-      }
-      const std::string key = upper_case(arg);
-      if (key.empty() || key[0] == '$') {
-        p.unresolved.push_back({at, code});
-        continue;
-      }
-      const auto it = decls.find(key);
-      if (it == decls.end() || it->second.type.empty())
-        throw InputError(at + ": target '" + arg + "' is not declared (in the .src or its .dat)");
-      const Decl& d = it->second;
-      if (d.type == "E6AXIS" || d.type == "AXIS") continue;
-      if (d.assigned || !d.has_value) {
-        p.unresolved.push_back({at, code});
-        continue;
-      }
-      if (used.count(key)) {
-        p.targets[used[key]].joint_motion &= ptp;
-        p.motions.back().target = static_cast<int>(used[key]);
-        continue;
-      }
-      p.motions.back().target = static_cast<int>(p.targets.size());
-      used[key] = p.targets.size();
+    Decl d;
+    std::string missing;
+    if (rhs == "$NULLFRAME") return {};
+    if (std::regex_match(rhs, m, data)) return numbered(m[1].str(), m[2].str(), where_);
+    if (std::regex_match(rhs, m, stool)) return numbered("TOOL", fdat(m[1].str(), missing)["TOOL_NO"], where_, missing);
+    if (std::regex_match(rhs, m, sbase)) return numbered("BASE", fdat(m[1].str(), missing)["BASE_NO"], where_, missing);
+    if (std::regex_match(rhs, m, word) && lookup(rhs, d) && d.type == "FRAME" && !d.value.empty() && !d.run_time)
+      return {rhs, "", ""};
+    return {"", "$" + kind + " = " + trim(rhs_) + " is set at run time", ""};
+  }
+
+  void apply_fdat(FrameState& s, const std::string& where_) const {
+    if (s.fdat.empty()) return;  // FDAT_ACT as a program before this one left it: the frames stay
+    std::string missing;
+    auto f = fdat(s.fdat, missing);
+    s.tool = numbered("TOOL", f["TOOL_NO"], where_, missing);
+    s.base = numbered("BASE", f["BASE_NO"], where_, missing);
+    s.ipo = missing.empty() ? upper_case(f["IPO_FRAME"].empty() ? "#BASE" : f["IPO_FRAME"]) : "!" + missing;
+  }
+
+  void assign(FrameState& s, const std::string& lhs, const std::string& rhs, const std::string& where_) const {
+    static const std::regex sipo(R"(SIPO_MODE\s*\(\s*(\w+)\s*\.\s*IPO_FRAME\s*\))", std::regex::icase);
+    std::smatch m;
+    const std::string l = upper_case(lhs), r = trim(rhs);
+    if (l == "$TOOL") s.tool = frame_of(rhs, "TOOL", where_);
+    if (l == "$BASE") s.base = frame_of(rhs, "BASE", where_);
+    if (l == "FDAT_ACT") s.fdat = upper_case(trim(rhs));
+    std::string missing;
+    if (l == "$IPO_MODE" && std::regex_match(r, m, sipo)) {
+      const std::string ipo = upper_case(fdat(m[1].str(), missing)["IPO_FRAME"]);
+      s.ipo = !missing.empty() ? "!" + missing : ipo.empty() ? "#BASE" : ipo;
+    } else if (l == "$IPO_MODE") {
+      s.ipo = upper_case(r);
+    }
+  }
+
+  // The assignments of a WITH list (each item up to an approximation C_SPL, C_DIS, ...)
+  void apply_with(FrameState& s, const std::string& list, const std::string& where_) const {
+    static const std::regex item_re(R"(^(\$?\w+)(?:\s*\[[^\]]*\])?\s*=\s*(.*)$)");
+    for (std::string item : split_top(list)) {
+      std::smatch m;
+      if (std::regex_search(item, m, kApprox)) item = item.substr(0, static_cast<size_t>(m.position(0)));
+      if (std::regex_match(item, m, item_re)) assign(s, m[1].str(), m[2].str(), where_);
+    }
+  }
+
+  struct Frames {
+    std::string key, named, why;
+    Eigen::Isometry3d tool = Eigen::Isometry3d::Identity(), base = Eigen::Isometry3d::Identity();
+  };
+
+  Eigen::Isometry3d frame_value(const std::string& key, const char* what, const std::string& where_) const {
+    if (key.empty()) return Eigen::Isometry3d::Identity();
+    Decl d;
+    if (!lookup(key, d) || d.value.empty())
+      throw InputError(where_ + ": the motion's " + what + " " + key + " is not declared: give the backup's $config.dat or --declarations");
+    const Aggregate a = read_aggregate(d.value, where(d.path, d.line));
+    if (!a.missing.empty()) throw InputError(where(d.path, d.line) + ": " + key + " has no " + a.missing + " value");
+    return pose_to_iso(a.pose);
+  }
+
+  Frames frames_at(const FrameState& s, const std::string& where_) const {
+    Frames fr;
+    for (const std::string& e : {s.tool.error, s.base.error, s.ipo[0] == '!' ? s.ipo.substr(1) : std::string()})
+      if (!e.empty()) throw InputError(where_ + ": " + e);
+    if (!s.tool.why.empty() || !s.base.why.empty()) {
+      fr.why = "its " + std::string(s.tool.why.empty() ? "base" : "tool") + " is not known before run time (" +
+               (s.tool.why.empty() ? s.base.why : s.tool.why) + ")";
+      return fr;
+    }
+    if (s.ipo == "#TCP") throw InputError(where_ + ": a stationary tool (IPO_FRAME #TCP): kincal does not compensate it");
+    if (s.ipo != "#BASE") return fr.why = "its interpolation mode $IPO_MODE = " + s.ipo + " is set at run time", fr;
+    fr.tool = frame_value(s.tool.key, "tool", where_);
+    fr.base = frame_value(s.base.key, "base", where_);
+    fr.named = s.tool.key + (s.tool.key.empty() || s.base.key.empty() ? "" : ", ") + s.base.key;
+    fr.key = s.tool.key + "|" + s.base.key;
+    return fr;
+  }
+
+  void unresolved(const std::string& where_, const std::string& code, const std::string& why) {
+    p.unresolved.push_back({where_, trim(code), why});
+  }
+
+  // The target `text` at [b, ..) of a motion statement (p.motions.back()) in file f, line i
+  void resolve(int f, size_t i, const std::string& code, size_t b, const std::string& text, const FrameState& s) {
+    const std::string w = at(f, i);
+    NativeMotion& mo = p.motions.back();
+    const bool joint = mo.kind == 'J';
+    if (top_colon(text)) return unresolved(w, code, "a geometric operator (" + text + "): computed at run time");
+    if (text[0] == '{') {
+      if (text.back() != '}') throw InputError(w + ": the aggregate " + text + " is not closed by }");
+      const Aggregate a = read_aggregate(text, w);
+      if (a.joints) return;  // axis values: joints, as written
+      if (!a.missing.empty())
+        return unresolved(w, code, "an aggregate without " + a.missing + ": the rest is where the robot is at run time");
+      const Frames fr = frames_at(s, w);
+      if (!fr.why.empty()) return unresolved(w, code, fr.why);
       NativeTarget t;
+      t.file = f;
+      t.line = static_cast<int>(i + 1);
+      t.begin = b;
+      t.end = b + text.size();
+      t.pose = a.pose;
+      t.taught = a.taught;
+      t.external = a.external;
+      t.tool = fr.tool;
+      t.frame = fr.base;
+      t.frames_named = fr.named;
+      t.joint_motion = joint;
+      mo.target = static_cast<int>(p.targets.size());
+      return p.targets.push_back(t);
+    }
+    if (text[0] == '$') return unresolved(w, code, "a system variable (" + text + "): where the robot is at run time");
+    static const std::regex word(R"(\w+)");
+    if (!std::regex_match(text, word)) return unresolved(w, code, "an expression (" + text + "): computed at run time");
+    Decl d;
+    if (!lookup(text, d)) return unresolved(w, code, "declared nowhere");
+    if (is_axis(d.type)) return;  // joints, as written
+    if (!is_pos(d.type)) throw InputError(w + ": target '" + text + "' is declared as " + d.type + ", not a position");
+    if (d.run_time || assigned_[static_cast<size_t>(prog_)].count(upper_case(text)))
+      return unresolved(w, code, "assigned in the program: computed at run time");
+    if (d.value.empty()) return unresolved(w, code, "declared without a value: set at run time");
+    const Frames fr = frames_at(s, w);
+    if (!fr.why.empty()) return unresolved(w, code, fr.why);
+    if (d.file < 0) {  // declared in the backup's other files: compensated there
+      const int cf = add(d.path);
+      if (!locate(cf, d.line, d) || upper_case(d.name) != upper_case(text))
+        throw InputError(where(d.path, d.line) + ": the declaration of " + text + " is not one line");
+      located_[upper_case(text)] = d;
+    }
+    const std::string key = std::to_string(d.file) + ":" + upper_case(d.name);
+    auto& by_frame = uses_[key];
+    if (auto it = by_frame.find(fr.key); it != by_frame.end()) {
+      NativeTarget& t = p.targets[static_cast<size_t>(it->second)];
+      t.joint_motion = t.joint_motion && joint;
+      if (t.copy_of >= 0) t.edits.push_back({f, static_cast<int>(i + 1), b, b + text.size(), t.name});
+      mo.target = it->second;
+      return;
+    }
+    NativeTarget t;
+    if (by_frame.empty()) {
+      const std::string dw = where(d.path, d.line);
+      const Aggregate a = read_aggregate(d.value, dw);
+      if (!a.missing.empty()) throw InputError(dw + ": the target has no " + a.missing + " value");
       t.file = d.file;
       t.line = d.line;
       t.begin = d.begin;
       t.end = d.end;
-      t.name = arg;
-      t.pose = parse_aggregate(p.lines[static_cast<size_t>(d.file)][static_cast<size_t>(d.line - 1)].substr(d.begin, d.end - d.begin),
-                               where(p.paths[static_cast<size_t>(d.file)], d.line));
-      t.joint_motion = ptp;
+      t.name = d.name;
+      t.pose = a.pose;
+      t.taught = a.taught;
+      t.external = a.external;
       t.joint_edits.push_back({d.file, d.line, d.type_begin, d.type_end, d.type == "E6POS" ? "E6AXIS" : "AXIS"});
-      p.targets.push_back(t);
+      first_[key] = static_cast<int>(p.targets.size());
+    } else {  // a second frame: a copy, declared after the original, that these motions name
+      t = p.targets[static_cast<size_t>(first_[key])];
+      t.copy_of = first_[key];
+      t.name = copy_name(d.name);
+      t.edits = {{f, static_cast<int>(i + 1), b, b + text.size(), t.name}};
+    }
+    t.tool = fr.tool;
+    t.frame = fr.base;
+    t.frames_named = fr.named;
+    t.joint_motion = joint;
+    mo.target = static_cast<int>(p.targets.size());
+    by_frame[fr.key] = mo.target;
+    p.targets.push_back(t);
+  }
+  std::map<std::string, int> first_;  // declared target -> its original
+
+  // NAME_1, NAME_2, ...: cut to KRL's 24 characters, unique among the declared names
+  std::string copy_name(const std::string& name) {
+    for (int n = 1;; ++n) {
+      const std::string suffix = "_" + std::to_string(n);
+      const std::string c = name.substr(0, std::min(name.size(), 24 - suffix.size())) + suffix;
+      if (taken_.insert(upper_case(c)).second) return c;
     }
   }
-  keep_named_targets_cartesian(p, ';', true);
-  return p;
-}
 
-// a KRL aggregate with X..C, S and T replaced (every other field kept as written)
-std::string krl_aggregate(const std::string& old, const Pose6& pose, const ControllerTarget& t, bool is_frame) {
-  std::vector<std::string> items = split_top(old.substr(1, old.size() - 2));
-  const double v[6] = {pose.xyz[0], pose.xyz[1], pose.xyz[2], pose.abc[0], pose.abc[1], pose.abc[2]};
-  bool has_s = false, has_t = false;
-  for (std::string& item : items) {
-    size_t k = 0;
-    while (k < item.size() && (std::isalnum(static_cast<unsigned char>(item[k])) || item[k] == '_')) ++k;
-    const std::string key = upper_case(item.substr(0, k));
-    const std::string sep = item.substr(k, item.find_first_not_of(" \t", k) - k);
-    const std::string name = item.substr(0, k);
-    for (int f = 0; f < 6; ++f)
-      if (key == std::string(1, "XYZABC"[f])) item = name + sep + ctl::fixed(v[f], f < 3 ? 4 : 6);
-    if (key == "S") item = name + sep + std::to_string(t.kuka_s), has_s = true;
-    if (key == "T") item = name + sep + std::to_string(t.kuka_t), has_t = true;
+  // The motions of the .src f, in order, with their tool and base.
+  void motions(int f) {
+    static const std::regex block_re(R"(^\s*(SPLINE|PTP_SPLINE)\b\s*(.*)$)", std::regex::icase),
+        end_re(R"(^\s*ENDSPLINE\b.*$)", std::regex::icase),
+        motion_re(R"(^\s*(PTP|LIN|CIRC|SPTP|SLIN|SCIRC|SPL|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SCIRC_REL|SPL_REL)\b\s*(.*)$)",
+                  std::regex::icase),
+        bas_re(R"(^\s*BAS\s*\(\s*#(\w+)\s*(?:,\s*(.*?))?\s*\)\s*$)", std::regex::icase);
+    FrameState s, block;  // the program's frames (tool 0, base 0 at its start); a spline block's
+    std::string open;      // the spline block open, "" when none
+    int open_line = 0;
+    for (size_t i = 0; i < p.lines[static_cast<size_t>(f)].size(); ++i) {  // (a target's file may join p.lines)
+      const std::string code = code_of(p.lines[static_cast<size_t>(f)][i]), w = at(f, i);
+      std::smatch m;
+      if (std::regex_match(code, m, block_re)) {
+        if (!open.empty()) throw InputError(w + ": " + upper_case(m[1].str()) + " inside the " + open + " block of line " + std::to_string(open_line));
+        open = upper_case(m[1].str());
+        open_line = static_cast<int>(i + 1);
+        block = s;
+        const size_t with = with_at(code, static_cast<size_t>(m.position(2)));
+        if (with != std::string::npos) apply_with(block, code.substr(with + 4), w);
+      } else if (std::regex_match(code, end_re)) {
+        if (open.empty()) throw InputError(w + ": ENDSPLINE without SPLINE");
+        open.clear();
+      } else if (std::regex_match(code, m, motion_re)) {
+        motion(f, i, code, m, open.empty() ? s : block, open);
+      } else if (std::regex_match(code, m, bas_re)) {
+        const std::string what = upper_case(m[1].str());
+        if (what == "PTP_PARAMS" || what == "CP_PARAMS" || what == "FRAMES") apply_fdat(s, w);
+        if (what == "TOOL" || what == "BASE") s.*(what == "TOOL" ? &FrameState::tool : &FrameState::base) = numbered(what, trim(m[2].str()), w);
+      } else if (std::regex_match(code, m, kAssign)) {
+        assign(s, m[1].str(), m[3].str(), w);
+      }
+    }
+    if (!open.empty()) throw InputError(where(p.paths[static_cast<size_t>(f)], open_line) + ": " + open + " is not closed by ENDSPLINE");
   }
-  std::string out = "{";
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + items[i];
-  if (!is_frame && !has_s) out += ",S " + std::to_string(t.kuka_s);
-  if (!is_frame && !has_t) out += ",T " + std::to_string(t.kuka_t);
-  return out + "}";
-}
 
-// a KRL aggregate of a Cartesian target as an axis target {A1 .., .., A6 ..}, its external axes E1..E6 kept
-std::string krl_axis(const std::string& old, const Vec6& q_deg) {
-  std::string out = "{";
-  for (int j = 0; j < 6; ++j) out += std::string(j ? "," : "") + "A" + std::to_string(j + 1) + " " + ctl::fixed(q_deg[j], ctl::kJointDecimals);
-  for (const std::string& item : split_top(old.substr(1, old.size() - 2)))
-    if (std::regex_match(item, std::regex(R"(E[1-6]\b.*)", std::regex::icase))) out += "," + item;
-  return out + "}";
+  void motion(int f, size_t i, const std::string& code, const std::smatch& m, const FrameState& outer, const std::string& block) {
+    const std::string w = at(f, i), kw = upper_case(m[1].str());
+    const std::string base_kw = kw.substr(0, kw.find("_REL"));
+    const bool ok = block.empty()      ? base_kw != "SPL"
+                    : block == "SPLINE" ? base_kw == "SPL" || base_kw == "SLIN" || base_kw == "SCIRC"
+                                        : base_kw == "SPTP";
+    if (!ok)
+      throw InputError(w + ": " + kw + (block.empty() ? std::string(" outside a SPLINE ... ENDSPLINE block")
+                                                      : " inside a " + block + " block (" + (block == "SPLINE" ? "SPL, SLIN, SCIRC" : "SPTP") + " only)"));
+    FrameState s = outer;
+    size_t end = code.size();
+    const size_t with = with_at(code, static_cast<size_t>(m.position(2)));
+    if (with != std::string::npos) {
+      if (kw.find("_REL") == std::string::npos) apply_with(s, code.substr(with + 4), w);
+      end = with;
+    }
+    const auto args = top_args(code, static_cast<size_t>(m.position(2)), end);
+    const size_t n = base_kw.find("CIRC") != std::string::npos ? 2 : 1;
+    if (args.size() < n || args[n - 1].first == args[n - 1].second)
+      throw InputError(w + ": " + kw + " needs " + (n == 2 ? "an auxiliary point and an end point" : "a target"));
+    for (size_t a = n; a < args.size(); ++a)
+      if (n == 1 || upper_case(code.substr(args[a].first, 2)) != "CA")
+        throw InputError(w + ": '" + code.substr(args[a].first, args[a].second - args[a].first) + "' after the target of " + kw);
+    const char kind = base_kw == "PTP" || base_kw == "SPTP" ? 'J' : n == 2 ? 'C' : base_kw == "SPL" ? 'O' : 'L';
+    for (size_t a = 0; a < n; ++a) {
+      auto [b, e] = args[a];
+      std::string text = code.substr(b, e - b);
+      if (text.empty()) throw InputError(w + ": " + kw + " needs a target");
+      std::smatch ap;
+      const size_t brace = text[0] == '{' ? text.find('}') : 0;
+      if (std::regex_search(text.cbegin() + static_cast<long>(brace == std::string::npos ? 0 : brace), text.cend(), ap, kApprox))
+        text = trim(text.substr(0, static_cast<size_t>(ap.position(0)) + (brace == std::string::npos ? 0 : brace)));
+      p.motions.push_back(motion_around(code, static_cast<int>(i + 1), kind, b, text.size()));
+      p.motions.back().file = f;
+      if (kw.find("_REL") != std::string::npos) {
+        if (a == 0) unresolved(w, code, "a relative motion (" + kw + "): its target depends on where the robot is");
+        continue;
+      }
+      resolve(f, i, code, b, text, s);
+    }
+  }
+};
+
+}  // namespace
+
+NativeProgram read_krl_program(const std::vector<std::string>& src_paths, const Declarations& context) {
+  KrlReader r(context);
+  for (const std::string& src : src_paths) r.read_program(src);
+  keep_named_targets_cartesian(r.p, ';', true);
+  return std::move(r.p);
 }
 
 }  // namespace kincal

@@ -63,11 +63,12 @@ bool block_line(const std::string& text) {
 std::vector<Stmt> statements(const std::vector<std::string>& lines) {
   std::vector<Stmt> out;
   Stmt cur;
-  auto add = [&](const std::string& piece, int line, size_t col) {
+  auto add = [&](const std::string& piece, int line, size_t col) {  // a line joined after one blank
     if (cur.text.empty() && trim(piece).empty()) return;
+    const size_t skip = cur.text.empty() ? 0 : std::min(piece.size(), piece.find_first_not_of(" \t"));
     if (!cur.text.empty()) cur.text += ' ';
-    cur.pieces.push_back({cur.text.size(), line, col});
-    cur.text += piece;
+    cur.pieces.push_back({cur.text.size(), line, col + skip});
+    cur.text += piece.substr(skip);
   };
   auto flush = [&] {
     if (!trim(cur.text).empty()) cur.ended = true, out.push_back(cur);

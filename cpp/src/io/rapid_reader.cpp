@@ -1,4 +1,4 @@
-// kincal: RAPID modules read in (the writers of their values are in rapid.cpp) (the modules of one task read as one; the backup's other modules as
+// kincal: RAPID modules read in (the modules of one task read as one; the backup's other modules as
 // context). A statement runs to its ';' over as many lines as it takes; MODULE/ENDMODULE are checked.
 // Motions: every instruction of the RAPID manual that moves the robot to a robtarget (Move*, Trigg*,
 // Search*, Arc*, Cap*), with the tooldata and wobjdata of each statement; MoveAbsJ, MoveExtJ and
@@ -6,6 +6,7 @@
 // CRobT, a VAR, an assigned one), a name declared nowhere, and any motion-looking instruction kincal
 // does not read are listed as unresolved with why. A declared target used in a second (tool, wobj) gets
 // a copy named after it (name_1, ...).
+// (The writers of a read value, rapid_robtarget and rapid_jointtarget, are in rapid.cpp.)
 #include "controller_writers.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/native.hpp"

@@ -1,10 +1,18 @@
-// kincal: ABB RAPID modules (IRC5 / OmniCore): MODULE NAME with the targets declared CONST
+// kincal: ABB RAPID modules (IRC5 / OmniCore), and the values of a read module rewritten (rapid_robtarget,
+// rapid_jointtarget: number by number, a value over several lines kept in its lines). New modules: MODULE NAME with the targets declared CONST
 // (jointtarget for MoveAbsJ; robtarget with quaternion and confdata [cf1, cf4, cf6, cfx] for MoveJ
 // then MoveL) and PROC main. Identifiers up to 32 characters. Speeds: VelSet (percent) for the joint
 // motions, a declared speeddata (mm/s) for the linear ones; zones: fine, or a declared zonedata in the
 // proportions of the predefined z10 ([FALSE, z, 1.5z, 1.5z, 0.15z, 1.5z, 0.15z]). The tool and work
 // object are tool0 and wobj0 (filtered targets are the model's tool in the robot's base frame).
 #include "controller_writers.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace kincal::ctl {
 
@@ -62,3 +70,79 @@ std::vector<OutputFile> write_rapid(const std::string& out, const std::vector<Co
 }
 
 }  // namespace kincal::ctl
+
+namespace kincal {
+
+namespace {
+
+// the spans of a value's top-level parts (inside its outer brackets)
+std::vector<std::pair<size_t, size_t>> part_spans(const std::string& v) {
+  std::vector<std::pair<size_t, size_t>> out;
+  const size_t open = v.find('[');
+  int depth = 0;
+  size_t b = open + 1;
+  for (size_t c = open; open != std::string::npos && c < v.size(); ++c) {
+    if (v[c] == '[') ++depth;
+    if (v[c] == ']' && --depth == 0) {
+      out.emplace_back(b, c);
+      break;
+    }
+    if (v[c] == ',' && depth == 1) out.emplace_back(b, c), b = c + 1;
+  }
+  for (auto& [x, y] : out) {
+    while (x < y && std::isspace(static_cast<unsigned char>(v[x]))) ++x;
+    while (y > x && std::isspace(static_cast<unsigned char>(v[y - 1]))) --y;
+  }
+  return out;
+}
+
+}  // namespace
+
+// a robtarget value with trans, rot and robconf replaced number by number: every other character, the
+// blanks and line breaks of a value over several lines and the extax included, kept as written
+std::string rapid_robtarget(const std::string& old, const Pose6& pose, const ControllerTarget& t) {
+  const auto q = ctl::quaternion_of(pose.abc);
+  std::vector<std::string> now;
+  for (int k = 0; k < 3; ++k) now.push_back(ctl::fixed(pose.xyz[k], 4));
+  for (int k = 0; k < 4; ++k) now.push_back(ctl::fixed(q[static_cast<size_t>(k)], 9));
+  for (int k = 0; k < 4; ++k) now.push_back(std::to_string(t.abb_conf[static_cast<size_t>(k)]));
+  const auto parts = part_spans(old);
+  std::string s = old;
+  size_t n = now.size();
+  for (size_t k = std::min<size_t>(3, parts.size()); k-- > 0;) {  // from the right: spans stay valid
+    const std::string part = old.substr(parts[k].first, parts[k].second - parts[k].first);
+    std::vector<std::pair<size_t, size_t>> num;
+    for (size_t c = 0; c < part.size();) {
+      if (std::strchr("+-.0123456789", part[c])) {
+        size_t e = c;
+        while (e < part.size() && std::strchr("+-.0123456789eE", part[e])) ++e;
+        num.emplace_back(c, e), c = e;
+      } else {
+        ++c;
+      }
+    }
+    const size_t want = k == 0 ? 3 : 4;
+    if (num.size() != want || n < want) return old;  // (read values always have them)
+    for (size_t j = want; j-- > 0;) s.replace(parts[k].first + num[j].first, num[j].second - num[j].first, now[--n]);
+  }
+  return s;
+}
+
+// a robtarget value as a jointtarget [[q1..q6],[extax]], its external axes kept as written (and as many
+// line breaks as the robtarget had, for a value over several lines)
+std::string rapid_jointtarget(const std::string& old, const Vec6& q_deg) {
+  const auto parts = part_spans(old);
+  std::string qs = "[";
+  for (int j = 0; j < 6; ++j) qs += (j ? "," : "") + ctl::fixed(q_deg[j], ctl::kJointDecimals);
+  qs += "]";
+  if (parts.size() != 4) return "[" + qs + "]";
+  std::string s = old.substr(0, parts[0].first) + qs + old.substr(parts[0].second, parts[1].first - parts[0].second);
+  const std::string gone = old.substr(parts[1].first, parts[3].first - parts[1].first);
+  const size_t breaks = static_cast<size_t>(std::count(gone.begin(), gone.end(), '\n'));
+  const std::string eol = old.find('\r') != std::string::npos ? "\r\n" : "\n";
+  for (size_t k = 0; k < breaks; ++k) s += eol;
+  if (breaks) s += gone.substr(gone.find_last_of('\n') + 1);  // the extax's indentation
+  return s + old.substr(parts[3].first);
+}
+
+}  // namespace kincal

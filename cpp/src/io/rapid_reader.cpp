@@ -1,23 +1,97 @@
-// kincal: RAPID modules read in: MODULE/ENDMODULE checked, robtarget and wobjdata declarations, and
-// the motions MoveJ, MoveL, MoveC (and their DO/Sync/AO/GO variants) to declared names or inline
-// robtargets, with the work object of \WObj applied (uframe * oframe). A target computed by a function
-// (Offs, RelTool, CRobT, ...) is unresolved; MoveAbsJ (joints) stays as it is. Statements that carry a
-// target must stand on one line (RobotStudio writes them so).
+// kincal: RAPID modules read in (the modules of one task read as one; the backup's other modules as
+// context). A statement runs to its ';' over as many lines as it takes; MODULE/ENDMODULE are checked.
+// Motions: every instruction of the RAPID manual that moves the robot to a robtarget (Move*, Trigg*,
+// Search*, Arc*, Cap*), with the tooldata and wobjdata of each statement; MoveAbsJ, MoveExtJ and
+// SearchExtJ are motions without a Cartesian target. A target the program computes (Offs, RelTool,
+// CRobT, a VAR, an assigned one), a name declared nowhere, and any motion-looking instruction kincal
+// does not read are listed as unresolved with why. A declared target used in a second (tool, wobj) gets
+// a copy named after it (name_1, ...).
+// (The writers of a read value, rapid_robtarget and rapid_jointtarget, are in rapid.cpp.)
 #include "controller_writers.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/native.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <deque>
 #include <map>
 #include <regex>
-#include <tuple>
+#include <set>
 
 namespace kincal {
 
 namespace {
 
-std::string code_of(const std::string& l) { return code_before(l, '!'); }
+constexpr size_t kRapidNameLimit = 32;
+
+// One statement: its code (comments cut, the lines joined by one blank) and where each piece stands.
+struct Stmt {
+  std::string text;
+  struct Piece { size_t at; int line; size_t col; };
+  std::vector<Piece> pieces;
+  bool ended = false;  // by ';' or as a block line (MODULE, PROC, IF .. THEN, ...)
+  int line() const { return pieces.front().line; }
+  std::pair<int, size_t> pos(size_t o) const {  // the (line, column) of text offset o
+    auto it = std::upper_bound(pieces.begin(), pieces.end(), o, [](size_t v, const Piece& p) { return v < p.at; });
+    --it;
+    return {it->line, it->col + (o - it->at)};
+  }
+};
+
+std::string trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
+  return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+}
+
+// a line that is a statement without ';': MODULE, routine heads and ends, IF .. THEN, labels, ...
+bool block_line(const std::string& text) {
+  static const std::regex word_re(R"(^\s*(?:LOCAL\s+)?(\w+))"), then_re(R"(\b(THEN|DO)\s*$)", std::regex::icase),
+      label_re(R"(^\s*(CASE\b[^;]*|DEFAULT\s*|\w+\s*):\s*$)", std::regex::icase);
+  static const std::set<std::string> heads{"MODULE", "ENDMODULE", "PROC", "FUNC", "TRAP", "ENDPROC", "ENDFUNC",
+                                           "ENDTRAP", "ELSE", "ENDIF", "ENDFOR", "ENDWHILE", "TEST", "ENDTEST",
+                                           "ERROR", "BACKWARD", "UNDO", "RECORD", "ENDRECORD", "VERSION", "LANGUAGE"};
+  const std::string t = trim(text);
+  if (t.empty()) return false;
+  if (t.rfind("%%%", 0) == 0) return true;
+  std::smatch m;
+  if (std::regex_search(t, m, word_re) && heads.count(upper_case(m[1].str()))) return true;
+  return std::regex_search(t, then_re) || std::regex_search(t, label_re);
+}
+
+std::vector<Stmt> statements(const std::vector<std::string>& lines) {
+  std::vector<Stmt> out;
+  Stmt cur;
+  auto add = [&](const std::string& piece, int line, size_t col) {  // a line joined after one blank
+    if (cur.text.empty() && trim(piece).empty()) return;
+    const size_t skip = cur.text.empty() ? 0 : std::min(piece.size(), piece.find_first_not_of(" \t"));
+    if (!cur.text.empty()) cur.text += ' ';
+    cur.pieces.push_back({cur.text.size(), line, col + skip});
+    cur.text += piece.substr(skip);
+  };
+  auto flush = [&] {
+    if (!trim(cur.text).empty()) cur.ended = true, out.push_back(cur);
+    cur = Stmt{};
+  };
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string code = code_before(lines[i], '!');
+    bool str = false;
+    size_t from = 0;
+    for (size_t c = 0; c < code.size(); ++c) {
+      if (code[c] == '"') str = !str;
+      if (code[c] != ';' || str) continue;
+      add(code.substr(from, c + 1 - from), static_cast<int>(i + 1), from);
+      flush();
+      from = c + 1;
+    }
+    add(code.substr(from), static_cast<int>(i + 1), from);
+    if (block_line(cur.text)) flush();
+  }
+  if (!trim(cur.text).empty()) out.push_back(cur);  // not ended: an error where it matters
+  return out;
+}
 
 std::vector<double> numbers(const std::string& part, size_t n, const std::string& at, const char* what) {
   const std::string s = part.size() >= 2 && part.front() == '[' && part.back() == ']' ? part.substr(1, part.size() - 2) : "";
@@ -35,193 +109,479 @@ std::vector<double> numbers(const std::string& part, size_t n, const std::string
   return v;
 }
 
-Eigen::Isometry3d frame_of(const std::vector<double>& t, const std::vector<double>& q) {
+std::vector<std::string> parts_of(const std::string& v) {
+  const std::string t = trim(v);
+  return t.size() >= 2 && t.front() == '[' && t.back() == ']' ? split_top(t.substr(1, t.size() - 2)) : std::vector<std::string>{};
+}
+
+Eigen::Isometry3d frame_of(const std::string& part, const std::string& at, const char* what) {
+  const auto pq = parts_of(part);
+  if (pq.size() != 2) throw InputError(at + ": " + what + " is [[x,y,z],[q1,q2,q3,q4]], not '" + part + "'");
+  const auto t = numbers(pq[0], 3, at, what), q = numbers(pq[1], 4, at, what);
   Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
   f.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
   f.translation() = Vec3(t[0], t[1], t[2]);
   return f;
 }
 
-// a robtarget value [[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[e1..e6]]
-Pose6 parse_robtarget(const std::string& v, const std::string& at) {
-  const std::string inner = v.size() >= 2 && v.front() == '[' && v.back() == ']' ? v.substr(1, v.size() - 2) : "";
-  const auto parts = split_top(inner);
-  if (inner.empty() || parts.size() != 4)
-    throw InputError(at + ": a robtarget has 4 parts [trans],[rot],[robconf],[extax], this one " +
-                     std::to_string(inner.empty() ? 0 : parts.size()));
-  const auto t = numbers(parts[0], 3, at, "the robtarget's trans");
-  const auto q = numbers(parts[1], 4, at, "the robtarget's rot");
-  numbers(parts[2], 4, at, "the robtarget's robconf");
-  numbers(parts[3], 6, at, "the robtarget's extax");
-  return iso_to_pose(frame_of(t, q));
+// a robtarget value [[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[e1..e6]] into t (pose, taught, external)
+void parse_robtarget(const std::string& v, const std::string& at, NativeTarget& t) {
+  const auto parts = parts_of(v);
+  if (parts.size() != 4)
+    throw InputError(at + ": a robtarget has 4 parts [trans],[rot],[robconf],[extax], this one " + std::to_string(parts.size()));
+  t.pose = iso_to_pose(frame_of("[" + parts[0] + "," + parts[1] + "]", at, "the robtarget's trans and rot"));
+  numbers(parts[0], 3, at, "the robtarget's trans");
+  numbers(parts[1], 4, at, "the robtarget's rot");
+  const auto cf = numbers(parts[2], 4, at, "the robtarget's robconf");
+  const auto ex = numbers(parts[3], 6, at, "the robtarget's extax");
+  ControllerTarget taught;
+  for (size_t k = 0; k < 4; ++k) taught.abb_conf[k] = static_cast<int>(std::lround(cf[k]));
+  t.taught = taught;
+  for (size_t k = 0; k < 6; ++k) t.external[k] = ex[k] >= 8.99e9 ? std::numeric_limits<double>::quiet_NaN() : ex[k];
+}
+
+// One data declaration of a module.
+struct Decl {
+  std::string type, storage, name, value, path;  // type and storage upper case
+  int file = 0, line = 0;
+  bool local = false, array = false;
+  int vline = 0, vlast = 0, tline = 0;      // value's first and last line, the type's line
+  size_t vbegin = 0, vend = 0, tbegin = 0, tend = 0;
+};
+
+std::vector<Decl> declarations_of(const std::vector<Stmt>& stmts, int file, const std::string& path) {
+  static const std::regex decl_re(
+      R"(^\s*(LOCAL\s+|TASK\s+)?(CONST|PERS|VAR)\s+(\w+)\s+(\w+)\s*(\{[^}]*\})?\s*(?::=\s*(.*?))?\s*;\s*$)", std::regex::icase);
+  std::vector<Decl> out;
+  for (const Stmt& s : stmts) {
+    std::smatch m;
+    if (!std::regex_match(s.text, m, decl_re)) continue;
+    Decl d;
+    d.local = upper_case(m[1].str()).rfind("LOCAL", 0) == 0;
+    d.storage = upper_case(m[2].str()), d.type = upper_case(m[3].str()), d.name = m[4].str();
+    d.array = m[5].matched, d.file = file, d.line = s.line(), d.path = path;
+    std::tie(d.tline, d.tbegin) = s.pos(static_cast<size_t>(m.position(3)));
+    d.tend = d.tbegin + static_cast<size_t>(m.length(3));
+    if (m[6].matched && m.length(6) > 0) {
+      d.value = m[6].str();
+      const auto [b, e] = span_of(m, 6);
+      std::tie(d.vline, d.vbegin) = s.pos(b);
+      std::tie(d.vlast, d.vend) = s.pos(e - 1);
+      ++d.vend;
+    }
+    out.push_back(d);
+  }
+  return out;
+}
+
+// A statement's arguments: the spans (in its text) of each top-level, comma-separated item's value,
+// with the optional arguments (\Conc, \ID:=10, \WObj:=w, ...) before and after it left out. Pure
+// switches give no item.
+std::vector<std::pair<size_t, size_t>> positional(const std::string& s, size_t from) {
+  std::vector<std::pair<size_t, size_t>> out;
+  int depth = 0;
+  bool str = false;
+  size_t b = from;
+  auto item = [&](size_t e) {
+    size_t i = b;
+    static const std::regex opt_re(R"(^\s*\\\w+(?:\s*:=\s*(?:"[^"]*"|[^\s\\,]+))?\s*)");
+    std::smatch m;
+    std::string rest = s.substr(i, e - i);
+    while (std::regex_search(rest, m, opt_re) && m.length(0) > 0) i += static_cast<size_t>(m.length(0)), rest = rest.substr(static_cast<size_t>(m.length(0)));
+    size_t j = i;
+    int d = 0;
+    for (; j < e; ++j) {
+      if (s[j] == '[' || s[j] == '(' || s[j] == '{') ++d;
+      if (s[j] == ']' || s[j] == ')' || s[j] == '}') --d;
+      if (s[j] == '\\' && d == 0) break;
+    }
+    while (i < j && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+    while (j > i && std::isspace(static_cast<unsigned char>(s[j - 1]))) --j;
+    if (j > i) out.emplace_back(i, j);
+  };
+  for (size_t c = from; c < s.size(); ++c) {
+    if (s[c] == '"') str = !str;
+    if (str) continue;
+    if (s[c] == '[' || s[c] == '(' || s[c] == '{') ++depth;
+    if (s[c] == ']' || s[c] == ')' || s[c] == '}') --depth;
+    if (depth == 0 && (s[c] == ',' || s[c] == ';')) item(c), b = c + 1;
+  }
+  if (b < s.size()) item(s.size());
+  return out;
+}
+
+// The motion instructions read: the positional arguments that are targets, the tool's place counted
+// from the last positional argument, the kind, and the search point (an output) if any.
+struct Instr {
+  int to[2];
+  int n_to;
+  int tool_back;
+  char kind;
+  int search_point = -1;
+};
+
+const Instr* instruction(const std::string& word) {
+  static const std::map<std::string, Instr> table = [] {
+    std::map<std::string, Instr> t;
+    t["MOVEJ"] = {{0, 0}, 1, 1, 'J'};
+    t["MOVEL"] = {{0, 0}, 1, 1, 'L'};
+    t["MOVEC"] = {{0, 1}, 2, 1, 'C'};
+    for (const char* x : {"DO", "AO", "GO"}) {  // Tool, Signal, Value
+      t[std::string("MOVEJ") + x] = {{0, 0}, 1, 3, 'O'};
+      t[std::string("MOVEL") + x] = {{0, 0}, 1, 3, 'O'};
+      t[std::string("MOVEC") + x] = {{0, 1}, 2, 3, 'C'};
+    }
+    t["MOVEJSYNC"] = {{0, 0}, 1, 2, 'O'};  // Tool, ProcName
+    t["MOVELSYNC"] = {{0, 0}, 1, 2, 'O'};
+    t["MOVECSYNC"] = {{0, 1}, 2, 2, 'C'};
+    t["TRIGGJ"] = t["TRIGGJIOS"] = {{0, 0}, 1, 1, 'J'};
+    t["TRIGGL"] = t["TRIGGLIOS"] = {{0, 0}, 1, 1, 'L'};
+    t["TRIGGC"] = {{0, 1}, 2, 1, 'C'};
+    t["SEARCHL"] = t["SEARCHJ"] = {{2, 2}, 1, 1, 'O', 1};  // Signal, SearchPoint, ToPoint, Speed, Tool
+    t["SEARCHC"] = {{2, 3}, 2, 1, 'C', 1};
+    for (const char* n : {"", "1", "2"}) {  // ArcL1, ArcL2 ...: the MultiMove forms
+      // (a copy of ArcLStart would strike the arc earlier: not a line kincal inserts targets on)
+      t[std::string("ARCL") + n + "START"] = {{0, 0}, 1, 1, 'O'};
+      t[std::string("ARCL") + n] = t[std::string("ARCL") + n + "END"] = {{0, 0}, 1, 1, 'L'};
+      for (const char* e : {"", "START", "END"}) t[std::string("ARCC") + n + e] = {{0, 1}, 2, 1, 'C'};
+    }
+    t["CAPL"] = {{0, 0}, 1, 1, 'L'};
+    t["CAPC"] = {{0, 1}, 2, 1, 'C'};
+    t["MOVEABSJ"] = t["MOVEEXTJ"] = t["SEARCHEXTJ"] = {{0, 0}, 0, 0, 'O'};  // no robtarget
+    return t;
+  }();
+  const auto it = table.find(word);
+  return it == table.end() ? nullptr : &it->second;
+}
+
+// Instructions of the motion families that do not move the robot (settings, events, process data).
+bool setting_instruction(const std::string& w) {
+  static const std::set<std::string> s{
+      "TRIGGIO", "TRIGGEQUIP", "TRIGGINT", "TRIGGCHECKIO", "TRIGGSPEED", "TRIGGRAMPAO", "TRIGGSTOPPROC",
+      "TRIGGDATARESET", "TRIGGDATACOPY", "ARCREFRESH", "ARCKILL", "CAPREFRESH", "CAPCONDSETDO", "CAPEQUISETUP",
+      "CAPAPTRSETUP", "CAPLATRSETUP", "CAPNOPROCESS", "CAPWEAVESYNC", "CAPINIT", "MOVEJSYNCSETUP"};
+  return s.count(w) > 0;
+}
+
+// Motions of other process options, listed rather than read.
+bool other_motion(const std::string& w) {
+  static const std::regex family(R"(^(MOVE|ARC|TRIGG|SEARCH|CAP)\w+$)"),
+      other(R"(^(SPOT(L|J|ML)|DISP(L|C)|PAINT(L|C)|CONTACTL)$)");
+  return std::regex_match(w, family) || std::regex_match(w, other);
+}
+
+struct Module {
+  std::string path;
+  std::vector<Stmt> stmts;
+  std::vector<Decl> decls;
+};
+
+Module module_of(const std::string& path, const std::vector<std::string>& lines, int file) {
+  Module m{path, statements(lines), {}};
+  m.decls = declarations_of(m.stmts, file, path);
+  return m;
+}
+
+// names assigned (p := .., p.trans.z := .., p{2} := ..) or written by a search (its SearchPoint)
+void assigned_names(const Module& m, std::map<std::string, std::string>& assigned) {
+  static const std::regex assign_re(R"(^\s*(\w+)(?:\.\w+|\{[^}]*\})*\s*:=)"), instr_re(R"(^\s*(\w+))");
+  for (const Stmt& s : m.stmts) {
+    std::smatch a;
+    const std::string at = where(m.path, s.line());
+    if (std::regex_search(s.text, a, assign_re)) {
+      assigned.emplace(upper_case(a[1].str()), at);
+    } else if (std::regex_search(s.text, a, instr_re)) {
+      const Instr* in = instruction(upper_case(a[1].str()));
+      if (!in || in->search_point < 0) continue;
+      const auto args = positional(s.text, static_cast<size_t>(a.length(0)));
+      if (args.size() > static_cast<size_t>(in->search_point)) {
+        const auto& [b, e] = args[static_cast<size_t>(in->search_point)];
+        assigned.emplace(upper_case(s.text.substr(b, e - b)), at);
+      }
+    }
+  }
+}
+
+void check_module(const Module& m) {
+  static const std::regex mod_re(R"(^\s*MODULE\s+\w+)", std::regex::icase), end_re(R"(^\s*ENDMODULE\b)", std::regex::icase);
+  int module_line = 0;
+  bool closed = false;
+  for (const Stmt& s : m.stmts) {
+    const std::string at = where(m.path, s.line());
+    if (!s.ended) throw InputError(at + ": a statement not ended by ';' (end of file)");
+    if (std::regex_search(s.text, mod_re)) {
+      if (module_line && !closed) throw InputError(at + ": MODULE inside MODULE");
+      module_line = s.line(), closed = false;
+    } else if (std::regex_search(s.text, end_re)) {
+      if (!module_line || closed) throw InputError(at + ": ENDMODULE without MODULE");
+      closed = true;
+    }
+  }
+  if (!module_line) throw InputError(m.path + ": no MODULE in the file");
+  if (!closed) throw InputError(where(m.path, module_line) + ": MODULE is not closed by ENDMODULE (end of file)");
+}
+
+std::vector<std::string> file_lines(const std::string& path) {
+  NativeProgram tmp;
+  add_program_file(tmp, path);
+  return tmp.lines[0];
 }
 
 }  // namespace
 
-Declarations read_rapid_declarations(const std::vector<std::string>&) { return {}; }  // (being written)
-
-NativeProgram read_rapid_program(const std::vector<std::string>& paths, const Declarations&) {
-  const std::string& path = paths[0];
-  NativeProgram p;
-  p.format = ControllerFormat::Rapid;
-  add_program_file(p, path);
-  const auto& lines = p.lines[0];
-  static const std::regex decl_re(
-      R"(^\s*(?:LOCAL\s+|TASK\s+)?(CONST|PERS|VAR)\s+(robtarget|wobjdata)\s+(\w+)\s*(:=\s*(.*?))?\s*;\s*$)",
-      std::regex::icase);
-  static const std::regex move_re(R"(^\s*(Move(?:J|L|C)\w*)\s+(.*?);?\s*$)", std::regex::icase);
-  struct Decl {
-    int line = 0;
-    size_t begin = 0, end = 0, type_begin = 0, type_end = 0;
-    bool has_value = false, robtarget = true;
-    std::string value;
-  };
-  std::map<std::string, Decl> decls;
-  std::map<std::string, bool> assigned;  // robtargets the module assigns (p := ..., p.trans.z := ...)
-  static const std::regex assign_re(R"(^\s*(\w+)(?:\.\w+|\{[^}]*\})*\s*:=)");
-  int module_line = 0;
-  bool closed = false;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    const std::string code = code_of(lines[i]);
-    const std::string at = where(path, static_cast<int>(i + 1));
-    std::smatch m;
-    static const std::regex mod_re(R"(^\s*MODULE\s+\w+)", std::regex::icase), end_re(R"(^\s*ENDMODULE\b)", std::regex::icase);
-    if (std::regex_search(code, mod_re)) {
-      if (module_line && !closed) throw InputError(at + ": MODULE inside MODULE");
-      module_line = static_cast<int>(i + 1), closed = false;
-    } else if (std::regex_search(code, end_re)) {
-      if (!module_line || closed) throw InputError(at + ": ENDMODULE without MODULE");
-      closed = true;
+Declarations read_rapid_declarations(const std::vector<std::string>& paths) {
+  Declarations out;
+  std::map<std::string, std::string> assigned;
+  std::vector<Module> mods;
+  for (const std::string& path : paths) {
+    mods.push_back(module_of(path, file_lines(path), 0));
+    assigned_names(mods.back(), assigned);
+  }
+  for (const Module& m : mods)
+    for (const Decl& d : m.decls) {
+      if (d.local) continue;
+      Declaration x{d.type, d.name, m.path, d.line, trim(d.value), d.storage == "VAR" || assigned.count(upper_case(d.name)) > 0};
+      out.named.emplace(upper_case(d.name), x);
     }
-    if (std::regex_search(code, std::regex(R"(\brobtarget\b)", std::regex::icase)) &&
-        code.find(';') == std::string::npos)
-      throw InputError(at + ": a robtarget declaration over several lines (kincal reads one per line)");
-    if (std::regex_match(code, m, decl_re)) {
+  return out;
+}
+
+namespace {
+
+// The reader of one task's modules.
+struct Reader {
+  NativeProgram p;
+  std::deque<Module> mods;                       // per file of p (context files: their declarations)
+  std::deque<Decl> elsewhere;                    // the backup's declarations that do not join the program
+  std::map<std::string, const Decl*> global;     // non-LOCAL declarations of the modules read
+  std::map<std::string, std::string> assigned;   // name -> where
+  std::set<std::string> routines, names;         // upper case
+  const Declarations& context;
+  std::map<std::string, std::vector<std::pair<std::string, size_t>>> uses;  // declaration -> (frames, target)
+
+  explicit Reader(const Declarations& c) : context(c) {}
+
+  // a declaration visible from file f: its own LOCAL ones, then the task's, then the backup's (a
+  // Cartesian target of the backup joins the program: its file is then written with it)
+  const Decl* find(const std::string& name, int f, bool join) {
+    const std::string u = upper_case(name);
+    for (const Decl& d : mods[static_cast<size_t>(f)].decls)
+      if (d.local && upper_case(d.name) == u) return &d;
+    const auto it = global.find(u);
+    if (it != global.end()) return it->second;
+    const Declaration* c = context.find(name);
+    if (!c) return nullptr;
+    if (!join || c->type != "ROBTARGET" || c->run_time || c->value.empty()) {
       Decl d;
-      d.line = static_cast<int>(i + 1);
-      d.robtarget = upper_case(m[2].str()) == "ROBTARGET";
-      std::tie(d.type_begin, d.type_end) = span_of(m, 2);
-      d.has_value = m[5].matched;
-      if (d.has_value) {
-        std::tie(d.begin, d.end) = span_of(m, 5);
-        d.value = m[5].str();
-        if (d.robtarget) parse_robtarget(d.value, at);  // checked here, where it is declared
-      }
-      decls[upper_case(m[3].str())] = d;
-    } else if (std::regex_search(code, m, assign_re)) {
-      assigned[upper_case(m[1].str())] = true;
+      d.type = c->type, d.storage = c->run_time ? "VAR" : "PERS", d.name = c->name, d.value = c->value;
+      d.path = c->path, d.line = c->line, d.file = -1;
+      elsewhere.push_back(d);
+      return &elsewhere.back();
+    }
+    size_t file = static_cast<size_t>(std::find(p.paths.begin(), p.paths.end(), c->path) - p.paths.begin());
+    if (file == p.paths.size()) {
+      add_program_file(p, c->path);
+      mods.push_back(module_of(c->path, p.lines.back(), static_cast<int>(file)));
+    }
+    for (const Decl& d : mods[file].decls)
+      if (!d.local && upper_case(d.name) == u) return &d;
+    throw InputError(where(c->path, c->line) + ": '" + name + "' is not declared here as the backup's files said");
+  }
+
+  // the tool's or work object's frame; "" or why the statement cannot be compensated
+  std::string frame(const std::string& name, bool tool, int f, const std::string& at, Eigen::Isometry3d& out) {
+    out = Eigen::Isometry3d::Identity();
+    if (upper_case(name) == (tool ? "TOOL0" : "WOBJ0")) return "";
+    const char* what = tool ? "tool" : "work object";
+    if (!std::regex_match(name, std::regex(R"(\w+)"))) return std::string("its ") + what + " is computed at run time (" + name + ")";
+    const Decl* d = find(name, f, false);
+    if (!d) return std::string("its ") + what + " '" + name + "' is declared nowhere";
+    const std::string type = tool ? "TOOLDATA" : "WOBJDATA";
+    const std::string dat = where(d->path, d->line);
+    if (d->type != type) throw InputError(at + ": " + what + " '" + name + "' is a " + d->type + " (" + dat + "), not a " + type);
+    if (d->value.empty() || d->storage == "VAR" || assigned.count(upper_case(name)))
+      return std::string("its ") + what + " '" + name + "' is set at run time";
+    const auto parts = parts_of(d->value);
+    if (tool) {
+      if (parts.size() != 3) throw InputError(dat + ": a tooldata has 3 parts [robhold,tframe,tload], this one " + std::to_string(parts.size()));
+      if (upper_case(parts[0]) == "FALSE")
+        throw InputError(at + ": tool '" + name + "' is a stationary tool (robhold FALSE): kincal compensates tools the robot holds");
+      out = frame_of(parts[1], dat, "the tooldata's tframe");
+      return "";
+    }
+    if (parts.size() != 5) throw InputError(dat + ": a wobjdata has 5 parts [robhold,ufprog,ufmec,uframe,oframe], this one " + std::to_string(parts.size()));
+    if (upper_case(parts[0]) == "TRUE")
+      throw InputError(at + ": work object '" + name + "' is held by the robot (robhold TRUE): kincal does not compensate a stationary tool's programs");
+    if (upper_case(parts[1]) == "FALSE" || trim(parts[2]) != "\"\"")
+      throw InputError(at + ": work object '" + name + "' is a moving user frame (ufprog FALSE or ufmec " + parts[2] + "): kincal compensates fixed work objects");
+    out = frame_of(parts[3], dat, "the wobjdata's uframe") * frame_of(parts[4], dat, "the wobjdata's oframe");
+    return "";
+  }
+
+  std::string copy_name(const std::string& name) {
+    for (int k = 1;; ++k) {
+      const std::string suffix = "_" + std::to_string(k);
+      const std::string n = name.substr(0, std::min(name.size(), kRapidNameLimit - suffix.size())) + suffix;
+      if (names.insert(upper_case(n)).second) return n;
     }
   }
-  if (!module_line) throw InputError(path + ": no MODULE in the file");
-  if (!closed) throw InputError(where(path, module_line) + ": MODULE is not closed by ENDMODULE (end of file)");
-  std::map<std::string, size_t> used;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    const std::string code = code_of(lines[i]);
-    std::smatch m;
-    if (!std::regex_match(code, m, move_re)) continue;
-    const std::string at = where(path, static_cast<int>(i + 1));
-    if (code.find(';') == std::string::npos) throw InputError(at + ": a motion over several lines (kincal reads one per line)");
-    std::vector<std::string> args = split_top(m[2].str());
-    while (!args.empty() && !args[0].empty() && args[0][0] == '\\') args.erase(args.begin());  // \Conc ...
-    const size_t n_targets = upper_case(m[1].str()).rfind("MOVEC", 0) == 0 ? 2 : 1;
-    // MoveJ (not MoveJDO, MoveJSync, ...) becomes MoveAbsJ when its target is written as joints
-    const bool movej = upper_case(m[1].str()) == "MOVEJ";
-    const auto [move_begin, move_end] = span_of(m, 1);
-    const NativeEdit to_absj{0, static_cast<int>(i + 1), move_begin, move_end, "MoveAbsJ"};
-    if (args.size() < n_targets + 2) throw InputError(at + ": " + m[1].str() + " needs target(s), speed and zone");
-    // the work object: \WObj:=name anywhere in the statement
-    Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
-    std::smatch w;
-    if (std::regex_search(code, w, std::regex(R"(\\WObj\s*:=\s*(\w+))", std::regex::icase)) && upper_case(w[1].str()) != "WOBJ0") {
-      const auto it = decls.find(upper_case(w[1].str()));
-      if (it == decls.end() || it->second.robtarget || !it->second.has_value)
-        throw InputError(at + ": work object '" + w[1].str() + "' is not declared with a value in the module");
-      const auto parts = split_top(it->second.value.substr(1, it->second.value.size() - 2));
-      const std::string wat = where(path, it->second.line);
-      if (parts.size() != 5) throw InputError(wat + ": a wobjdata has 5 parts, this one " + std::to_string(parts.size()));
-      const auto uf = split_top(parts[3].substr(1, parts[3].size() - 2)), of = split_top(parts[4].substr(1, parts[4].size() - 2));
-      if (uf.size() != 2 || of.size() != 2) throw InputError(wat + ": uframe and oframe are [[x,y,z],[q1,q2,q3,q4]]");
-      frame = frame_of(numbers(uf[0], 3, wat, "uframe"), numbers(uf[1], 4, wat, "uframe")) *
-              frame_of(numbers(of[0], 3, wat, "oframe"), numbers(of[1], 4, wat, "oframe"));
+
+  void motion(const Module& m, const Stmt& s, int f, size_t word_at, const std::string& word) {
+    const std::string at = where(m.path, s.line()), statement = trim(s.text), W = upper_case(word);
+    const Instr* in = instruction(W);
+    if (!in) {
+      p.unresolved.push_back({at, statement, "an instruction kincal does not read (" + word + ")"});
+      return;
     }
-    const std::string instr = upper_case(m[1].str());
-    const char kind = instr == "MOVEJ" ? 'J' : instr == "MOVEL" ? 'L' : n_targets == 2 ? 'C' : 'O';
-    for (size_t a = 0; a < n_targets; ++a) {
-      const std::string& arg = args[a];
-      p.motions.push_back(motion_around(code, static_cast<int>(i + 1), kind, code.find(arg, static_cast<size_t>(m.position(2))),
-                                        arg.size()));
-      if (!arg.empty() && arg[0] == '[') {
-        NativeTarget t;
-        t.line = static_cast<int>(i + 1);
-        t.begin = lines[i].find(arg);
-        t.end = t.begin + arg.size();
-        t.pose = parse_robtarget(arg, at);
-        t.frame = frame;
+    const auto args = positional(s.text, word_at + word.size());
+    auto arg = [&](size_t i) { return s.text.substr(args[i].first, args[i].second - args[i].first); };
+    auto line_of = [&](size_t o) { return s.pos(o); };
+    if (in->n_to == 0) {  // joints or external axes: kept as written
+      p.motions.push_back(motion_around(s.text, s.line(), W == "MOVEABSJ" ? 'J' : 'O', word_at, word.size()));
+      p.motions.back().file = f;
+      return;
+    }
+    const size_t need = static_cast<size_t>(std::max(in->to[0], in->to[1]) + in->tool_back + 1);
+    if (args.size() < need) throw InputError(at + ": " + word + " needs target(s), speed, zone and tool (" + std::to_string(args.size()) + " arguments)");
+    const std::string tool = arg(args.size() - static_cast<size_t>(in->tool_back));
+    std::smatch w;
+    const std::string wobj = std::regex_search(s.text, w, std::regex(R"(\\WObj\s*:=\s*([^\s\\,;]+))", std::regex::icase)) ? w[1].str() : "wobj0";
+    Eigen::Isometry3d tframe, wframe;
+    std::string why = frame(tool, true, f, at, tframe);
+    if (why.empty()) why = frame(wobj, false, f, at, wframe);
+    std::string named;
+    for (const std::string& n : {tool, wobj})
+      if (upper_case(n) != "TOOL0" && upper_case(n) != "WOBJ0") named += (named.empty() ? "" : ", ") + n;
+    const bool movej = W == "MOVEJ";
+    const auto [wl, wc] = line_of(word_at);
+    const NativeEdit to_absj{f, wl, wc, wc + word.size(), "MoveAbsJ"};
+    for (int a = 0; a < in->n_to; ++a) {
+      const size_t i = static_cast<size_t>(in->to[a]);
+      const std::string v = arg(i);
+      p.motions.push_back(motion_around(s.text, s.line(), in->kind, args[i].first, v.size()));
+      NativeMotion& mo = p.motions.back();
+      mo.file = f;
+      if (W.size() > 3 && W.compare(W.size() - 3, 3, "END") == 0 && in->kind == 'L')  // a target inserted before
+        mo.head.replace(mo.head.find(word), word.size(), word.substr(0, word.size() - 3));  // ArcLEnd continues the seam
+      if (!why.empty()) {
+        if (a == 0) p.unresolved.push_back({at, statement, why});
+        continue;
+      }
+      NativeTarget t;
+      t.tool = tframe, t.frame = wframe, t.frames_named = named, t.file = f;
+      if (v[0] == '[') {
+        std::tie(t.line, t.begin) = line_of(args[i].first);
+        int last = 0;
+        std::tie(last, t.end) = line_of(args[i].second - 1);
+        ++t.end;
+        if (last != t.line) t.last_line = last;
+        parse_robtarget(v, at, t);
         t.joint_motion = movej;
         t.joint_edits.push_back(to_absj);
-        p.motions.back().target = static_cast<int>(p.targets.size());
+        mo.target = static_cast<int>(p.targets.size());
         p.targets.push_back(t);
         continue;
       }
-      if (!std::regex_match(arg, std::regex(R"(\w+)"))) {  // Offs(..), RelTool(..), CRobT(..), p{i}, ...
-        p.unresolved.push_back({at, code});
+      if (!std::regex_match(v, std::regex(R"(\w+)"))) {  // Offs(..), RelTool(..), CRobT(..), p{i}, ...
+        p.unresolved.push_back({at, statement, v.find('{') != std::string::npos ? "computed at run time (an array element)" : "computed at run time"});
         continue;
       }
-      const auto it = decls.find(upper_case(arg));
-      if (it == decls.end() || !it->second.robtarget)
-        throw InputError(at + ": target '" + arg + "' is not declared as a robtarget in the module");
-      if (!it->second.has_value || assigned[upper_case(arg)] ||
-          !std::regex_search(lines[static_cast<size_t>(it->second.line - 1)],
-                             std::regex(R"(\bCONST\b|\bPERS\b)", std::regex::icase))) {
-        p.unresolved.push_back({at, code});  // a VAR, no value, or assigned in the module: set at run time
+      const Decl* d = find(v, f, true);
+      if (!d) {
+        p.unresolved.push_back({at, statement, "declared nowhere"});
         continue;
       }
-      if (used.count(upper_case(arg))) {
-        NativeTarget& t = p.targets[used[upper_case(arg)]];
-        t.joint_motion &= movej;
+      const std::string dat = where(d->path, d->line);
+      if (d->type != "ROBTARGET") throw InputError(at + ": target '" + v + "' is not declared as a robtarget (a " + d->type + ", " + dat + ")");
+      const Declaration* c = context.find(v);
+      const auto as = assigned.find(upper_case(v));
+      if (d->value.empty() || d->storage == "VAR" || as != assigned.end() || (c && c->path == d->path && c->run_time)) {
+        p.unresolved.push_back({at, statement, "computed at run time (" + (as != assigned.end() ? "assigned at " + as->second : d->value.empty() ? "declared without a value" : "a VAR") + ")"});
+        continue;
+      }
+      const std::string key = std::to_string(d->file) + ":" + upper_case(d->name), frames = upper_case(tool + "," + wobj);
+      auto& u = uses[key];
+      const auto same = std::find_if(u.begin(), u.end(), [&](const auto& x) { return x.first == frames; });
+      if (same != u.end()) {
+        NativeTarget& old = p.targets[same->second];
+        mo.target = static_cast<int>(same->second);
+        if (old.copy_of >= 0) {
+          old.edits.push_back({f, to_absj.line, 0, 0, old.name});
+          std::tie(old.edits.back().line, old.edits.back().begin) = line_of(args[i].first);
+          old.edits.back().end = old.edits.back().begin + v.size();
+          continue;
+        }
+        old.joint_motion &= movej;
+        old.joint_edits.push_back(to_absj);
+        continue;
+      }
+      t.line = d->vline, t.begin = d->vbegin, t.end = d->vend, t.file = d->file;
+      if (d->vlast != d->vline) t.last_line = d->vlast;
+      t.name = d->name;
+      parse_robtarget(d->value, where(d->path, d->vline), t);
+      if (u.empty()) {
+        t.joint_motion = movej;
+        t.joint_edits.push_back({d->file, d->tline, d->tbegin, d->tend, "jointtarget"});
         t.joint_edits.push_back(to_absj);
-        p.motions.back().target = static_cast<int>(used[upper_case(arg)]);
-        continue;
+      } else {  // a second (tool, wobj): a copy, declared after the original, and this statement renamed
+        t.copy_of = static_cast<int>(u.front().second);
+        t.name = copy_name(d->name);
+        NativeEdit e{f, 0, 0, 0, t.name};
+        std::tie(e.line, e.begin) = line_of(args[i].first);
+        e.end = e.begin + v.size();
+        t.edits.push_back(e);
       }
-      p.motions.back().target = static_cast<int>(p.targets.size());
-      used[upper_case(arg)] = p.targets.size();
-      const Decl& d = it->second;
-      NativeTarget t;
-      t.line = d.line;
-      t.begin = d.begin;
-      t.end = d.end;
-      t.name = arg;
-      t.pose = parse_robtarget(d.value, where(path, d.line));
-      t.frame = frame;
-      t.joint_motion = movej;
-      t.joint_edits.push_back({0, d.line, d.type_begin, d.type_end, "jointtarget"});
-      t.joint_edits.push_back(to_absj);
+      u.emplace_back(frames, p.targets.size());
+      mo.target = static_cast<int>(p.targets.size());
       p.targets.push_back(t);
     }
   }
-  keep_named_targets_cartesian(p, '!', true);
-  return p;
-}
 
-// a robtarget value with trans, rot and robconf replaced (extax kept as written)
-std::string rapid_robtarget(const std::string& old, const Pose6& pose, const ControllerTarget& t) {
-  const auto parts = split_top(old.substr(1, old.size() - 2));
-  const auto q = ctl::quaternion_of(pose.abc);
-  std::string s = "[[";
-  for (int k = 0; k < 3; ++k) s += (k ? "," : "") + ctl::fixed(pose.xyz[k], 4);
-  s += "],[";
-  for (int k = 0; k < 4; ++k) s += (k ? "," : "") + ctl::fixed(q[static_cast<size_t>(k)], 9);
-  s += "],[";
-  for (int k = 0; k < 4; ++k) s += (k ? "," : "") + std::to_string(t.abb_conf[static_cast<size_t>(k)]);
-  return s + "]," + parts[3] + "]";
-}
+  void read(const std::vector<std::string>& paths) {
+    p.format = ControllerFormat::Rapid;
+    for (const std::string& path : paths) {
+      add_program_file(p, path);
+      mods.push_back(module_of(path, p.lines.back(), static_cast<int>(mods.size())));
+      check_module(mods.back());
+    }
+    static const std::regex routine_re(R"(^\s*(?:LOCAL\s+)?(?:PROC|TRAP|FUNC\s+\w+)\s+(\w+))", std::regex::icase);
+    for (const Module& m : mods) {
+      assigned_names(m, assigned);
+      for (const Decl& d : m.decls) {
+        names.insert(upper_case(d.name));
+        if (!d.local) global.emplace(upper_case(d.name), &d);
+      }
+      for (const Stmt& s : m.stmts) {
+        std::smatch r;
+        if (std::regex_search(s.text, r, routine_re)) routines.insert(upper_case(r[1].str()));
+      }
+    }
+    for (const auto& [n, d] : context.named) names.insert(n);
+    // a statement's instruction: after a label, CASE ..:, or a compact IF's condition
+    static const std::regex instr_re(
+        R"(^(\s*(?:(?:CASE\b[^:;]*|DEFAULT\s*|\w+\s*):(?!=)\s*)?(?:IF\b.*?\s(?=(?:Move|Arc|Trigg|Search|Cap)\w*[\s\\]))?)([A-Za-z]\w*)(?=[\s\\;]))",
+        std::regex::icase);
+    const size_t n_read = mods.size();
+    for (size_t f = 0; f < n_read; ++f)
+      for (const Stmt& s : mods[f].stmts) {
+        std::smatch m;
+        if (!std::regex_search(s.text, m, instr_re)) continue;
+        const std::string W = upper_case(m[2].str());
+        if (routines.count(W) || setting_instruction(W) || !(instruction(W) || other_motion(W))) continue;
+        motion(mods[f], s, static_cast<int>(f), static_cast<size_t>(m.position(2)), m[2].str());
+      }
+    keep_named_targets_cartesian(p, '!', true);
+    for (NativeTarget& t : p.targets)
+      if (t.copy_of >= 0) t.joint_motion = false, t.joint_edits.clear();  // (a copy stays a robtarget)
+  }
+};
 
-// a robtarget value as a jointtarget [[q1..q6],[extax]], its external axes kept as written
-std::string rapid_jointtarget(const std::string& old, const Vec6& q_deg) {
-  const auto parts = split_top(old.substr(1, old.size() - 2));
-  std::string s = "[[";
-  for (int j = 0; j < 6; ++j) s += (j ? "," : "") + ctl::fixed(q_deg[j], ctl::kJointDecimals);
-  return s + "]," + parts[3] + "]";
+}  // namespace
+
+NativeProgram read_rapid_program(const std::vector<std::string>& paths, const Declarations& context) {
+  Reader r(context);
+  r.read(paths);
+  return std::move(r.p);
 }
 
 }  // namespace kincal

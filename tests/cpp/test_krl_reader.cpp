@@ -354,17 +354,16 @@ TEST(KrlReader, KrlBackupProgramsReadAsOneReachTheirTaughtBranch) {
 
 TEST(KrlReader, KrlTapeProgramAsBefore) {
   // tests/data/programs/tape.src: E6POS / POS / FRAME targets, the inline LIN, XHOME joints, joint edits; its
-  // $TOOL = TOOL_DATA[1] needs the tool's declaration now
+  // $TOOL = $NULLFRAME is tool 0 (a TOOL_DATA[n] would need its declaration: KrlMissingToolDataIsAnError)
   const std::string tape = kBackup + "../../../tape.src";
-  const std::string e = error_of([&] { read_native_program(tape, ControllerFormat::Krl); });
-  EXPECT_NE(e.find("tape.src:22: the motion's tool TOOL_DATA[1] is not declared"), std::string::npos) << e;
-  const NativeProgram p = read_native_program(tape, ControllerFormat::Krl, tools());
+  const NativeProgram p = read_native_program(tape, ControllerFormat::Krl);
   ASSERT_EQ(p.targets.size(), 6u);  // XP1, XP2, the inline LIN, XAUX, XP3, XP4
   EXPECT_TRUE(p.unresolved.empty());
   EXPECT_TRUE(p.targets[0].joint_motion);
   EXPECT_EQ(p.targets[0].joint_edits.at(0).text, "E6AXIS");
   EXPECT_EQ(p.targets[3].joint_edits.at(0).text, "AXIS");
-  EXPECT_EQ(p.targets[0].frames_named, "TOOL_DATA[1]");
+  EXPECT_EQ(p.targets[0].frames_named, "");
+  EXPECT_TRUE(p.targets[0].tool.isApprox(Eigen::Isometry3d::Identity()));
 }
 
 }  // namespace

@@ -428,16 +428,15 @@ TEST(RapidKept, ModuleChecksRunTimeTargetsAndMalformedValues) {
   EXPECT_EQ(p.motions.size(), 5u);
 }
 
-// Enabled when native.cpp's writer hands a RAPID value over several lines to rapid_robtarget /
-// rapid_jointtarget (today its several-line branch calls the LS writers, and the value is left as it was).
-TEST(RapidMultiLine, DISABLED_ValuesOverSeveralLinesAreWrittenBackInTheirLines) {
+// native.cpp's writer hands a RAPID value over several lines to rapid_robtarget / rapid_jointtarget.
+TEST(RapidMultiLine, ValuesOverSeveralLinesAreWrittenBackInTheirLines) {
   const NativeProgram p = read_mod("wml.mod", "  CONST robtarget p1:=[[1900,-300,700],\n      [0.707106781,0,0.707106781,0],\n"
                                                "      [0,-1,-1,0],\n      [9E9,9E9,9E9,9E9,9E9,9E9]];\n  PROC main()\n"
                                                "    MoveL p1, v100, fine, tool0;\n  ENDPROC\n");
   ASSERT_EQ(p.targets.size(), 1u);
   Pose6 pose = p.targets[0].pose;
   pose.xyz.x() += 1;
-  const auto out = write_native_program(p, {pose}, {ControllerTarget{}}, {false}, ::testing::TempDir() + "wml_out.mod");
+  const auto out = write_native_program(p, {pose}, {ControllerTarget{}}, {false}, {::testing::TempDir() + "wml_out.mod"});
   ASSERT_EQ(out.size(), 1u);
   EXPECT_NE(out[0].text.find("p1:=[[1901.0000,-300.0000,700.0000],\n      [0.707106781,"), std::string::npos) << out[0].text;
   EXPECT_NE(out[0].text.find("\n      [0,0,0,0],\n      [9E9,9E9,9E9,9E9,9E9,9E9]];\n"), std::string::npos) << out[0].text;

@@ -93,9 +93,11 @@ def test_rapid_movej_target_becomes_jointtarget_with_moveabsj(tmp_path, model, c
     assert "MoveAbsJ p1,v500,z10,thead\\WObj:=wtable;" in changed  # only the instruction's name changes
     m = re.search(r"CONST jointtarget p1:=\[\[" + ",".join([N] * 6) + r"\],\[9E9,9E9,9E9,9E9,9E9,9E9\]\];", b)
     assert m
-    # p1 is [1900, -720, 600] with q = (0.7071, 0, 0.7071, 0) in the work object wtable (x + 100, y - 20)
+    # p1 is [1900, -720, 600] with q = (0.7071, 0, 0.7071, 0) in the work object wtable (x + 500, y - 20), the
+    # TCP of thead (350 mm along the flange's z, which the orientation turns to the base's x): the model's
+    # tool (the flange) at [2400 - 350, -740, 600]
     rot = Rotation.from_quat([0, 0.707106781, 0, 0.707106781])  # scipy: x, y, z, w
-    _assert_reaches(calibrated, [float(m.group(k)) for k in range(1, 7)], [2000, -740, 600, rot], 1e-3, 1e-4)
+    _assert_reaches(calibrated, [float(m.group(k)) for k in range(1, 7)], [2050, -740, 600, rot], 1e-3, 1e-4)
 
 
 def test_ls_j_position_becomes_joint_form(tmp_path, model, calibrated):

@@ -97,20 +97,24 @@ def test_rapid_only_target_lines_change(tmp_path, model, calibrated, tool):
     changed = [a.split("\n")[i - 1].strip() for i in _changed(a, b)]
     assert [c.split("[[")[0] for c in changed] == ["CONST robtarget p1:=", "CONST robtarget p2:=",
                                                    "PERS robtarget paux:=", "CONST robtarget p3:=", "MoveL "]
-    # the work object wtable (uframe x + 100, oframe y - 20) is applied: the robot's pose is the
-    # object pose moved by (100, -20, 0); the new robtargets stay in the work object
+    # the work object wtable (uframe x + 500, oframe y - 20) and the tool thead (TCP 350 mm along the flange's
+    # z) are applied: the TCP is the object pose moved by (500, -20, 0), the model's tool (the flange) 350 mm
+    # behind it along the target's z; the new robtargets stay in the work object
     for line in b.split("\n"):
         m = re.search(r"\[\[([^\]]*)\],\[([^\]]*)\],\[([^\]]*)\],\[9E9", line)
         if not m:
             continue
         old = re.search(r"\[\[([^\]]*)\]", a.split("\n")[b.split("\n").index(line)]).group(1)
-        want = np.array([float(v) for v in old.split(",")]) + [100, -20, 0]
-        xyz = [float(v) for v in m.group(1).split(",")]
-        t = {"pose": list(np.array(xyz) + [100, -20, 0]) + _abc_of_quaternion(*[float(v) for v in m.group(2).split(",")]),
-             "abb_conf": [int(v) for v in m.group(3).split(",")]}
+        want = np.array([float(v) for v in old.split(",")]) + [500, -20, 0]
+        xyz = np.array([float(v) for v in m.group(1).split(",")]) + [500, -20, 0]
+        w, x, y, z = (float(v) for v in m.group(2).split(","))
+        flange = xyz - Rotation.from_quat([x, y, z, w]).apply([0, 0, 350])
+        t = {"pose": list(flange) + _abc_of_quaternion(w, x, y, z), "abb_conf": [int(v) for v in m.group(3).split(",")]}
         q = _core.select_branch(calibrated, "rapid", t)
         assert not isinstance(q, str), q
-        assert np.linalg.norm(kincal.fk(calibrated, q)[0][:3] - want) < 1e-3
+        reached = kincal.fk(calibrated, q)[0]
+        tcp = reached[:3] + Rotation.from_euler("ZYX", reached[3:], degrees=True).apply([0, 0, 350])
+        assert np.linalg.norm(tcp - want) < 1e-3
 
 
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])

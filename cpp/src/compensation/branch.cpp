@@ -25,7 +25,11 @@ int fanuc_turn(double q) { return static_cast<int>(std::floor((q + 180.0) / 360.
 
 // the value of a joint with the wanted 360-degree multiple in format f (joint j, branch data of t)
 double unwrap(ControllerFormat f, int j, double q, const ControllerTarget& t) {
-  const double w = wrap180(q);
+  // a solution on a border up to rounding (A1 = -1e-14 for a target taught at 0) is on it: branch data
+  // count the border as its taught side
+  double w = wrap180(q);
+  const double border = 90.0 * std::round(w / 90.0);
+  if (std::abs(w - border) < 1e-9) w = wrap180(border);
   if (f == ControllerFormat::Krl) {
     const bool neg = (t.kuka_t >> j) & 1;
     if (neg) return w < 0 ? w : w - 360.0;

@@ -196,7 +196,10 @@ std::vector<OutputFile> write_native_program(const NativeProgram& p, const std::
     for (int l = nt.line; l <= nt.last_line; ++l) joined += f[static_cast<size_t>(l - 1)] + (l < nt.last_line ? "\n" : "");
     const size_t end = joined.size() - f[static_cast<size_t>(nt.last_line - 1)].size() + nt.end;
     const std::string old = joined.substr(nt.begin, end - nt.begin);
-    joined.replace(nt.begin, end - nt.begin, as_joints ? ls_joint_position(old, t[k].q_deg) : ls_position(old, pose[k], t[k]));
+    joined.replace(nt.begin, end - nt.begin,
+                   p.format == ControllerFormat::Rapid
+                       ? (as_joints ? rapid_jointtarget(old, t[k].q_deg) : rapid_robtarget(old, pose[k], t[k]))
+                       : (as_joints ? ls_joint_position(old, t[k].q_deg) : ls_position(old, pose[k], t[k])));
     size_t b = 0;
     for (int l = nt.line; l <= nt.last_line; ++l) {
       const size_t e = l < nt.last_line ? joined.find('\n', b) : joined.size();

@@ -1,7 +1,7 @@
 MODULE tape
   ! tape laying: approach, lay, arc, retract (hand-written, RAPID syntax)
   PERS tooldata thead:=[TRUE,[[0,0,350],[1,0,0,0]],[300,[0,0,150],[1,0,0,0],0,0,0]];
-  TASK PERS wobjdata wtable:=[FALSE,TRUE,"",[[100,0,0],[1,0,0,0]],[[0,-20,0],[1,0,0,0]]];
+  TASK PERS wobjdata wtable:=[FALSE,TRUE,"",[[500,0,0],[1,0,0,0]],[[0,-20,0],[1,0,0,0]]];
   CONST jointtarget jhome:=[[0,-90,90,0,90,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST robtarget p1:=[[1900,-720,600],[0.707106781,0,0.707106781,0],[0,-2,-2,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST robtarget p2:=[[1900,-720,500],[0.707106781,0,0.707106781,0],[0,-2,-2,0],[9E9,9E9,9E9,9E9,9E9,9E9]];

@@ -105,8 +105,9 @@ def test_ls_j_position_becomes_joint_form(tmp_path, model, calibrated):
     assert "1 target(s) written as joints, 3 as filtered poses" in r.stderr
     a, b = (DATA / "tape.ls").read_text(), out.read_text()
     # P[2] (J motions only) in joint form on its three lines; P[3] (L and an Offset motion), P[4], P[5]
-    # (C, L) stay Cartesian: 12 lines of /POS, no line of /MN
-    assert len(_changed(a, b)) == 12 and all(i > a.split("\n").index("/POS") for i in _changed(a, b))
+    # (C, L) stay Cartesian with their taught CONFIG line unchanged (the taught branch kept): 9 lines of /POS,
+    # no line of /MN
+    assert len(_changed(a, b)) == 9 and all(i > a.split("\n").index("/POS") for i in _changed(a, b))
     m = re.search(r"P\[2:\"approach\"\]\{\s*GP1:\s*UF : 0, UT : 1,\s*" +
                   r",\s*".join(f"J{j}=\\s*{N} deg" for j in range(1, 7)) + r"\s*\};", b)
     assert m, b

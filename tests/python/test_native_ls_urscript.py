@@ -234,7 +234,8 @@ def test_ls_several_frames_need_each_given(tmp_path, model, tool):
               f"frames.ls:{line_p2 + 2}"),
              (every + ["--uframe", "7=0,0,0,0,0,0"], "--uframe 7: no position is in UF 7", "frames.ls"),
              (every + ["--program-base", "1,0,0,0,0,0"], "--uframe and --program-base together", "--uframe"),
-             (every + ["--tolerance", "0.05"], "--tolerance follows the path of one tool", "P[4] is in UT 2")]
+             (every[:-4] + ["--uframe", "2=0,0,0,0,0,0", "--utool", "2=0,0,10,0,0,0", "--tolerance", "0.05"],
+              "--tolerance follows the path of one tool", "P[4] is in another tool than P[2]")]
     for extra, where, cause in cases:
         r = run(tool, *base, *extra)
         assert r.returncode == 1 and where in r.stderr and cause in r.stderr and not out.exists(), (extra, r.stderr)

@@ -127,23 +127,25 @@ def test_runtime_targets_are_listed(tmp_path, model, tool):
     out = tmp_path / "out.mod"
     r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "rt.mod"), "--out", str(out),
             "--targets", "filtered")
-    assert r.returncode == 1 and "2 target(s) computed at run time" in r.stderr, r.stderr
-    assert "rt.mod:20:" in r.stderr and "Offs(p3" in r.stderr and "rt.mod:21:" in r.stderr and not out.exists()
+    assert r.returncode == 1 and "2 motion(s) whose target kincal does not compensate" in r.stderr, r.stderr
+    assert "rt.mod:20: computed at run time" in r.stderr and "Offs(p3" in r.stderr and "rt.mod:21:" in r.stderr
+    assert not out.exists()
     r = run(tool, *args, "--model", str(model), "--program", str(tmp_path / "rt.mod"), "--out", str(out),
             "--targets", "filtered", "--skip-unresolved")
-    assert r.returncode == 0 and "rt.mod:20: target computed at run time, passed through" in r.stderr, r.stderr
+    assert r.returncode == 0 and "rt.mod:20: computed at run time" in r.stderr, r.stderr
+    assert "passed through unchanged: MoveL Offs(p3,0,0,50)" in r.stderr
     assert "MoveL Offs(p3,0,0,50)," in out.read_text()
 
 
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
 @pytest.mark.parametrize("ext,edit,message", [
     (".mod", ("ENDMODULE\n", ""), "tape.mod:1: MODULE is not closed by ENDMODULE"),
-    (".mod", ("MoveL p2,", "MoveL p9,"), "tape.mod:16: target 'p9' is not declared"),
+    (".mod", ("MoveL p2,", "MoveL p9,"), "tape.mod:16: declared nowhere: MoveL p9,"),
     (".mod", ("[0,-2,-2,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n  CONST robtarget p2", "[0,-2,-2,0]];\n  CONST robtarget p2"),
      "tape.mod:6: a robtarget has 4 parts"),
-    (".mod", ("[[1900,-720,500]", "[[1900,-72O,500]"), "tape.mod:7: the robtarget's trans: '-72O' is not a number"),
+    (".mod", ("[[1900,-720,500]", "[[1900,-72O,500]"), "tape.mod:7: the robtarget's trans and rot: '-72O' is not a number"),
     (".src", ("PTP XHOME\nEND\n", "PTP XHOME\n"), "tape.src:4: DEF is not closed by END"),
-    (".src", ("LIN XP2 C_DIS", "LIN XP7 C_DIS"), "tape.src:26: target 'XP7' is not declared"),
+    (".src", ("LIN XP2 C_DIS", "LIN XP7 C_DIS"), "tape.src:26: declared nowhere: LIN XP7 C_DIS"),
     (".dat", ("Z 500.0,A 0.0", "Z 5OO.0,A 0.0"), "tape.dat:10: Z '5OO.0' is not a number"),
     (".dat", ("ENDDAT\n", ""), "tape.dat:3: DEFDAT is not closed by ENDDAT"),
 ])
@@ -187,7 +189,9 @@ def test_targets_assigned_or_computed_in_the_program_are_run_time(tmp_path, mode
     (tmp_path / "out").mkdir()
     r = run("kincal", "compensate", "--model", str(model), "--program", str(tmp_path / name), "--out",
             str(tmp_path / "out" / name))
-    assert r.returncode == 1 and "computed at run time" in r.stderr and where in r.stderr, r.stderr
+    assert r.returncode == 1 and "whose target kincal does not compensate" in r.stderr, r.stderr
+    why = "a relative motion (LIN_REL)" if case == "krl-rel" else "computed at run time"
+    assert f"{where} {why}" in r.stderr or (case.startswith("krl") and where in r.stderr and why in r.stderr), r.stderr
     assert not any((tmp_path / "out").iterdir())
 
 
@@ -258,30 +262,33 @@ def test_crlf_gcode_keeps_its_line_ends(tmp_path, model, tool):
 
 @pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
 def test_filtered_module_takes_the_name_of_its_file(tmp_path, model, tool):
-    # a KRL module is named by its files (DEF in the .src, DEFDAT in the .dat), a RAPID module by MODULE:
-    # written to another file name it takes that name, every other line as when written under its own
-    # name; a file name the controller cannot take is refused, naming --out and the rule, nothing written
+    # a KRL module is named by its files (DEF in the .src, DEFDAT in the .dat): written to another file name it
+    # takes that name, every other line as when written under its own name; a file name the controller cannot
+    # take is refused, naming --out and the rule, nothing written. RAPID does not tie a module's name to its
+    # file's: MODULE keeps its name under any file name (issue 30: MainModule in test_4.mod came back renamed)
     for f in ("tape.src", "tape.dat", "tape.mod"):
         shutil.copy(DATA / f, tmp_path / f)
     args = ["compensate"] if tool == "kincal" else []
     for d in ("same", "other", "bad"):
         (tmp_path / d).mkdir()
     for prog, new, head in (("tape.src", "other.src", ["DEF tape( )", "DEFDAT  tape"]),
-                            ("tape.mod", "other.mod", ["MODULE tape"])):
+                            ("tape.mod", "other-1.mod", [])):
         common = [*args, "--model", str(model), "--program", str(tmp_path / prog), "--targets", "filtered"]
         assert run(tool, *common, "--out", str(tmp_path / "same" / prog)).returncode == 0
         r = run(tool, *common, "--out", str(tmp_path / "other" / new))
         assert r.returncode == 0, r.stderr
         exts = (".src", ".dat") if prog.endswith(".src") else (".mod",)
         same = "".join((tmp_path / "same" / ("tape" + e)).read_text() for e in exts)
-        other = "".join((tmp_path / "other" / ("other" + e)).read_text() for e in exts)
+        other = "".join((tmp_path / "other" / (Path(new).stem + e)).read_text() for e in exts)
         for h in head:
             assert h in same
             same = same.replace(h, h.replace("tape", "other"))
         assert other == same
+        if prog.endswith(".mod"):
+            assert "MODULE tape" in other
+            continue
         bad = tmp_path / "bad" / ("other-1" + Path(prog).suffix)
         r = run(tool, *common, "--out", str(bad))
-        lang = "KRL" if prog.endswith(".src") else "RAPID"
-        assert r.returncode == 1 and f"--out {bad}: a {lang} module is named by its file" in r.stderr, r.stderr
+        assert r.returncode == 1 and f"--out {bad}: a KRL module is named by its file" in r.stderr, r.stderr
         assert "'other-1' is not a" in r.stderr and "a letter, then letters, digits or '_'" in r.stderr
         assert not any((tmp_path / "bad").iterdir())

@@ -152,22 +152,32 @@ def test_bad_tolerance(tmp_path, calibrated):
     assert r.returncode != 0 and "--tolerance" in r.stderr and not (tmp_path / "o.csv").exists()
 
 
-def _native_line(lang: str, ends: np.ndarray) -> dict:
+def _taught(robot, pose) -> dict:
+    """The branch data of the nominal solution nearest home: what the program was taught on."""
+    home = np.array([0, -90, 90, 0, 90, 0])
+    sols = [np.asarray(s["q_deg"]) for s in kincal.ik(robot, pose) if s["within_limits"]]
+    return _core.branch_data(robot, min(sols, key=lambda q: np.abs(q - home).max()))
+
+
+def _native_line(lang: str, ends: np.ndarray, robot) -> dict:
     """The line's two ends as a hand-written program: a joint motion to the first, a straight line to
-    the second (KRL PTP/LIN, RAPID MoveJ/MoveL, LS J/L, URScript movej/movel)."""
+    the second (KRL PTP/LIN, RAPID MoveJ/MoveL, LS J/L, URScript movej/movel), with the branch data of the
+    nominal solutions nearest home (the taught ones)."""
     a, b = ends
+    conf = {id(p): _taught(robot, p) for p in (a, b)}
     krl = lambda p: "{" + ",".join(f"{k} {v:.4f}" for k, v in zip("XYZABC", p)) + "}"
     if lang == "krl":
         return {"line.src": "DEF line( )\n$VEL.CP = 0.2 ; m/s\nPTP XP1\nLIN XP2 C_DIS\nEND\n",
                 "line.dat": f"DEFDAT line\nDECL E6POS XP1={krl(a)}\nDECL E6POS XP2={krl(b)}\nENDDAT\n"}
     if lang == "rapid":
         q = lambda p: ",".join(f"{v:.9f}" for v in np.roll(_abc_rot(p[3:]).as_quat(), 1))
-        rt = lambda p: f"[[{p[0]:.4f},{p[1]:.4f},{p[2]:.4f}],[{q(p)}],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]"
+        rt = lambda p: (f"[[{p[0]:.4f},{p[1]:.4f},{p[2]:.4f}],[{q(p)}],[{','.join(map(str, conf[id(p)]['abb_conf']))}],"
+                        "[9E9,9E9,9E9,9E9,9E9,9E9]]")
         return {"line.mod": f"MODULE line\n  CONST robtarget p1:={rt(a)};\n  CONST robtarget p2:={rt(b)};\n"
                             "  PROC main()\n    MoveJ p1,v500,fine,tool0;\n    MoveL p2,v200,z1,tool0; ! the line\n"
                             "  ENDPROC\nENDMODULE\n"}
     if lang == "ls":
-        pos = lambda n, p: (f"P[{n}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
+        pos = lambda n, p: (f"P[{n}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : '{conf[id(p)]['fanuc_config']}',\n"
                             f"\tX = {p[0]:.3f}  mm,\tY = {p[1]:.3f}  mm,\tZ = {p[2]:.3f}  mm,\n"
                             f"\tW = {p[5]:.3f} deg,\tP = {p[4]:.3f} deg,\tR = {p[3]:.3f} deg\n}};\n")
         return {"LINE.ls": "/PROG  LINE\n/ATTR\nLINE_COUNT\t= 3;\n/MN\n   1:  J P[1] 20% FINE    ;\n"
@@ -210,7 +220,7 @@ def test_native_program_straight_line_keeps_within_tolerance(tmp_path, calibrate
     # straight-line motion (its speed, zone, tool) before it, every other line is kept; the controller's
     # LIN through the written targets, emulated here, keeps the real robot within 0.05 mm of the line
     ends = kincal.line_program(count=2, step_mm=1480.0)
-    files = _native_line(lang, ends)
+    files = _native_line(lang, ends, calibrated)
     for name, text in files.items():
         (tmp_path / name).write_text(text)
     (tmp_path / "out").mkdir()

@@ -205,8 +205,8 @@ def rapid_statements(text: str) -> list:
     out, cur, start = [], "", 0
     for i, line in enumerate(text.replace("\r", "").split("\n"), 1):
         code = re.sub(r"!.*$", "", line) if '"' not in line else line
-        if not cur.strip() and re.match(r"\s*(PROC|ENDPROC|MODULE|ENDMODULE|FUNC|ENDFUNC|TRAP|ENDTRAP|IF|ELSEIF|ELSE|ENDIF|FOR|"
-                                        r"ENDFOR|WHILE|ENDWHILE|TEST|CASE|DEFAULT|ENDTEST|%%%|VERSION|LANGUAGE)\b", code):
+        if not cur.strip() and re.match(r"\s*(?:(?:PROC|ENDPROC|MODULE|ENDMODULE|FUNC|ENDFUNC|TRAP|ENDTRAP|IF|ELSEIF|ELSE|ENDIF|"
+                                        r"FOR|ENDFOR|WHILE|ENDWHILE|TEST|CASE|DEFAULT|ENDTEST|VERSION|LANGUAGE)\b|%%%)", code):
             continue  # a line that is no statement ending in ';'
         if not cur.strip():
             start = i
@@ -366,8 +366,11 @@ def masked(text: str, ext: str, copies: dict) -> list:
         return re.sub(r"[ \t]+", "", re.sub(NUM, "N", m.group(0)))
     text = text.replace("\r", "")
     if ext == ".src" or ext == ".dat":
-        text = re.sub(r"X\s+" + NUM + r"\s*,\s*Y\s+" + NUM + r"\s*,\s*Z\s+" + NUM + r"\s*,\s*A\s+" + NUM + r"\s*,\s*B\s+" + NUM +
-                      r"\s*,\s*C\s+" + NUM + r"(?:\s*,\s*S\s+\d+\s*,\s*T\s+\d+)?", num_n, text)
+        # the branch data are part of the target's value: S and T added to an inline target that had none
+        # (so that the controller takes the compensated branch) change nothing else
+        text = re.sub(r"(X\s+" + NUM + r"\s*,\s*Y\s+" + NUM + r"\s*,\s*Z\s+" + NUM + r"\s*,\s*A\s+" + NUM + r"\s*,\s*B\s+" +
+                      NUM + r"\s*,\s*C\s+" + NUM + r")(?:\s*,\s*S\s+\d+\s*,\s*T\s+\d+)?",
+                      lambda m: re.sub(r"[ \t]+", "", re.sub(NUM, "N", m.group(1))), text)
     elif ext == ".ls":
         text = re.sub(r"CONFIG : '[^']*'", "CONFIG : 'N'", text)
         text = re.sub(r"\b[XYZWPR] =\s*" + NUM, num_n, text)

@@ -161,7 +161,10 @@ def test_unreachable_taught_solution_is_an_error(tmp_path, kr500, calibrated, ki
             "--targets", "filtered"]
     r = run("kincal", *base)
     assert r.returncode == 1
-    assert f"{prog.name}:" in r.stderr and "taught" in r.stderr and "--allow-branch-change" in r.stderr
+    declared_in = prog.with_suffix(".dat") if kind == "krl" else prog  # the first target's line
+    # (an LS position's line: its CONFIG's, where its values start)
+    line = next(i + 1 for i, l in enumerate(declared_in.read_text().split("\n")) if re.search(r"XP1=|p1:=|CONFIG", l))
+    assert f"{declared_in.name}:{line}:" in r.stderr and "taught" in r.stderr and "--allow-branch-change" in r.stderr
     assert not out.exists()
     r = run("kincal", *base, "--allow-branch-change")
     assert r.returncode == 0, r.stderr

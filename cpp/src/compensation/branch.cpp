@@ -23,24 +23,23 @@ Vec3 turn(const Model& m, int j, double q_deg, const Vec3& x) {
 int quadrant(double q) { return static_cast<int>(std::floor(q / 90.0)); }
 int fanuc_turn(double q) { return static_cast<int>(std::floor((q + 180.0) / 360.0)); }
 
-// the value of a joint with the wanted 360-degree multiple in format f (joint j, branch data of t)
-double unwrap(ControllerFormat f, int j, double q, const ControllerTarget& t) {
-  // a solution on a border up to rounding (A1 = -1e-14 for a target taught at 0) is on it: branch data
-  // count the border as its taught side
-  double w = wrap180(q);
-  const double border = 90.0 * std::round(w / 90.0);
-  if (std::abs(w - border) < 1e-9) w = wrap180(border);
+// the value of a joint with the wanted 360-degree multiple in format f (joint j, branch data of t); a value
+// within tol of a border may count on either side of it
+double unwrap(ControllerFormat f, int j, double q, const ControllerTarget& t, double tol) {
+  const double w = wrap180(q);
   if (f == ControllerFormat::Krl) {
     const bool neg = (t.kuka_t >> j) & 1;
-    if (neg) return w < 0 ? w : w - 360.0;
-    return w >= 0 ? w : w + 360.0;
+    if (neg) return w < tol ? w : w - 360.0;
+    return w > -tol ? w : w + 360.0;
   }
   const int idx = j == 0 ? 0 : j == 3 ? 1 : j == 5 ? 2 : -1;
   if (idx < 0) return w;
   if (f == ControllerFormat::Rapid) {
     const int cf = t.abb_conf[static_cast<size_t>(idx)];
-    for (int k = -3; k <= 3; ++k)
-      if (quadrant(w + 360.0 * k) == cf) return w + 360.0 * k;
+    for (int k = -3; k <= 3; ++k) {
+      const double v = w + 360.0 * k;
+      if (quadrant(v) == cf || quadrant(v + tol) == cf || quadrant(v - tol) == cf) return v;
+    }
     return std::nan("");
   }
   // FANUC: the turn number written after the three letters
@@ -49,6 +48,37 @@ double unwrap(ControllerFormat f, int j, double q, const ControllerTarget& t) {
   if (c == std::string::npos || std::sscanf(t.fanuc_config.c_str() + c + 1, "%d , %d , %d", &turns[0], &turns[1], &turns[2]) != 3)
     return std::nan("");
   return w + 360.0 * turns[idx];
+}
+
+bool same_branch(ControllerFormat f, const ControllerTarget& a, const ControllerTarget& b) {
+  return f == ControllerFormat::Krl     ? (a.kuka_s == b.kuka_s && a.kuka_t == b.kuka_t)
+         : f == ControllerFormat::Rapid ? a.abb_conf == b.abb_conf
+                                        : a.fanuc_config == b.fanuc_config;
+}
+
+// whether joints q have t's branch data, with each joint within tol of a border (a multiple of 90 deg) taken
+// on either side of it
+bool branch_matches(const Robot& robot, ControllerFormat f, const Vec6& q, const ControllerTarget& t, double tol) {
+  ControllerTarget c = t;
+  c.q_deg = q;
+  set_branch_data(robot, c);
+  if (same_branch(f, c, t)) return true;
+  std::vector<int> near;
+  for (int j = 0; j < 6 && tol > 0; ++j)
+    if (std::abs(q[j] - 90.0 * std::round(q[j] / 90.0)) < tol) near.push_back(j);
+  if (near.empty() || near.size() > 4) return false;
+  for (unsigned mask = 1; mask < (1u << near.size()); ++mask) {
+    c.q_deg = q;
+    for (size_t k = 0; k < near.size(); ++k) {
+      if (!((mask >> k) & 1)) continue;
+      const int j = near[k];
+      const double border = 90.0 * std::round(q[j] / 90.0);
+      c.q_deg[j] = border + (q[j] < border ? 2.0 : -2.0) * tol;  // to the border's other side
+    }
+    set_branch_data(robot, c);
+    if (same_branch(f, c, t)) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -93,7 +123,8 @@ void set_branch_data(const Robot& robot, ControllerTarget& t) {
                    std::to_string(fanuc_turn(q[3])) + ", " + std::to_string(fanuc_turn(q[5]));
 }
 
-std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const ControllerTarget& t, std::string* why) {
+std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const ControllerTarget& t, std::string* why,
+                                  double border_tolerance) {
   const IkSolutions s = robot.ik().solve(pose_to_iso(t.pose), IkOptions());
   if (s.status != IkStatus::Ok) {
     if (why) *why = "the nominal inverse kinematics has no solution";
@@ -101,19 +132,14 @@ std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const 
   }
   std::optional<Vec6> found;
   for (int i = 0; i < s.count; ++i) {
-    ControllerTarget c = t;
-    for (int j = 0; j < 6; ++j) c.q_deg[j] = unwrap(f, j, s.sol[static_cast<size_t>(i)].q_deg[j], t);
-    if (!c.q_deg.allFinite()) continue;
-    set_branch_data(robot, c);
-    const bool same = f == ControllerFormat::Krl     ? (c.kuka_s == t.kuka_s && c.kuka_t == t.kuka_t)
-                      : f == ControllerFormat::Rapid ? c.abb_conf == t.abb_conf
-                                                     : c.fanuc_config == t.fanuc_config;
-    if (!same) continue;
-    if (found && (*found - c.q_deg).cwiseAbs().maxCoeff() > 1e-6) {
+    Vec6 q;
+    for (int j = 0; j < 6; ++j) q[j] = unwrap(f, j, s.sol[static_cast<size_t>(i)].q_deg[j], t, border_tolerance);
+    if (!q.allFinite() || !branch_matches(robot, f, q, t, border_tolerance)) continue;
+    if (found && (*found - q).cwiseAbs().maxCoeff() > 1e-6) {
       if (why) *why = "two solutions have the same branch data";
       return std::nullopt;
     }
-    found = c.q_deg;
+    found = q;
   }
   if (!found && why) *why = "no solution has the target's branch data";
   return found;

@@ -155,12 +155,14 @@ TargetFrames target_frames(const NativeProgram& p, const NativeOptions& n, const
   TargetFrames f;
   f.base = frames(n.user_frames, &NativeTarget::uframe, n.program_base, "UF", "--uframe", "--program-base");
   f.tool = frames(n.user_tools, &NativeTarget::utool, n.program_tool, "UT", "--utool", "--program-tool");
-  // external axes: a linear track moves the base; any other one that varies is refused at its first change
+  // external axes: a linear track moves the base; any other one that varies is refused at the first motion
+  // (in the order of the program) whose target has another value than the program's first
   for (int j = 0; j < 6; ++j) {
-    const auto track = n.track.find(j);
+    if (n.track.count(j)) continue;
     const double* first = nullptr;
-    for (size_t k = 0; k < p.targets.size() && track == n.track.end(); ++k) {
-      const double& e = p.targets[k].external[static_cast<size_t>(j)];
+    for (const NativeMotion& m : p.motions) {
+      if (m.target < 0) continue;
+      const double& e = p.targets[static_cast<size_t>(m.target)].external[static_cast<size_t>(j)];
       if (!std::isfinite(e)) continue;
       if (!first) first = &e;
       if (std::abs(e - *first) > 1e-9) {
@@ -168,12 +170,16 @@ TargetFrames target_frames(const NativeProgram& p, const NativeOptions& n, const
         std::snprintf(buf, sizeof buf, ": external axis E%d moves (%.6g, was %.6g): a linear track that carries the "
                       "robot takes --track E%d=X,Y,Z (its direction in the program's base frame); a rotary axis "
                       "(a positioner) is not supported", j + 1, e, *first, j + 1);
-        throw InputError(where_of[k] + buf);
+        throw InputError(motion_where(p, m) + buf);
       }
     }
   }
+  // the robot on the track at e: the world (base 0) moves by -e * dir in the robot's base. KRL and RAPID: the
+  // world is --program-base, each motion's base in it; LS: the user frame (--uframe, or --program-base) is in
+  // the robot's base at e = 0
+  const bool ls = p.format == ControllerFormat::FanucLs;
   for (size_t k = 0; k < f.base.size(); ++k) {
-    Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();  // the robot moved by e * dir: the program moves by -e * dir
+    Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
     for (const auto& [j, dir] : n.track) {
       const double e = p.targets[k].external[static_cast<size_t>(j)];
       if (!std::isfinite(e))
@@ -181,7 +187,7 @@ TargetFrames target_frames(const NativeProgram& p, const NativeOptions& n, const
                          std::to_string(j + 1));
       shift.translation() -= e * dir;
     }
-    f.base[k] = f.base[k] * shift * p.targets[k].frame;
+    f.base[k] = ls ? shift * f.base[k] * p.targets[k].frame : f.base[k] * shift * p.targets[k].frame;
     f.tool[k] = f.tool[k] * p.targets[k].tool;
   }
   return f;
@@ -201,7 +207,7 @@ std::vector<std::optional<Vec6>> taught_references(const Robot& robot, const Nat
     ControllerTarget t = *p.targets[k].taught;
     t.pose = poses[k];
     std::string why;
-    refs[k] = select_branch(robot, p.format, t, &why);
+    refs[k] = select_branch(robot, p.format, t, &why, 1e-4);  // (printed to 1e-4 mm, 1e-6 deg or so)
     if (refs[k]) continue;
     const std::string msg = where_of[k] + ": the taught branch (" + branch_text(p.format, t) + ") does not reach the "
                             "target in the nominal model (" + why + ")";

@@ -40,7 +40,7 @@ ControllerFormat controller_format_named(const std::string& name) {
 ControllerFormat controller_format_of_path(const std::string& path) {
   const std::string p = lower(path);
   if (ends_with(p, ".src") || ends_with(p, ".dat")) return ControllerFormat::Krl;
-  if (ends_with(p, ".mod") || ends_with(p, ".modx")) return ControllerFormat::Rapid;
+  if (ends_with(p, ".mod") || ends_with(p, ".modx") || ends_with(p, ".sys")) return ControllerFormat::Rapid;
   if (ends_with(p, ".ls")) return ControllerFormat::FanucLs;
   if (ends_with(p, ".script")) return ControllerFormat::UrScript;
   if (ends_with(p, ".csv")) return ControllerFormat::Csv;

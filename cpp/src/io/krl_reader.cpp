@@ -342,6 +342,7 @@ class KrlReader {
     Decl d;
     std::string missing;
     if (rhs == "$NULLFRAME") return {};
+    if (!rhs.empty() && rhs[0] == '{' && rhs.back() == '}') return {trim(rhs_), "", ""};  // a FRAME literal
     if (std::regex_match(rhs, m, data)) return numbered(m[1].str(), m[2].str(), where_);
     if (std::regex_match(rhs, m, stool)) return numbered("TOOL", fdat(m[1].str(), missing)["TOOL_NO"], where_, missing);
     if (std::regex_match(rhs, m, sbase)) return numbered("BASE", fdat(m[1].str(), missing)["BASE_NO"], where_, missing);
@@ -392,6 +393,14 @@ class KrlReader {
 
   Eigen::Isometry3d frame_value(const std::string& key, const char* what, const std::string& where_) const {
     if (key.empty()) return Eigen::Isometry3d::Identity();
+    if (!key.empty() && key[0] == '{') {  // $TOOL = {X .., ..} or {FRAME: X .., ..}: the literal
+      std::string text = key;
+      static const std::regex typed(R"(^\{\s*FRAME\s*:\s*)", std::regex::icase);
+      text = std::regex_replace(text, typed, "{");
+      const Aggregate a = read_aggregate(text, where_);
+      if (!a.missing.empty()) throw InputError(where_ + ": the motion's " + what + " " + key + " has no " + a.missing + " value");
+      return pose_to_iso(a.pose);
+    }
     Decl d;
     if (!lookup(key, d) || d.value.empty())
       throw InputError(where_ + ": the motion's " + what + " " + key + " is not declared: give the backup's $config.dat or --declarations");

@@ -245,6 +245,8 @@ const Instr* instruction(const std::string& word) {
       t[std::string("ARCL") + n] = t[std::string("ARCL") + n + "END"] = {{0, 0}, 1, 1, 'L'};
       for (const char* e : {"", "START", "END"}) t[std::string("ARCC") + n + e] = {{0, 1}, 2, 1, 'C'};
     }
+    t["SPOTL"] = {{0, 0}, 1, 1, 'L'};  // ToPoint, Speed, Spot, Tool (the spot welding option)
+    t["SPOTJ"] = {{0, 0}, 1, 1, 'O'};
     t["CAPL"] = {{0, 0}, 1, 1, 'L'};
     t["CAPC"] = {{0, 1}, 2, 1, 'C'};
     t["MOVEABSJ"] = t["MOVEEXTJ"] = t["SEARCHEXTJ"] = {{0, 0}, 0, 0, 'O'};  // no robtarget

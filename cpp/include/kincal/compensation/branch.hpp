@@ -43,9 +43,11 @@ void set_branch_data(const Robot& robot, ControllerTarget& t);
 
 /// What the controller's nominal model does with a filtered target: the solution of the nominal IK of
 /// t.pose whose branch data (in format f: Krl, Rapid or FanucLs) is the target's. Empty, with why,
-/// when none or several different ones match.
+/// when none or several different ones match. border_tolerance (deg): a joint that close to a border (a
+/// multiple of 90 deg) counts on either side of it: a taught program's target read back from its printed
+/// pose (A1 taught at 0 comes back at -2e-6); 0: the controller's exact selection.
 std::optional<Vec6> select_branch(const Robot& robot, ControllerFormat f, const ControllerTarget& t,
-                                  std::string* why = nullptr);
+                                  std::string* why = nullptr, double border_tolerance = 0);
 
 /// How joints q_deg sit against a taught target's branch data in format f (Krl, Rapid, FanucLs): `arm`
 /// when the arm, elbow and wrist choice differs (KUKA S, ABB cfx, FANUC F/N U/D T/B); `turns` the joints

@@ -292,12 +292,12 @@ TEST(RapidInstructions, MultiMoveIdAfterTheToPointIsNotARunTimeTarget) {
 
 TEST(RapidInstructions, AMotionLikeInstructionKincalDoesNotReadIsListedWithWhy) {
   const NativeProgram p = read_proc("unread.mod",
-      "    ArcRepL p1, v100, sm1, wd1, fine, tool1;\n    SpotL p1, vmax, spot1, gun1;\n    MoveLCustom p1;\n"
+      "    ArcRepL p1, v100, sm1, wd1, fine, tool1;\n    DispL \\On, p1, v100, bead1, z10, tool1;\n    MoveLCustom p1;\n"
       "    TriggIO tr1, 10 \\DOp:=do1, 1;\n    MoveToSafe;\n    IF bRun MoveQuick p1;\n");
   // (TriggIO: a setting; MoveToSafe: a routine of a module not read, named like a motion: listed)
   ASSERT_EQ(p.unresolved.size(), 5u);
   EXPECT_EQ(p.unresolved[0].why, "an instruction kincal does not read (ArcRepL)");
-  EXPECT_EQ(p.unresolved[1].why, "an instruction kincal does not read (SpotL)");
+  EXPECT_EQ(p.unresolved[1].why, "an instruction kincal does not read (DispL)");
   EXPECT_EQ(p.unresolved[2].why, "an instruction kincal does not read (MoveLCustom)");
   EXPECT_EQ(p.unresolved[3].why, "an instruction kincal does not read (MoveToSafe)");
   EXPECT_EQ(p.unresolved[4].why, "an instruction kincal does not read (MoveQuick)");  // in a compact IF

@@ -11,6 +11,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import run
@@ -100,3 +101,43 @@ def test_several_files_and_out_inside_the_input_refused(tmp_path, model):
     assert r.returncode == 1
     assert "inside the input folder" in r.stderr
     assert not (backup / "filtered").exists()
+
+
+KRC = DATA / "krl" / "KRC"
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_kuka_backup_each_target_in_its_own_tool_and_base(tmp_path, model, calibrated, tool):
+    """A KUKA backup (tests/data/programs/krl/KRC, re-created: $config.dat with XHOME, TOOL_DATA[1..2],
+    BASE_DATA[1..2] and two Cartesian targets; pick (KSS 5 inline forms, FDAT_ACT + BAS), weld (KSS 8
+    SPTP/SLIN WITH $TOOL = STOOL2(..), $BASE = SBASE(..)) and service ($TOOL / $BASE / BAS(#TOOL, n))) filtered
+    in one command. The independent reader of test_program_corpus follows each motion's tool and base from
+    the programs' text; every written target, selected by the controller's nominal model through those
+    frames, puts the calibrated robot's TCP on the program's pose (1e-3 mm, 1e-3 deg), with the taught S."""
+    from test_program_corpus import krl_frames, krl_uses, line_diff_problems, reached_problems
+
+    out = tmp_path / "out"
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(KRC), "--out", str(out), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    assert "0 program(s) failed" in r.stderr
+    config_in = (KRC / "R1" / "System" / "$config.dat").read_text()
+    config_out = (out / "R1" / "System" / "$config.dat").read_text()
+    frames = krl_frames(config_in)
+    assert krl_frames(config_out).keys() == frames.keys()  # the frames themselves are not changed
+    dats_in = "\n".join(p.read_text() for p in sorted(KRC.rglob("*.dat")))
+    dats_out = "\n".join(p.read_text() for p in sorted(out.rglob("*.dat")))
+    tools, bases, n = set(), set(), 0
+    for src in sorted((KRC / "R1" / "Program").glob("*.src")):
+        rel = src.relative_to(KRC)
+        uses_in = krl_uses(src, dats_in, frames, np.eye(4))
+        uses_out = krl_uses(out / rel, dats_out, frames, np.eye(4))
+        assert uses_in and not reached_problems(calibrated, uses_in, uses_out, "krl", r.stderr), src.name
+        for a, b in ((src, out / rel), (src.with_suffix(".dat"), (out / rel).with_suffix(".dat"))):
+            assert not line_diff_problems(a.read_text(), b.read_text(), a.suffix), a.name
+        tools |= {u.tool.tobytes() for u in uses_in}
+        bases |= {u.base.tobytes() for u in uses_in}
+        n += len(uses_in)
+    assert len(tools) >= 2 and len(bases) >= 2 and n >= 15
+    assert not line_diff_problems(config_in, config_out, ".dat")
+    assert "DECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0," in config_out  # kept as written

@@ -8,6 +8,7 @@ listed with file:line and the exit status is 1."""
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -125,13 +126,18 @@ def test_kuka_backup_each_target_in_its_own_tool_and_base(tmp_path, model, calib
     config_out = (out / "R1" / "System" / "$config.dat").read_text()
     frames = krl_frames(config_in)
     assert krl_frames(config_out).keys() == frames.keys()  # the frames themselves are not changed
-    dats_in = "\n".join(p.read_text() for p in sorted(KRC.rglob("*.dat")))
-    dats_out = "\n".join(p.read_text() for p in sorted(out.rglob("*.dat")))
+    def visible(root: Path, src: Path) -> str:
+        """What a program sees, the last declaration of a name winning in the reader: the other data lists'
+        DECL GLOBAL lines, $config.dat, then its own .dat."""
+        others = [l for d in sorted(root.rglob("*.dat")) if d.stem not in (src.stem, "$config")
+                  for l in d.read_text().split("\n") if re.match(r"\s*DECL\s+GLOBAL\b", l, re.I)]
+        return "\n".join(others + [(root / "R1" / "System" / "$config.dat").read_text(), src.with_suffix(".dat").read_text()])
+
     tools, bases, n = set(), set(), 0
     for src in sorted((KRC / "R1" / "Program").glob("*.src")):
         rel = src.relative_to(KRC)
-        uses_in = krl_uses(src, dats_in, frames, np.eye(4))
-        uses_out = krl_uses(out / rel, dats_out, frames, np.eye(4))
+        uses_in = krl_uses(src, visible(KRC, src), frames, np.eye(4))
+        uses_out = krl_uses(out / rel, visible(out, out / rel), frames, np.eye(4))
         assert uses_in and not reached_problems(calibrated, uses_in, uses_out, "krl", r.stderr), src.name
         for a, b in ((src, out / rel), (src.with_suffix(".dat"), (out / rel).with_suffix(".dat"))):
             assert not line_diff_problems(a.read_text(), b.read_text(), a.suffix), a.name

@@ -155,6 +155,13 @@ def krl_uses(src: Path, dat_text: str, frames: dict, pb: np.ndarray) -> list:
 
     def set_frames(code):
         nonlocal tool, base
+        for m in re.finditer(r"\$(TOOL|BASE)\s*=\s*\$NULLFRAME|BAS\s*\(\s*#(TOOL|BASE)\s*,\s*(\d+)\s*\)", code, re.I):
+            kind = (m.group(1) or m.group(2)).upper()
+            f = np.eye(4) if m.group(1) else frame_of(kind, m.group(3))
+            if kind == "TOOL":
+                tool = f
+            else:
+                base = f
         for m in re.finditer(r"\$(TOOL|BASE)\s*=\s*(?:(TOOL|BASE)_DATA\[(\d+)\]|\{FRAME:\s*([^}]*)\}|S(?:TOOL2|BASE)\((\w+))", code, re.I):
             if m.group(3):
                 f = frame_of(m.group(2).upper(), m.group(3))

@@ -193,6 +193,9 @@ TargetFrames target_frames(const NativeProgram& p, const NativeOptions& n, const
   return f;
 }
 
+// "NAME: " for a declared target, "" for an inline one (its line says which)
+std::string named(const NativeTarget& t) { return t.name.empty() ? "" : t.name + ": "; }
+
 // The taught targets' references: the nominal solution of each desired pose on its taught branch (none for
 // targets without branch data: they keep the branch nearest the previous joints). A taught branch that does
 // not reach the pose is an error, or with allow_branch_change a warning (the nearest branch is then taken).
@@ -209,7 +212,7 @@ std::vector<std::optional<Vec6>> taught_references(const Robot& robot, const Nat
     std::string why;
     refs[k] = select_branch(robot, p.format, t, &why, 1e-4);  // (printed to 1e-4 mm, 1e-6 deg or so)
     if (refs[k]) continue;
-    const std::string msg = where_of[k] + ": the taught branch (" + branch_text(p.format, t) + ") does not reach the "
+    const std::string msg = where_of[k] + ": " + named(p.targets[k]) + "the taught branch (" + branch_text(p.format, t) + ") does not reach the "
                             "target in the nominal model (" + why + ")";
     if (!n.allow_branch_change) throw InputError(msg + "; --allow-branch-change takes the nearest branch");
     warnings.push_back(msg + "; the branch nearest the previous target is taken (--allow-branch-change)");
@@ -234,10 +237,10 @@ void check_taught_branches(const Robot& robot, const NativeProgram& p, const std
       ((std::abs(q[k][j] - (*refs[k])[j]) < 5.0 ? crossed : changed) += (crossed.empty() ? "" : ", ") + std::string(buf));
     }
     if (!crossed.empty())
-      warnings.push_back(where_of[k] + ": the compensation moves a joint across its turn's border (" + crossed +
+      warnings.push_back(where_of[k] + ": " + named(p.targets[k]) + "the compensation moves a joint across its turn's border (" + crossed +
                          "): written with the new turn");
     if (!d.arm && changed.empty()) continue;
-    const std::string msg = where_of[k] + ": the compensated joints leave the taught branch (" +
+    const std::string msg = where_of[k] + ": " + named(p.targets[k]) + "the compensated joints leave the taught branch (" +
                             branch_text(p.format, taught) + (d.arm ? "; another arm, elbow or wrist choice" : "") +
                             (changed.empty() ? "" : "; another turn: " + changed) +
                             "): the calibrated robot cannot reach the target on it within the joint limits";

@@ -357,15 +357,35 @@ NativeMotion motion_around(const std::string& code, int line, char kind, size_t 
 }
 
 void keep_named_targets_cartesian(NativeProgram& p, char comment, bool ignore_case) {
+  // every whole word of the program's code counted once (one pass: programs of thousands of targets)
+  const auto key = [&](std::string w) { return ignore_case ? upper_case(std::move(w)) : w; };
+  std::map<std::string, int> wanted;
+  for (const NativeTarget& t : p.targets)
+    if (!t.name.empty() && t.joint_motion) wanted.emplace(key(t.name), 0);
+  if (wanted.empty()) return;
+  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (const auto& file : p.lines)
+    for (const std::string& l : file) {
+      const std::string code = code_before(l, comment);
+      for (size_t i = 0; i < code.size();) {
+        if (!word(code[i])) {
+          ++i;
+          continue;
+        }
+        size_t j = i;
+        while (j < code.size() && word(code[j])) ++j;
+        const auto it = wanted.find(key(code.substr(i, j - i)));
+        if (it != wanted.end()) ++it->second;
+        i = j;
+      }
+    }
+  std::vector<int> motions(p.targets.size(), 0);
+  for (const NativeMotion& m : p.motions)
+    if (m.target >= 0) ++motions[static_cast<size_t>(m.target)];
   for (size_t k = 0; k < p.targets.size(); ++k) {
     NativeTarget& t = p.targets[k];
     if (t.name.empty() || !t.joint_motion) continue;
-    int named = 0;
-    for (const auto& file : p.lines)
-      for (const std::string& l : file) named += word_count(code_before(l, comment), t.name, ignore_case);
-    const auto motions = std::count_if(p.motions.begin(), p.motions.end(),
-                                       [&](const NativeMotion& m) { return m.target == static_cast<int>(k); });
-    t.joint_motion = named == motions + 1;  // its declaration (or assignment) and its motions only
+    t.joint_motion = wanted[key(t.name)] == motions[k] + 1;  // its declaration (or assignment) and its motions only
   }
 }
 

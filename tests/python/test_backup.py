@@ -147,3 +147,30 @@ def test_kuka_backup_each_target_in_its_own_tool_and_base(tmp_path, model, calib
     assert len(tools) >= 2 and len(bases) >= 2 and n >= 15
     assert not line_diff_problems(config_in, config_out, ".dat")
     assert "DECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0," in config_out  # kept as written
+
+
+@pytest.mark.parametrize("tool", ["kincal", "kincal-compensate"])
+def test_rapid_task_targets_declared_in_a_data_module(tmp_path, model, tool):
+    """A RAPID task whose data module (tooldata, wobjdata, robtargets; no motion) serves a program module: the
+    targets are compensated where they are declared, in the data module, exactly as when the two are one
+    module (tape.mod split in two), and the data module is not copied back over its filtered self."""
+    lines = (DATA / "tape.mod").read_text().split("\n")
+    decl = [l for l in lines if re.match(r"\s*(PERS|CONST|TASK PERS|VAR)\b", l)]
+    body = [l for l in lines[1:] if l not in decl]
+    task = tmp_path / "TASK1"
+    (task / "PROGMOD").mkdir(parents=True)
+    (task / "SYSMOD").mkdir()
+    (task / "SYSMOD" / "Data.sys").write_text("\n".join(["MODULE Data(SYSMODULE)", *decl, "ENDMODULE", ""]))
+    (task / "PROGMOD" / "Main.mod").write_text("\n".join(["MODULE Main", *body]))
+    out = tmp_path / "out"
+    args = ["compensate"] if tool == "kincal" else []
+    r = run(tool, *args, "--model", str(model), "--program", str(task), "--out", str(out), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    alone = tmp_path / "alone.mod"
+    assert run(tool, *args, "--model", str(model), "--program", str(DATA / "tape.mod"), "--out", str(alone),
+               "--targets", "filtered").returncode == 0
+    filtered = alone.read_text().split("\n")
+    data_out = (out / "SYSMOD" / "Data.sys").read_text().split("\n")
+    assert data_out[1:-2] == [filtered[lines.index(l)] for l in decl]
+    assert data_out != (task / "SYSMOD" / "Data.sys").read_text().split("\n")
+    assert (out / "PROGMOD" / "Main.mod").read_text().split("\n")[1:] == [filtered[lines.index(l)] if l else "" for l in body]

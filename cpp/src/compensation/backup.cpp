@@ -187,6 +187,7 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
   std::sort(jobs.begin(), jobs.end(), [&](const auto& x, const auto& y) { return programs[x[0]] < programs[y[0]]; });
   r.programs.resize(jobs.size());
   std::vector<char> copy_unchanged(jobs.size(), 0);
+  std::vector<std::vector<std::string>> job_files(jobs.size());  // per job: the files it read (and writes)
   std::mutex progress_mutex;
   size_t done = 0;
   parallel_for(jobs.size(), b.threads, [&](size_t j) {
@@ -195,7 +196,8 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
     try {
       for (const size_t i : jobs[j])
         if (!alone[i].error.empty()) throw InputError(alone[i].error);
-      NativeProgram p = jobs[j].size() == 1 ? std::move(alone[jobs[j][0]].p) : read(out.inputs);
+      const NativeProgram p = jobs[j].size() == 1 ? std::move(alone[jobs[j][0]].p) : read(out.inputs);
+      job_files[j] = p.paths;
       if (p.targets.empty() && (p.unresolved.empty() || native.skip_unresolved)) {
         copy_unchanged[j] = 1;  // joints only, or nothing to move: the file as it is
         for (const auto& u : p.unresolved)
@@ -223,11 +225,10 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
   for (size_t j = 0; j < jobs.size(); ++j) {
     if (!r.programs[j].error.empty()) ++r.failed;
     if (copy_unchanged[j]) continue;
-    for (const size_t i : jobs[j])
-      for (const std::string& f : alone[i].p.paths.empty() ? std::vector<std::string>{programs[i]} : alone[i].p.paths)
-        owned.insert(f);
+    owned.insert(job_files[j].begin(), job_files[j].end());  // (empty when it failed before reading)
+    for (const size_t i : jobs[j]) owned.insert(alone[i].p.paths.begin(), alone[i].p.paths.end());
     for (const std::string& f : r.programs[j].inputs) owned.insert(f);
-    if (programs.size() && language_of(r.programs[j].inputs[0]) == ControllerFormat::Krl)
+    if (language_of(r.programs[j].inputs[0]) == ControllerFormat::Krl)
       for (const std::string& in : r.programs[j].inputs) {  // a failed KRL program's .dat leaves no output either
         fs::path dat = in;
         dat.replace_extension(".dat");

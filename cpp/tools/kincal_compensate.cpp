@@ -291,8 +291,12 @@ int main(int argc, char** argv) {
       }
       std::fprintf(stderr, "%s: %zu program(s) filtered, %zu file(s) copied unchanged, %d program(s) failed\n",
                    out.c_str(), filtered, br.copied.size(), br.failed);
-      for (const auto& p : br.programs)
-        if (!p.error.empty()) std::fprintf(stderr, "kincal-compensate: error: %s\n", p.error.c_str());
+      for (const auto& p : br.programs) {
+        if (p.error.empty()) continue;
+        std::string inputs;  // every program of a group that fails together (they share a written file)
+        for (const auto& in : p.inputs) inputs += (inputs.empty() ? "" : ", ") + in;
+        std::fprintf(stderr, "kincal-compensate: error: not written: %s:\n  %s\n", inputs.c_str(), p.error.c_str());
+      }
       return br.failed ? 1 : 0;
     }
     if (!declarations.empty())

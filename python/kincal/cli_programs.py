@@ -47,7 +47,8 @@ def add_options(sp) -> None:
                          "an error naming it)")
     sp.add_argument("--track", action="append", default=[], metavar="AXIS=X,Y,Z",
                     help="a linear track that carries the robot: external axis AXIS (E1..E6) moves the robot's base "
-                         "by X,Y,Z (mm per unit of the axis) in the program's base frame")
+                         "by X,Y,Z (mm per unit of the axis) in the program's base frame (KRL, RAPID: base 0, "
+                         "--program-base; FANUC LS: the robot's base at E1 = 0, in which --uframe is given)")
     sp.add_argument("--jobs", type=int, default=0,
                     help="a backup's programs filtered at once (default: every core)")
     sp.add_argument("--tolerance", type=float, metavar="MM",

@@ -174,3 +174,88 @@ def test_rapid_task_targets_declared_in_a_data_module(tmp_path, model, tool):
     assert data_out[1:-2] == [filtered[lines.index(l)] for l in decl]
     assert data_out != (task / "SYSMOD" / "Data.sys").read_text().split("\n")
     assert (out / "PROGMOD" / "Main.mod").read_text().split("\n")[1:] == [filtered[lines.index(l)] if l else "" for l in body]
+
+
+def _cell(dst: Path, tool1_x: float | None = None) -> Path:
+    """A copy of the re-created KUKA backup; tool1_x moves TOOL_DATA[1] (another cell's tool)."""
+    shutil.copytree(KRC, dst)
+    if tool1_x is not None:
+        cfg = dst / "R1" / "System" / "$config.dat"
+        text = cfg.read_text()
+        assert "TOOL_DATA[1]={X 240.0," in text
+        cfg.write_text(text.replace("TOOL_DATA[1]={X 240.0,", f"TOOL_DATA[1]={{X {tool1_x},"))
+    return dst
+
+
+def test_each_controller_of_a_folder_has_its_own_declarations(tmp_path, model):
+    """Two cells' backups in one folder (cellB's TOOL_DATA[1] 10 mm longer): each program takes its own
+    controller's tools and targets: every output equals its cell filtered alone."""
+    _cell(tmp_path / "cells" / "cellA")
+    _cell(tmp_path / "cells" / "cellB", tool1_x=250.0)
+    r = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / "cells"), "--out",
+            str(tmp_path / "out"), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    for cell in ("cellA", "cellB"):
+        r1 = run("kincal-compensate", "--model", str(model), "--program", str(tmp_path / "cells" / cell), "--out",
+                 str(tmp_path / "alone" / cell), "--targets", "filtered")
+        assert r1.returncode == 0, r1.stderr
+        for f in (tmp_path / "alone" / cell).rglob("*"):
+            if f.is_file():
+                assert f.read_bytes() == (tmp_path / "out" / cell / f.relative_to(tmp_path / "alone" / cell)).read_bytes(), f
+    a = (tmp_path / "out" / "cellA" / "R1" / "Program" / "pick.dat").read_text()
+    b = (tmp_path / "out" / "cellB" / "R1" / "Program" / "pick.dat").read_text()
+    assert a != b  # tool 1's targets compensated for each cell's tool
+
+
+def test_a_failing_group_keeps_the_files_it_shares(tmp_path, model):
+    """service.src names a target declared nowhere: service and weld (which share weld.dat's XSEAM_START) are
+    not written, and say so; pick is; $config.dat, which they read, is copied unchanged so the backup can be
+    restored; an earlier run's output of the failed programs is removed."""
+    cell = _cell(tmp_path / "KRC")
+    out = tmp_path / "out"
+    args = ["--model", str(model), "--program", str(cell), "--out", str(out), "--targets", "filtered"]
+    assert run("kincal-compensate", *args).returncode == 0  # an earlier, good run
+    src = cell / "R1" / "Program" / "service.src"
+    src.write_text(src.read_text().replace("PTP XPARK", "PTP XPARK\nLIN XNOWHERE"))
+    r = run("kincal-compensate", *args)
+    assert r.returncode == 1
+    assert "not written" in r.stderr and "service.src" in r.stderr and "weld.src" in r.stderr
+    assert "declared nowhere: LIN XNOWHERE" in r.stderr
+    program = out / "R1" / "Program"
+    assert (program / "pick.src").exists() and (program / "pick.dat").exists()
+    for name in ("service.src", "service.dat", "weld.src", "weld.dat"):
+        assert not (program / name).exists(), name
+    cfg = "R1/System/$config.dat"
+    assert (out / cfg).read_bytes() == (cell / cfg).read_bytes()
+
+
+def test_a_lone_program_writes_the_data_list_its_target_is_declared_in(tmp_path, model):
+    """One program (upper-case file names, as some controllers write them) moving to XPARK of $config.dat,
+    with no other program: $config.dat comes out with XPARK compensated; two .src files given as files take
+    --declarations."""
+    cell = tmp_path / "KRC"
+    (cell / "R1" / "Program").mkdir(parents=True)
+    (cell / "R1" / "System").mkdir()
+    shutil.copy(KRC / "R1" / "System" / "$config.dat", cell / "R1" / "System" / "$config.dat")
+    (cell / "R1" / "Program" / "PARK.SRC").write_text("DEF park( )\nPTP XHOME\nPTP XPARK\nLIN XP1\nEND\n")
+    (cell / "R1" / "Program" / "PARK.DAT").write_text(
+        "DEFDAT park\nDECL E6POS XP1={X 1800.0,Y 100.0,Z 1400.0,A 155.0,B 5.0,C 168.0}\nENDDAT\n")
+    out = tmp_path / "out"
+    r = run("kincal-compensate", "--model", str(model), "--program", str(cell), "--out", str(out), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    cfg_in = (cell / "R1" / "System" / "$config.dat").read_text()
+    cfg_out = (out / "R1" / "System" / "$config.dat").read_text()
+    changed = [l.split("=")[0] for l, m in zip(cfg_in.split("\n"), cfg_out.split("\n")) if l != m]
+    assert changed == ["DECL E6POS XPARK"]
+    assert (out / "R1" / "Program" / "PARK.DAT").read_text() != (cell / "R1" / "Program" / "PARK.DAT").read_text()
+    # two programs given as files (each with its .dat), XHOME declared elsewhere (--declarations)
+    programs = tmp_path / "progs"
+    programs.mkdir()
+    for n in (2, 3):
+        (programs / f"park{n}.src").write_text(f"DEF park{n}( )\nPTP XHOME\nLIN XP1\nPTP XHOME\nEND\n")
+        shutil.copy(cell / "R1" / "Program" / "PARK.DAT", programs / f"park{n}.dat")
+    r = run("kincal-compensate", "--model", str(model), "--program", str(programs / "park2.src"),
+            str(programs / "park3.src"), "--declarations", str(cell / "R1" / "System" / "$config.dat"), "--out",
+            str(tmp_path / "o2"), "--targets", "filtered")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in (tmp_path / "o2").iterdir()) == ["park2.dat", "park2.src", "park3.dat", "park3.src"]

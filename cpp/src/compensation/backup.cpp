@@ -48,7 +48,22 @@ std::string task_of(const fs::path& p) {
 struct Input {
   std::string path;  // as found
   std::string rel;   // its path under out_dir
+  std::string root;  // the input it was found in (a file's: its folder)
 };
+
+// where a program's declarations are looked up: KRL the controller (the folder holding System/$config.dat
+// above the file, else the input it came in); RAPID its task
+std::string scope_of(const Input& f) {
+  if (language_of(f.path) == ControllerFormat::Rapid) return "rapid:" + task_of(f.path);
+  const fs::path root = fs::path(f.root).lexically_normal();
+  for (fs::path dir = fs::path(f.path).parent_path(); !dir.empty(); dir = dir.parent_path()) {
+    std::error_code ec;
+    for (const char* name : {"$config.dat", "$CONFIG.DAT", "$Config.dat"})
+      if (fs::exists(dir / "System" / name, ec)) return "krl:" + dir.string();
+    if (dir.lexically_normal() == root || dir == dir.parent_path()) break;
+  }
+  return "krl:" + f.root;
+}
 
 // every file under the inputs, with its place in the output tree
 std::vector<Input> files_of(const std::vector<std::string>& inputs, const std::string& out_dir) {
@@ -59,7 +74,19 @@ std::vector<Input> files_of(const std::vector<std::string>& inputs, const std::s
     const fs::file_status st = fs::status(in, ec);
     if (ec || !fs::exists(st)) throw InputError(in + ": no such file or folder");
     if (!fs::is_directory(st)) {
-      out.push_back({in, fs::path(in).filename().string()});
+      if (fs::weakly_canonical(fs::path(out_dir) / fs::path(in).filename()) == fs::weakly_canonical(fs::path(in)))
+        throw InputError("--out " + out_dir + ": would write over the input " + in + " (give another folder)");
+      const std::string parent = fs::path(in).parent_path().string();
+      out.push_back({in, fs::path(in).filename().string(), parent.empty() ? "." : parent});
+      if (ext_of(in) == ".src")  // a KRL program given as a file comes with its data list
+        for (const char* e : {".dat", ".DAT", ".Dat"}) {
+          fs::path dat = in;
+          dat.replace_extension(e);
+          if (fs::exists(dat, ec) && std::find(inputs.begin(), inputs.end(), dat.string()) == inputs.end()) {
+            out.push_back({dat.string(), dat.filename().string(), parent.empty() ? "." : parent});
+            break;
+          }
+        }
       continue;
     }
     const fs::path root = fs::weakly_canonical(fs::path(in));
@@ -72,7 +99,7 @@ std::vector<Input> files_of(const std::vector<std::string>& inputs, const std::s
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
       if (!it->is_regular_file()) continue;
       const fs::path rel = fs::relative(it->path(), in);
-      found.push_back({it->path().string(), (prefix.empty() ? rel : fs::path(prefix) / rel).string()});
+      found.push_back({it->path().string(), (prefix.empty() ? rel : fs::path(prefix) / rel).string(), in});
     }
     if (ec) throw InputError(in + ": " + ec.message());
     std::sort(found.begin(), found.end(), [](const Input& a, const Input& b) { return a.rel < b.rel; });
@@ -91,18 +118,30 @@ struct UnionFind {
   void join(size_t a, size_t b) { parent[find(a)] = find(b); }
 };
 
-// runs f(i) for i in [0, n) on `threads` threads (0: every core); f catches its own errors
+// runs f(i) for i in [0, n) on `threads` threads (0: every core); the first exception f lets out (a progress
+// callback interrupted) stops the handing out of indices and is rethrown once every thread has joined
 void parallel_for(size_t n, int threads, const std::function<void(size_t)>& f) {
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   const size_t k = std::min(n, static_cast<size_t>(threads > 0 ? static_cast<unsigned>(threads) : hw));
   std::atomic<size_t> next{0};
+  std::mutex m;
+  std::exception_ptr error;
   auto work = [&] {
-    for (size_t i = next++; i < n; i = next++) f(i);
+    for (size_t i = next++; i < n; i = next++) {
+      try {
+        f(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(m);
+        if (!error) error = std::current_exception();
+        next = n;
+      }
+    }
   };
   std::vector<std::thread> pool;
   for (size_t t = 1; t < k; ++t) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace
@@ -120,12 +159,15 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
   std::map<std::string, std::string> rel_of;  // input path -> output path under out_dir
   std::set<std::string> paths;
   for (const Input& f : files) rel_of[f.path] = (fs::path(out_dir) / f.rel).string(), paths.insert(f.path);
-  // the declarations: KRL from every .dat, RAPID per task; plus --declarations
-  std::map<std::string, std::vector<std::string>> decl_files;  // "krl" or the RAPID task -> files
+  // the declarations: KRL per controller (every data list under it), RAPID per task; plus --declarations
+  std::map<std::string, std::vector<std::string>> decl_files;  // scope -> files
+  std::map<std::string, std::string> scope;                     // program file -> its scope
   for (const Input& f : files) {
     const ControllerFormat l = language_of(f.path);
-    if (l == ControllerFormat::Krl && ext_of(f.path) == ".dat") decl_files["krl"].push_back(f.path);
-    if (l == ControllerFormat::Rapid) decl_files["rapid:" + task_of(f.path)].push_back(f.path);
+    if (l != ControllerFormat::Krl && l != ControllerFormat::Rapid) continue;
+    scope[f.path] = scope_of(f);
+    auto& list = decl_files[scope[f.path]];  // (a scope with programs only still takes --declarations)
+    if (l == ControllerFormat::Rapid || ext_of(f.path) == ".dat") list.push_back(f.path);
   }
   std::vector<std::string> extra_krl, extra_rapid;
   for (const std::string& d : b.declarations) {
@@ -136,15 +178,15 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
   }
   std::map<std::string, std::shared_ptr<const Declarations>> contexts;
   for (auto& [key, list] : decl_files) {
-    const bool krl = key == "krl";
+    const bool krl = key.rfind("krl:", 0) == 0;
     std::vector<std::string> all = krl ? extra_krl : extra_rapid;  // --declarations first: they win
     all.insert(all.end(), list.begin(), list.end());
     contexts[key] = std::make_shared<const Declarations>(
         read_declarations(all, krl ? ControllerFormat::Krl : ControllerFormat::Rapid));
   }
   const auto context_of = [&](const std::string& path) -> std::shared_ptr<const Declarations> {
-    const ControllerFormat l = language_of(path);
-    const auto it = contexts.find(l == ControllerFormat::Krl ? "krl" : "rapid:" + task_of(path));
+    const auto s = scope.find(path);
+    const auto it = s == scope.end() ? contexts.end() : contexts.find(s->second);
     return it == contexts.end() ? nullptr : it->second;
   };
   // the programs: each program file alone first
@@ -220,28 +262,45 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
       b.progress(++done, jobs.size());
     }
   });
-  // every other file copied unchanged: files no written program read, and programs with nothing to compensate
+  // a written program owns every file it wrote; a failed one its own files (its programs, a KRL program's .dat),
+  // which get no output (an earlier run's is removed); every other file is copied unchanged: files no written
+  // program wrote (data lists and modules a failed program shares), programs with nothing to compensate
   std::set<std::string> owned;
   for (size_t j = 0; j < jobs.size(); ++j) {
-    if (!r.programs[j].error.empty()) ++r.failed;
     if (copy_unchanged[j]) continue;
-    owned.insert(job_files[j].begin(), job_files[j].end());  // (empty when it failed before reading)
-    for (const size_t i : jobs[j]) owned.insert(alone[i].p.paths.begin(), alone[i].p.paths.end());
-    for (const std::string& f : r.programs[j].inputs) owned.insert(f);
-    if (language_of(r.programs[j].inputs[0]) == ControllerFormat::Krl)
-      for (const std::string& in : r.programs[j].inputs) {  // a failed KRL program's .dat leaves no output either
-        fs::path dat = in;
-        dat.replace_extension(".dat");
-        owned.insert(dat.string());
-      }
+    if (r.programs[j].error.empty()) {
+      owned.insert(job_files[j].begin(), job_files[j].end());
+      continue;
+    }
+    ++r.failed;
+    std::vector<std::string> own = r.programs[j].inputs;
+    for (const std::string& in : r.programs[j].inputs)
+      if (language_of(in) == ControllerFormat::Krl)
+        for (const char* e : {".dat", ".DAT", ".Dat"}) {
+          fs::path dat = in;
+          dat.replace_extension(e);
+          if (paths.count(dat.string())) own.push_back(dat.string());
+        }
+    for (const std::string& f : own) {
+      owned.insert(f);
+      std::error_code ec;
+      if (rel_of.count(f)) fs::remove(rel_of.at(f), ec);
+    }
   }
   for (const Input& f : files) {
     if (owned.count(f.path)) continue;
     const std::string to = rel_of.at(f.path);
-    fs::create_directories(fs::path(to).parent_path());
     std::error_code ec;
-    fs::copy_file(f.path, to, fs::copy_options::overwrite_existing, ec);
-    if (ec) throw InputError(to + ": cannot copy " + f.path + " (" + ec.message() + ")");
+    fs::create_directories(fs::path(to).parent_path(), ec);
+    if (!ec) fs::copy_file(f.path, to, fs::copy_options::overwrite_existing, ec);
+    if (ec) {  // listed with the programs, as a failure of its own
+      BackupProgram failed;
+      failed.inputs = {f.path};
+      failed.error = to + ": cannot copy " + f.path + " (" + ec.message() + ")";
+      r.programs.push_back(failed);
+      ++r.failed;
+      continue;
+    }
     r.copied.push_back(to);
   }
   return r;

@@ -234,7 +234,8 @@ void check_taught_branches(const Robot& robot, const NativeProgram& p, const std
     for (const int j : d.turns) {
       char buf[120];
       std::snprintf(buf, sizeof buf, "%sA%d %.4f deg (taught solution %.4f)", "", j + 1, q[k][j], (*refs[k])[j]);
-      ((std::abs(q[k][j] - (*refs[k])[j]) < 5.0 ? crossed : changed) += (crossed.empty() ? "" : ", ") + std::string(buf));
+      std::string& list = std::abs(q[k][j] - (*refs[k])[j]) < 5.0 ? crossed : changed;
+      list += (list.empty() ? "" : ", ") + std::string(buf);
     }
     if (!crossed.empty())
       warnings.push_back(where_of[k] + ": " + named(p.targets[k]) + "the compensation moves a joint across its turn's border (" + crossed +
@@ -423,8 +424,12 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
     // the program's own files beside out_path (KRL: its .dat); a file of --declarations it writes to beside it too
     const auto out_of = [&](const std::string& path) {
       if (path == p.paths[0]) return out_path;
-      const auto dat = [](const std::string& x) { return x.substr(0, x.find_last_of('.') == std::string::npos ? x.size() : x.find_last_of('.')) + ".dat"; };
-      if (in_format == ControllerFormat::Krl && p.paths.size() > 1 && path == p.paths[1] && path == dat(p.paths[0]))
+      const auto dat = [](const std::string& x) {  // the extension of the file's name (not of a folder's) to .dat
+        const size_t slash = x.find_last_of('/'), dot = x.find_last_of('.');
+        return (dot == std::string::npos || (slash != std::string::npos && dot < slash) ? x : x.substr(0, dot)) + ".dat";
+      };
+      if (in_format == ControllerFormat::Krl && p.paths.size() > 1 && path == p.paths[1] &&
+          upper_case(path) == upper_case(dat(p.paths[0])))
         return dat(out_path);
       const size_t slash = out_path.find_last_of('/');
       const std::string name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);

@@ -229,10 +229,13 @@ class KrlReader {
     own_.emplace_back();
     assigned_.emplace_back();
     const int src = add(src_path);
-    const std::string dat_path = ctl::with_ext(src_path, ".dat");
-    if (FILE* f = std::fopen(dat_path.c_str(), "rb")) {
-      std::fclose(f);
-      scan(add(dat_path), true);
+    for (const char* ext : {".dat", ".DAT", ".Dat"}) {  // its data list, in the case the controller wrote it
+      const std::string dat_path = ctl::with_ext(src_path, ext);
+      if (FILE* f = std::fopen(dat_path.c_str(), "rb")) {
+        std::fclose(f);
+        scan(add(dat_path), true);
+        break;
+      }
     }
     scan(src, false);
     motions(src);

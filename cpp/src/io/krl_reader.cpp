@@ -430,6 +430,25 @@ class KrlReader {
     return fr;
   }
 
+  // a target whose value stands in file f, line, [begin, end), read as aggregate a
+  static NativeTarget target_at(int f, int line, size_t begin, size_t end, const Aggregate& a) {
+    NativeTarget t;
+    t.file = f;
+    t.line = line;
+    t.begin = begin;
+    t.end = end;
+    t.pose = a.pose;
+    t.taught = a.taught;
+    t.external = a.external;
+    return t;
+  }
+
+  static void in_frames(NativeTarget& t, const Frames& fr) {
+    t.tool = fr.tool;
+    t.frame = fr.base;
+    t.frames_named = fr.named;
+  }
+
   void unresolved(const std::string& where_, const std::string& code, const std::string& why) {
     p.unresolved.push_back({where_, trim(code), why});
   }
@@ -448,17 +467,8 @@ class KrlReader {
         return unresolved(w, code, "an aggregate without " + a.missing + ": the rest is where the robot is at run time");
       const Frames fr = frames_at(s, w);
       if (!fr.why.empty()) return unresolved(w, code, fr.why);
-      NativeTarget t;
-      t.file = f;
-      t.line = static_cast<int>(i + 1);
-      t.begin = b;
-      t.end = b + text.size();
-      t.pose = a.pose;
-      t.taught = a.taught;
-      t.external = a.external;
-      t.tool = fr.tool;
-      t.frame = fr.base;
-      t.frames_named = fr.named;
+      NativeTarget t = target_at(f, static_cast<int>(i + 1), b, b + text.size(), a);
+      in_frames(t, fr);
       t.joint_motion = joint;
       mo.target = static_cast<int>(p.targets.size());
       return p.targets.push_back(t);
@@ -495,14 +505,8 @@ class KrlReader {
       const std::string dw = where(d.path, d.line);
       const Aggregate a = read_aggregate(d.value, dw);
       if (!a.missing.empty()) throw InputError(dw + ": the target has no " + a.missing + " value");
-      t.file = d.file;
-      t.line = d.line;
-      t.begin = d.begin;
-      t.end = d.end;
+      t = target_at(d.file, d.line, d.begin, d.end, a);
       t.name = d.name;
-      t.pose = a.pose;
-      t.taught = a.taught;
-      t.external = a.external;
       t.joint_edits.push_back({d.file, d.line, d.type_begin, d.type_end, d.type == "E6POS" ? "E6AXIS" : "AXIS"});
       first_[key] = static_cast<int>(p.targets.size());
     } else {  // a second frame: a copy, declared after the original, that these motions name
@@ -511,9 +515,7 @@ class KrlReader {
       t.name = copy_name(d.name);
       t.edits = {{f, static_cast<int>(i + 1), b, b + text.size(), t.name}};
     }
-    t.tool = fr.tool;
-    t.frame = fr.base;
-    t.frames_named = fr.named;
+    in_frames(t, fr);
     t.joint_motion = joint;
     mo.target = static_cast<int>(p.targets.size());
     by_frame[fr.key] = mo.target;

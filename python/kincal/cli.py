@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Iterator, Optional, Sequence
 
 import numpy as np
 
@@ -502,10 +504,28 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """kincal's matrices are small (tens to a few hundred rows): a BLAS thread pool costs more to wake than it
+    saves (BENCHMARKS.md, issue 29: `identify` on 540 rows took 2.67 s with OpenBLAS's two threads, 1.9 s with
+    one). Unless the user chose a number of threads, the commands run with one."""
+    chosen = any(v in os.environ for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"))
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # (a dependency; without it, BLAS's own default)
+        chosen = True
+    if chosen:
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        args.func(args)
+        with _one_blas_thread():
+            args.func(args)
     except (ValueError, OSError) as e:
         print(f"kincal {args.command}: error: {e}", file=sys.stderr)
         return 1

@@ -170,3 +170,17 @@ def test_unreachable_taught_solution_is_an_error(tmp_path, kr500, calibrated, ki
     assert r.returncode == 0, r.stderr
     assert "--allow-branch-change" in r.stderr  # the warning naming the target
     assert len(_read_back(kind, out)) == len(TAUGHT)
+
+
+def test_a_copy_is_named_by_the_motion_that_uses_it(tmp_path):
+    """XA is taught for base 0 and used again in a base 5 m up, out of reach: the error names the motion
+    (cp.src:5), the original's name, the second base and the copy it would have been written as."""
+    (tmp_path / "cp.src").write_text("DEF cp( )\n$TOOL = $NULLFRAME\nPTP XA\n$BASE = {X 0.0,Y 0.0,Z 5000.0,A 0.0,B 0.0,C 0.0}\n"
+                                     "PTP XA\nEND\n")
+    (tmp_path / "cp.dat").write_text("DEFDAT cp\nDECL E6POS XA={X 1821.7535,Y 96.2456,Z 1403.9982,A 155.1308,"
+                                      "B 5.7771,C 167.798,S 2,T 42}\nENDDAT\n")
+    r = run("kincal-compensate", "--model", "kr500", "--program", str(tmp_path / "cp.src"), "--out",
+            str(tmp_path / "out" / "cp.src"), "--targets", "filtered")
+    assert r.returncode == 1
+    assert "cp.src:5: XA in {X 0.0,Y 0.0,Z 5000.0" in r.stderr and "written as XA_1, declared after" in r.stderr
+    assert not (tmp_path / "out").exists()

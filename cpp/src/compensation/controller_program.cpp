@@ -274,7 +274,19 @@ ControllerProgramResult compensate_native_program(const Robot& robot, const Nati
   }
   if (p.targets.empty()) throw InputError(p.paths[0] + ": the program has no Cartesian targets to compensate");
   std::vector<std::string> where_of;
-  for (const NativeTarget& t : p.targets) where_of.push_back(where(p.paths[static_cast<size_t>(t.file)], t.line));
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    const NativeTarget& t = p.targets[k];
+    where_of.push_back(where(p.paths[static_cast<size_t>(t.file)], t.line));
+    if (t.copy_of < 0) continue;
+    // a copy (declared on the line after its original, in another tool or base) is named by the motion that uses it
+    for (const NativeMotion& m : p.motions)
+      if (m.target == static_cast<int>(k)) {
+        where_of.back() = motion_where(p, m) + ": " + p.targets[static_cast<size_t>(t.copy_of)].name + " in " +
+                          (t.frames_named.empty() ? "tool 0 and base 0" : t.frames_named) + " (written as " + t.name +
+                          ", declared after " + where_of.back() + ")";
+        break;
+      }
+  }
   const TargetFrames frames = target_frames(p, n, where_of);
   std::vector<Pose6> poses;
   for (size_t k = 0; k < p.targets.size(); ++k)

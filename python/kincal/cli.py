@@ -5,12 +5,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
-from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator, Optional, Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 
@@ -23,6 +21,7 @@ from . import feed as feedmod
 from . import fivebar, priors, report
 from . import identify as ident
 from . import strict_json
+from .blas_threads import one_blas_thread
 from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, masses
 from .kinematics_files import fk_file, ik_file
 from .setups import robot_for_setup
@@ -73,7 +72,7 @@ def cmd_compensate(args) -> None:
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
     if len(args.program) > 1 or Path(args.program[0]).is_dir():
-        _compensate_backup(robot, args)
+        programs.compensate_backup(robot, args, _comp_kwargs(args))
         return
     res = programs.compensate(robot, args, _comp_kwargs(args))
     for w in res["warnings"]:
@@ -84,40 +83,6 @@ def cmd_compensate(args) -> None:
           f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
     for line in programs.summary(res):
         print(f"{written}: {line}", file=sys.stderr)
-
-
-def _compensate_backup(robot, args) -> None:
-    """A controller backup (folders, several files): every program filtered into the same tree under --out;
-    a program that fails is listed (file:line: cause) and the exit status is 1, the others are written."""
-    bar = _count_bar("kincal compensate: programs")
-    res = programs.compensate(robot, args, _comp_kwargs(args), progress=bar)
-    if sys.stderr.isatty():
-        print(file=sys.stderr)
-    for p in res["programs"]:
-        for w in p["warnings"]:
-            print(f"kincal compensate: warning: {w}", file=sys.stderr)
-    written = [p for p in res["programs"] if not p["error"]]
-    for p in written:
-        if p["files"]:
-            n = len(p["iterations"])
-            print(f"{', '.join(p['files'])}: {n} target(s) compensated"
-                  + (f"; {p['targets_note']}" if p["targets_note"] else ""), file=sys.stderr)
-    print(f"{args.out}: {len([p for p in written if p['files']])} program(s) filtered, {len(res['copied'])} file(s) "
-          f"copied unchanged, {res['failed']} program(s) failed", file=sys.stderr)
-    if res["failed"]:
-        lines = [f"{', '.join(p['inputs'])}:\n    " + p["error"].replace("\n", "\n    ")
-                 for p in res["programs"] if p["error"]]
-        raise ValueError(f"{res['failed']} program(s) not written (the others are):\n  " + "\n  ".join(lines))
-
-
-def _count_bar(label: str):
-    """A progress report of done/all items on stderr (quiet when not a terminal)."""
-    if not sys.stderr.isatty():
-        return None
-
-    def report(done: int, total: int) -> None:
-        print(f"\r{label}: {done}/{total}   ", end="", file=sys.stderr, flush=True)
-    return report
 
 
 def _progress(label: str):
@@ -504,27 +469,10 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-@contextmanager
-def _one_blas_thread() -> Iterator[None]:
-    """kincal's matrices are small (tens to a few hundred rows): a BLAS thread pool costs more to wake than it
-    saves (BENCHMARKS.md, issue 29: `identify` on 540 rows took 2.67 s with OpenBLAS's two threads, 1.9 s with
-    one). Unless the user chose a number of threads, the commands run with one."""
-    chosen = any(v in os.environ for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"))
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # (a dependency; without it, BLAS's own default)
-        chosen = True
-    if chosen:
-        yield
-        return
-    with threadpool_limits(limits=1, user_api="blas"):
-        yield
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        with _one_blas_thread():
+        with one_blas_thread():
             args.func(args)
     except (ValueError, OSError) as e:
         print(f"kincal {args.command}: error: {e}", file=sys.stderr)

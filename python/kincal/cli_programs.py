@@ -4,7 +4,10 @@ by the C++ core (the same code as kincal-compensate)."""
 
 from __future__ import annotations
 
+import sys
+
 from . import _core
+from .cli_campaign import _step_progress
 from .tool_frame import warn_nominal_tcp
 
 FORMATS = ["krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"]
@@ -101,3 +104,27 @@ def summary(res: dict) -> list[str]:
         return lines
     return lines + [f"path between targets: largest deviation from the desired segments {res['path_before_mm']:.4f} mm "
                     f"before, {res['path_after_mm']:.4f} mm after {res['inserted']} inserted target(s)"]
+
+
+def compensate_backup(robot, args, comp_kwargs: dict) -> None:
+    """A controller backup (folders, several files): every program filtered into the same tree under --out;
+    a program that fails is listed (file:line: cause) and the exit status is 1, the others are written."""
+    step = _step_progress("kincal compensate: programs")  # (done counts from 1)
+    res = compensate(robot, args, comp_kwargs, progress=None if step is None else lambda done, n: step(done - 1, n))
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    for p in res["programs"]:
+        for w in p["warnings"]:
+            print(f"kincal compensate: warning: {w}", file=sys.stderr)
+    written = [p for p in res["programs"] if not p["error"]]
+    for p in written:
+        if p["files"]:
+            n = len(p["iterations"])
+            print(f"{', '.join(p['files'])}: {n} target(s) compensated"
+                  + (f"; {p['targets_note']}" if p["targets_note"] else ""), file=sys.stderr)
+    print(f"{args.out}: {len([p for p in written if p['files']])} program(s) filtered, {len(res['copied'])} file(s) "
+          f"copied unchanged, {res['failed']} program(s) failed", file=sys.stderr)
+    if res["failed"]:
+        lines = [f"{', '.join(p['inputs'])}:\n    " + p["error"].replace("\n", "\n    ")
+                 for p in res["programs"] if p["error"]]
+        raise ValueError(f"{res['failed']} program(s) not written (the others are):\n  " + "\n  ".join(lines))

@@ -35,6 +35,7 @@ from typing import Any, Callable, Optional, Protocol, Sequence
 import numpy as np
 
 from . import _core, strict_json
+from .fdist import f_survival
 
 #: how many of a round's candidates (best cross-validated gain first) the history lists and the
 #: verdict weighs
@@ -123,8 +124,6 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
     of Jc's span, when the caller has it; ``ridge``: a penalty weight per column, in the fits of the
     cross-validation). Columns the span absorbs are dropped; a candidate absorbed whole scores
     nothing."""
-    from scipy.special import fdtrc  # the F distribution's survival function (scipy.stats: a 2 s import)
-
     Q = _basis(Jc) if Q is None else Q
     r = r - Q @ (Q.T @ r)  # the current model refitted on its linearisation too (a robust fit leaves r off its span)
     Rp, keep = _projected(Q, R)
@@ -139,7 +138,7 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
     if dof <= 0 or k == 0:  # more columns than the residual has coordinates: nothing can be tested
         return {"F": 0.0, "p_value": 1.0, "cv_gain": 0.0, "absorbed": False, "parameters": int(k), "untestable": True}
     F = ((rss0 - rss1) / k) / (rss1 / dof) if rss1 > 0 else math.inf
-    p = float(fdtrc(k, dof, F)) if math.isfinite(F) else 0.0
+    p = f_survival(k, dof, F) if math.isfinite(F) else 0.0
     before = after = 0.0
     for h in row_folds:
         if ridge is None:
@@ -166,6 +165,11 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
     groups: dict = {}  # variants of the same columns, solved together
     for i, (m, ridge) in enumerate(variants):
         groups.setdefault(m, []).append(i)
+    solved = []  # per group of variants: its variants, the columns kept and each variant's ridge on the diagonal
+    for m, idx in groups.items():
+        cols = np.flatnonzero(keep[:m])
+        w2 = np.array([np.asarray(variants[i][1], dtype=float)[cols] ** 2 for i in idx])
+        solved.append((idx, cols, w2[:, :, None] * np.eye(len(cols))[None, :, :]))
     before = 0.0
     after = np.zeros(len(variants))
     for h in row_folds:
@@ -173,18 +177,16 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
         Gh, gh, ss = Rh.T @ Rh, Rh.T @ rh, float(rh @ rh)
         before += ss
         Gt, gt = G - Gh, g - gh
-        for m, idx in groups.items():
-            cols = np.flatnonzero(keep[:m])
+        for idx, cols, ridge2 in solved:
             if not len(cols):
                 after[idx] += ss
                 continue
-            w2 = np.array([np.asarray(variants[i][1], dtype=float)[cols] ** 2 for i in idx])
-            A = Gt[np.ix_(cols, cols)][None, :, :] + w2[:, :, None] * np.eye(len(cols))[None, :, :]
+            A = Gt[cols][:, cols][None, :, :] + ridge2
             try:
                 b = np.linalg.solve(A, np.broadcast_to(gt[cols], (len(idx), len(cols)))[:, :, None])[:, :, 0]
             except np.linalg.LinAlgError:
                 b = np.array([np.linalg.lstsq(a, gt[cols], rcond=1e-14)[0] for a in A])
-            Ghc = Gh[np.ix_(cols, cols)]
+            Ghc = Gh[cols][:, cols]
             after[idx] += ss - 2.0 * b @ gh[cols] + np.einsum("vi,ij,vj->v", b, Ghc, b)
     best = float(np.min(after))
     choice = int(np.flatnonzero(after <= best * (1.0 + ORDER_MARGIN) + 1e-300)[0])

@@ -31,15 +31,16 @@ def _draw(data: dict, seed: int) -> dict:
 @pytest.mark.skipif(not IPA.is_dir(), reason="needs ../shared/data/ipa-robot-accuracy")
 def test_auto_on_15_configurations_of_each_ur10_series():
     """Issue 29 asks, per series, a median of auto / min(none, joint_compliance) of at most 1.03 and
-    no draw above 1.10. Measured (2026-11-25): A 1.0, 1.0, 1.039, 1.0, 1.0; B 1.0, 1.104, 1.0, 1.0,
-    1.0; C 1.0 x 5; D 1.0, 1.315, 1.0, 1.11, 1.112. Met for A, B and C in the median; NOT met for D
-    (median 1.11) nor for the worst draws (B 1.10, D 1.32). With one target, 15 points per draw give
-    joint compliance an F-test p of 0.03-0.04 where it helps (its linear cross-validated gain 23%):
-    far from the diagnosis's 1e-6, so auto keeps the geometry alone; a rule at p < 0.05 keeps it
-    there but also keeps spurious transmission errors elsewhere (draws 3.7x worse on A and D), so
-    the rule stays. This test holds where the default stands: the three medians and D's within 2% of
-    the measured figures, no draw of A, B, C above 1.11. (A fixed choice whose fit the 12-point
-    training folds refuse counts as infinitely bad; the default must not refuse.)"""
+    no draw above 1.10. Measured (2026-11-25, fourteenth session): A 1.0 x 5; B 1.003, 1.05, 1.0, 1.0,
+    1.0; C 1.0 x 5; D 1.0, 1.893, 1.0, 1.0, 1.177. Every median is met; the draws of A, B and C are
+    met; two draws of D are NOT (1.89, 1.18). There, on the 15 configurations auto keeps joint
+    compliance, but in each 12-point training fold of its nested validation it is no candidate (the
+    admission rule counts every loaded joint's compliance, where the core holds the wrist's), and
+    even admitted its F-test p is 0.18-0.75 on 12 points (0.0002-0.008 when the priors are scored
+    as pseudo-observations, which made other draws worse: A's third 1.65): the geometry alone is
+    kept inside the folds. This test holds where the default stands: every median within 3%, no
+    draw of A, B, C above 1.10. (A fixed choice whose fit the 12-point training folds refuse counts
+    as infinitely bad; the default must not refuse.)"""
     robot = kincal.load_robot("ur10")
     ratios: dict = {}
     for s, f in SERIES.items():
@@ -57,6 +58,6 @@ def test_auto_on_15_configurations_of_each_ur10_series():
             print(f"series {s}, seed {seed}: CV RMS (mm) {', '.join(f'{k} {v:.4f}' for k, v in cv.items())}")
     print({s: [round(x, 3) for x in r] for s, r in ratios.items()})
     for s, r in ratios.items():
-        assert np.median(r) <= (1.03 if s != "D" else 1.11 * 1.02), (s, r)
+        assert np.median(r) <= 1.03, (s, r)
         if s != "D":
-            assert max(r) <= 1.11, (s, r)
+            assert max(r) <= 1.10, (s, r)

@@ -2,6 +2,7 @@
 // as dicts of numpy arrays: id, theta1_deg, theta2_deg, desired (n x 2), measured (n x 2), line.
 #include "common.hpp"
 
+#include "kincal/fivebar/fit.hpp"
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/model/model.hpp"
 

@@ -1,7 +1,10 @@
-# Installs the kincal build KINCAL_BUILD_DIR to a scratch prefix, then configures, builds and runs
-# the consumer project CONSUMER_DIR against that prefix alone (ctest: cmake_package_consumer).
+# Installs the kincal build KINCAL_BUILD_DIR to a scratch prefix, moves the prefix elsewhere, then
+# configures, builds and runs the consumer project CONSUMER_DIR against the moved prefix alone
+# (ctest: cmake_package_consumer). The installed package must be relocatable: its export may name
+# neither the first prefix nor the build or source tree, nor any other absolute path of this machine.
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
+set(moved ${WORK_DIR}/moved/prefix)
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
@@ -15,8 +18,36 @@ foreach(f lib/cmake/kincal/kincalConfig.cmake lib/cmake/kincal/kincalConfigVersi
     message(FATAL_ERROR "the install has no ${f}")
   endif()
 endforeach()
+# the move: from here on, a path into the first prefix leads nowhere
+file(MAKE_DIRECTORY ${WORK_DIR}/moved)
+file(RENAME ${prefix} ${moved})
+file(GLOB package_files ${moved}/lib/cmake/kincal/*.cmake)
+file(GLOB target_files ${moved}/lib/cmake/kincal/kincalTargets*.cmake)
+if(NOT target_files)
+  message(FATAL_ERROR "the install has no lib/cmake/kincal/kincalTargets*.cmake")
+endif()
+foreach(f IN LISTS package_files)
+  file(READ ${f} text)
+  # the first prefix lies in the build tree, so it is looked for first, to name the right one
+  foreach(place IN ITEMS "${prefix}" "${KINCAL_BUILD_DIR}" "${KINCAL_SOURCE_DIR}")
+    string(FIND "${text}" "${place}" at)
+    if(NOT at EQUAL -1)
+      message(FATAL_ERROR "the installed ${f} names ${place}: the package is not relocatable")
+    endif()
+  endforeach()
+endforeach()
+# the exported targets' properties: paths inside the package only (relative to _IMPORT_PREFIX), any
+# dependency as a target name, found again by kincalConfig.cmake on the consumer's machine
+foreach(f IN LISTS target_files)
+  file(STRINGS ${f} lines REGEX "^  (INTERFACE_[A-Z_]+|IMPORTED_[A-Z_]+) ")
+  foreach(line IN LISTS lines)
+    if(line MATCHES "[\";]/")
+      message(FATAL_ERROR "the installed ${f} has an absolute path: ${line}")
+    endif()
+  endforeach()
+endforeach()
 run(${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
-  -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_FIND_PACKAGE_NO_PACKAGE_REGISTRY=ON)
+  -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCMAKE_PREFIX_PATH=${moved} -DCMAKE_FIND_PACKAGE_NO_PACKAGE_REGISTRY=ON)
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run(${WORK_DIR}/build/consumer)
 message(STATUS "consumer: ${out}")

@@ -1,5 +1,6 @@
 // Five-bar hidden robot: kinematics round trips and derivatives, the paper's Table I picks, the
 // error matrix's interpolation, and the corrector's allocation-free loop.
+#include "kincal/fivebar/fit.hpp"
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/model/model.hpp"
 

@@ -1,5 +1,6 @@
 // kincal: nonlinear least-squares fit of the hidden robot's four lengths with Ceres (beyond the
 // paper's linear per-dyad synthesis: the distance between model and measured position itself).
+#include "kincal/fivebar/fit.hpp"
 #include "kincal/fivebar/fivebar.hpp"
 #include "kincal/model/model.hpp"
 

@@ -14,6 +14,9 @@
 #include "kincal/model/model.hpp"
 #include "kincal/model/robots.hpp"
 
+// the standard comes from kincal::core (cxx_std_17); CMakeLists.txt sets none
+static_assert(__cplusplus >= 201703L, "kincal's targets should compile their consumer as C++17");
+
 int main() {
   const kincal::Model model(kincal::kr500_spec());
   kincal::VecQ q(6);

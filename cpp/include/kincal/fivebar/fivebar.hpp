@@ -72,9 +72,7 @@ struct SubsetResult {
 SubsetResult fivebar_best_subset(const std::vector<FiveBarPoint>& pts, bool least_squares, bool desired_score,
                                  int n_min, int n_max);
 
-/// Beyond the paper: the four lengths fitted to the measured positions by nonlinear least squares
-/// (Ceres, analytic Jacobian), from `start`. rms: the fit's RMS distance (mm). (kincal::identify lib)
-FiveBar fivebar_fit_nonlinear(const std::vector<FiveBarPoint>& pts, const FiveBar& start, double* rms = nullptr);
+// fivebar_fit_nonlinear (on Ceres) is in kincal/fivebar/fit.hpp: kincal::identify defines it.
 
 /// The error-correction matrix: errors desired - measured on a regular grid, bilinear (eq. 7).
 struct ErrorMatrix {

@@ -1,4 +1,4 @@
-// kincal_benchmarks._bench: the C++ benchmarks for `kincal bench` (a module of their own, outside
+// kincal._benchmarks._bench: the C++ benchmarks for `kincal bench` (a module of their own, outside
 // kincal._core: the benchmarks are not part of the library).
 #include <pybind11/pybind11.h>
 

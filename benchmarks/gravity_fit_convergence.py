@@ -24,8 +24,8 @@ import numpy as np
 
 import kincal
 from kincal import _core
-from kincal import identify as ident
-from kincal.urdf import spec_urdf
+from kincal.calibration import identify as ident
+from kincal.io.urdf import spec_urdf
 
 NOISE_MM = 0.02
 

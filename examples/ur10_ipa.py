@@ -23,8 +23,10 @@ from pathlib import Path
 import numpy as np
 
 import kincal
-from kincal import datasets, diagnose, setups
-from kincal import identify as ident
+from kincal.io import datasets
+from kincal import diagnose
+from kincal.calibration import setups
+from kincal.calibration import identify as ident
 
 SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",
           "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}

@@ -24,8 +24,10 @@ from typing import Optional
 import numpy as np
 
 import kincal
-from kincal import _core, datasets, grouping
-from kincal import identify as ident
+from kincal import _core
+from kincal.io import datasets
+from kincal.stats import grouping
+from kincal.calibration import identify as ident
 from kincal.diagnose.residual_vars import gravity_torques
 
 SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",

@@ -18,9 +18,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 import kincal
-from kincal import datasets, grouping
-from kincal import identify as ident
-from kincal.setups import _refit_placements
+from kincal.io import datasets
+from kincal.stats import grouping
+from kincal.calibration import identify as ident
+from kincal.calibration.setups import _refit_placements
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ur10_maps import SERIES, predicted  # noqa: E402  (the UR10 examples' own helpers)

@@ -1,6 +1,11 @@
 """kincal: calibration, compensation and derivative analysis of industrial robots.
 
-The hot paths run in the C++ core (``kincal._core``); this package is the typed front over it.
+The hot paths run in the C++ core (``kincal._core``); this package is the typed front over it, in
+packages that follow the pipeline: ``calibration`` (identify, priors, setups, the effect choice,
+plan), ``diagnose``, ``programs`` (pose and joint files, feed), ``standards`` (ISO 9283, ISO 230-2,
+VDI/DGQ 3441), ``fivebar``, ``report``, ``io`` (JSON, CSV, URDF, public data sets), ``stats`` and
+``cli`` (the `kincal` command). The modules of the earlier flat layout (``kincal.identify``,
+``kincal.feed``, ...) are still reachable by their old names, with a DeprecationWarning.
 
     >>> import kincal
     >>> robot = kincal.load_robot("kr500")
@@ -10,17 +15,42 @@ The hot paths run in the C++ core (``kincal._core``); this package is the typed 
 
 from __future__ import annotations
 
+import importlib
 import json
-
+import warnings
 from pathlib import Path
 from typing import Optional, Sequence, Union
 
 import numpy as np
 
 from . import _core
-from . import strict_json
+from .io import strict_json
 from ._core import Robot
-from .urdf import urdf_model_json
+from .io.urdf import urdf_model_json
+
+#: the modules of the flat layout of 0.1 and where they are now; reachable by the old name, with a
+#: DeprecationWarning, for one release
+MOVED = {
+    "identify": "calibration.identify", "priors": "calibration.priors", "setups": "calibration.setups",
+    "plan": "calibration.plan", "fitting": "calibration.fitting", "gravity": "calibration.gravity",
+    "effect_choice": "calibration.effect_choice", "choice_report": "calibration.choice_report",
+    "tool_frame": "calibration.tool_frame", "simulation": "calibration.simulation",
+    "grouping": "stats.grouping", "stepwise": "stats.stepwise", "robust_scores": "stats.robust_scores",
+    "feed": "programs.feed", "kinematics_files": "programs.kinematics_files",
+    "accuracy": "standards.accuracy", "iso9283_plan": "standards.iso9283_plan", "accuracy_report": "standards.report",
+    "datasets": "io.datasets", "csv_text": "io.csv_text", "urdf": "io.urdf",
+    "accuracy_demo": "demo.accuracy",
+}
+
+
+def __getattr__(name: str):
+    """The old flat modules by their old names (MOVED), with a DeprecationWarning."""
+    if name in MOVED:
+        warnings.warn(f"kincal.{name} is now kincal.{MOVED[name]}; the old name goes in the next release",
+                      DeprecationWarning, stacklevel=2)
+        return importlib.import_module(f".{MOVED[name]}", __name__)
+    raise AttributeError(f"module 'kincal' has no attribute '{name}'")
+
 
 __all__ = ["Robot", "load_robot", "fk", "ik", "compensate", "run_program", "jacobian", "line_program", "__version__"]
 __version__ = "0.1.0"

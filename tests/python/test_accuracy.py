@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import accuracy as acc
+from kincal.standards import accuracy as acc
 
 from conftest import run
 

@@ -11,8 +11,8 @@ import re
 import numpy as np
 import pytest
 
-from kincal import accuracy as acc
-from kincal import accuracy_report as rep
+from kincal.standards import accuracy as acc
+from kincal.standards import report as rep
 
 from test_accuracy import _axis_csv, _axis_items
 

@@ -151,7 +151,7 @@ def test_standard_csv_variants_are_not_bad_input(tmp_path, tool):
 def test_python_csv_columns_read_past_a_byte_order_mark(tmp_path):
     # the Python side's column reader (pose, target, dirN of measurements and joint programs) reads a file
     # Excel saved with a BOM as the plain one: the first column keeps its name
-    from kincal import csv_text
+    from kincal.io import csv_text
 
     (tmp_path / "m.csv").write_bytes(b"\xef\xbb\xbfpose,q1,target\r\n7,0.5,1\r\n")
     assert csv_text.header(str(tmp_path / "m.csv")) == ["pose", "q1", "target"]

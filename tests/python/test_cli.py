@@ -219,11 +219,14 @@ def test_demo(tmp_path):
 def test_bench_prints_one_json_object():
     """kincal bench (the identification and diagnosis skipped, 50 poses): one JSON object on stdout
     with the core's timings beside KDL's, the derivative analysis and the whole run's time; the
-    benchmarks ship beside the package (kincal_benchmarks), not inside it."""
-    import kincal_benchmarks
+    benchmarks ship as the private subpackage kincal._benchmarks, no top-level package of their own."""
+    import importlib.util
+
+    from kincal import _benchmarks
 
     package = Path(kincal.__file__).parent
-    assert Path(kincal_benchmarks.__file__).parent.parent == package.parent  # installed beside kincal
+    assert Path(_benchmarks.__file__).parent == package / "_benchmarks"
+    assert importlib.util.find_spec("kincal_benchmarks") is None
     assert not (package / "_numpy_model.py").exists()
     r = run("kincal", "bench", "--poses", "50", "--no-identify", "--threads", "1")
     assert r.returncode == 0, r.stderr

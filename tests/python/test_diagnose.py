@@ -13,8 +13,8 @@ import pytest
 import kincal
 from kincal import _core
 from kincal import diagnose as dg
-from kincal import identify as ident
-from kincal.urdf import spec_urdf
+from kincal.calibration import identify as ident
+from kincal.io.urdf import spec_urdf
 
 from conftest import run
 
@@ -297,7 +297,7 @@ def test_a_model_without_masses_tries_compliance_with_fitted_moments(tmp_path, k
     the fitted one again."""
     import re
 
-    from kincal.effect_choice import JointCompliance
+    from kincal.calibration.effect_choice import JointCompliance
 
     spec = json.loads(kr500.to_json())["nominal"]
     text = re.sub(r"<inertial>.*?</inertial>", "", spec_urdf(spec, "urdf_robot"), flags=re.S)

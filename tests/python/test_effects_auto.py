@@ -19,9 +19,9 @@ import pytest
 
 import kincal
 from kincal import diagnose as dg
-from kincal import identify as ident
-from kincal.effect_choice import JointCompliance
-from kincal.urdf import spec_urdf
+from kincal.calibration import identify as ident
+from kincal.calibration.effect_choice import JointCompliance
+from kincal.io.urdf import spec_urdf
 
 from conftest import run
 

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import datasets, grouping
-from kincal import identify as ident
+from kincal.io import datasets
+from kincal.stats import grouping
+from kincal.calibration import identify as ident
 
 from conftest import SHARED
 

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from kincal.fdist import f_survival, incomplete_beta
+from kincal.stats.fdist import f_survival, incomplete_beta
 
 
 def test_f_survival_agrees_with_scipy():

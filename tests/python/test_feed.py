@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kincal import feed
+from kincal.programs import feed
 
 from conftest import run
 

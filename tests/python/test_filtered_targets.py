@@ -28,7 +28,7 @@ from scipy.spatial.transform import Rotation
 
 import kincal
 from kincal import _core
-from kincal import identify as ident
+from kincal.calibration import identify as ident
 
 from conftest import count, run
 

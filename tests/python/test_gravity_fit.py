@@ -12,8 +12,8 @@ import pytest
 
 import kincal
 from kincal import _core
-from kincal import identify as ident
-from kincal.urdf import spec_urdf
+from kincal.calibration import identify as ident
+from kincal.io.urdf import spec_urdf
 
 from conftest import run
 

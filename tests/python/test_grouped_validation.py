@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import _core, grouping
-from kincal import identify as ident
+from kincal import _core
+from kincal.stats import grouping
+from kincal.calibration import identify as ident
 
 from conftest import run
 
@@ -137,7 +138,7 @@ def test_a_failed_fold_says_it_is_a_fold():
     import numpy as np
     import pytest
 
-    from kincal import identify as ident
+    from kincal.calibration import identify as ident
 
     def refuses(data, opts):
         raise ValueError(f"m.csv: the {len(data['pose'])} measured points of ...: too few or too similar poses")

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import _core, plan
-from kincal import identify as ident
-from kincal.urdf import spec_urdf
+from kincal import _core
+from kincal.calibration import plan
+from kincal.calibration import identify as ident
+from kincal.io.urdf import spec_urdf
 
 from conftest import random_q, run
 
@@ -146,7 +147,7 @@ def test_ur10_real_data_calibrates_across_series():
     beats the nominal one on every series. Measured: B held out 1.07 -> 0.41 mm, C 0.99 -> 0.50 mm,
     D 0.78 -> 0.50 mm RMS; we require at least a 30% reduction."""
     from conftest import SHARED
-    from kincal import datasets
+    from kincal.io import datasets
     base = SHARED / "data" / "ipa-robot-accuracy"
     if not base.exists():
         pytest.skip("the shared UR10 data are not present")
@@ -180,7 +181,7 @@ def test_observability_selection_beats_random_poses():
 def test_numpy_residuals_equal_the_core():
     """The numpy measurement model of the scipy benchmark baseline computes the core's residuals
     (kr500, compliance, two targets, a random parameter point) to 1e-9 mm."""
-    from kincal_benchmarks.numpy_model import NumpyPointModel
+    from kincal._benchmarks.numpy_model import NumpyPointModel
 
     robot = kincal.load_robot("kr500")
     data = ident.simulate(ident.default_truth(robot, seed=1), 50, seed=1, targets=2)
@@ -223,7 +224,7 @@ def test_ipa_orientations_read_as_abc():
     from scipy.spatial.transform import Rotation
 
     from conftest import SHARED
-    from kincal import datasets
+    from kincal.io import datasets
     path = SHARED / "data" / "ipa-robot-accuracy" / "Series_B/measurements_joint_configurations.csv"
     if not path.exists():
         pytest.skip("the shared UR10 data are not present")

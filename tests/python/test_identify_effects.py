@@ -12,7 +12,7 @@ import pytest
 
 import kincal
 from kincal import _core
-from kincal import identify as ident
+from kincal.calibration import identify as ident
 
 from conftest import run
 
@@ -50,7 +50,7 @@ def test_effects_grammar(kr500, text, harmonics, want):
 def test_compliance_joints_come_from_the_robot(kr500, tmp_path):
     """A URDF robot whose joints 2 and 3 carry gravity (the kr500 geometry and link masses, no head):
     joint_compliance means the joints the layout marks as loaded, and those only."""
-    from kincal.urdf import spec_urdf
+    from kincal.io.urdf import spec_urdf
 
     (tmp_path / "r.urdf").write_text(spec_urdf(json.loads(kr500.to_json())["nominal"], "urdf_robot"))
     robot = kincal.load_robot(str(tmp_path / "r.urdf"))

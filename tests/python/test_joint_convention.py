@@ -20,7 +20,7 @@ import pytest
 
 import kincal
 from kincal import _core
-from kincal import identify as ident
+from kincal.calibration import identify as ident
 
 from conftest import run
 

@@ -17,7 +17,7 @@ import pytest
 import kincal
 from kincal import _core
 from kincal import diagnose as dg
-from kincal import identify as ident
+from kincal.calibration import identify as ident
 from kincal.diagnose import residual_vars
 
 from conftest import run

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import _core, plan
-from kincal import identify as ident
+from kincal import _core
+from kincal.calibration import plan
+from kincal.calibration import identify as ident
 
 from conftest import run
 

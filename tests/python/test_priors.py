@@ -12,8 +12,10 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import _core, datasets, grouping
-from kincal import identify as ident
+from kincal import _core
+from kincal.io import datasets
+from kincal.stats import grouping
+from kincal.calibration import identify as ident
 
 from conftest import SHARED, run
 

@@ -104,7 +104,9 @@ def test_python_abc_helpers_are_exact_at_the_pole():
     give back the rotation within 1e-5 deg (a Python copy without the pole's branch was 177 deg off)."""
     import numpy as np
 
-    from kincal import _core, tool_frame, urdf
+    from kincal import _core
+    from kincal.calibration import tool_frame
+    from kincal.io import urdf
 
     rng = np.random.default_rng(3)
     for _ in range(20):

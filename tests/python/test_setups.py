@@ -15,8 +15,8 @@ import pytest
 import kincal
 from kincal import _core
 from kincal import diagnose as dg
-from kincal import identify as ident
-from kincal.setups import simulate_setups, with_setups
+from kincal.calibration import identify as ident
+from kincal.calibration.setups import simulate_setups, with_setups
 
 from conftest import run
 

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import kincal
-from kincal import identify as ident
-from kincal import strict_json
+from kincal.calibration import identify as ident
+from kincal.io import strict_json
 
 from conftest import non_strict_json_files, run, strict_json_error
 

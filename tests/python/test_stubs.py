@@ -12,7 +12,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.parametrize("module", ["kincal._core", "kincal_benchmarks._bench"])
+@pytest.mark.parametrize("module", ["kincal._core", "kincal._benchmarks._bench"])
 def test_stubs_match_the_module(module):
     pytest.importorskip("mypy")
     # the allowlist names what stubtest cannot check in the core (pybind11's generated members)
@@ -30,8 +30,8 @@ def test_package_passes_mypy():
 
 
 def test_benchmarks_pass_mypy():
-    """kincal_benchmarks (shipped beside kincal) against the installed, typed kincal."""
+    """The benchmarks (shipped as the private kincal._benchmarks) against the installed, typed kincal."""
     pytest.importorskip("mypy")
-    r = subprocess.run([sys.executable, "-m", "mypy", "--ignore-missing-imports", "-p", "kincal_benchmarks"],
+    r = subprocess.run([sys.executable, "-m", "mypy", "--ignore-missing-imports", "-p", "kincal._benchmarks"],
                        capture_output=True, text=True, timeout=300, cwd=str(ROOT / "benchmarks"))
     assert r.returncode == 0, r.stdout[-3000:]

@@ -12,7 +12,7 @@ import pytest
 
 import kincal
 from kincal import _core
-from kincal import identify as ident
+from kincal.calibration import identify as ident
 
 from conftest import run
 from test_accuracy import HAND, _runs_csv

@@ -21,8 +21,8 @@ import json
 import pytest
 
 import kincal
-from kincal import datasets
-from kincal import identify as ident
+from kincal.io import datasets
+from kincal.calibration import identify as ident
 
 from conftest import SHARED, run
 

@@ -2,29 +2,27 @@
 candidate effects of kincal.effect_choice (those `identify --effects auto` chooses from, with the
 same rule; here every step refitted and confirmed), with identify's fitting options in every fit;
 then what the final
-model still misses against every candidate variable (residual_vars), the final model identified on
-all the data, and the files of the command.
+model still misses against every candidate variable (residual_vars), and the final model identified
+on all the data (the command's files: workflow.py).
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Callable, Optional, Sequence, Union
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from .. import _core, grouping, report
-from .. import identify as ident
-from .. import stepwise as engine
-from .. import strict_json
+from .. import _core
+from ..stats import grouping
+from ..calibration import identify as ident
+from ..stats import stepwise as engine
 from .._core import Robot
-from ..effect_choice import (ALPHA, MAX_MAP_ORDER, MIN_GAIN, JointCompliance,  # noqa: F401
-                             SerialProblem, Spec, candidates, check_data, evaluate)
-from ..fitting import FitOptions
+from ..calibration.effect_choice import (ALPHA, MAX_MAP_ORDER, MIN_GAIN, JointCompliance,  # noqa: F401
+                                         SerialProblem, Spec, candidates, check_data, evaluate)
+from ..calibration.fitting import FitOptions
 from . import residual_vars
 
-__all__ = ["JointCompliance", "SerialProblem", "Spec", "candidates", "diagnose", "final_identification", "run",
-           "summary", "step_effect"]
+__all__ = ["JointCompliance", "SerialProblem", "Spec", "candidates", "diagnose", "final_identification", "step_effect"]
 
 def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
              max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
@@ -100,46 +98,3 @@ def final_identification(robot: Robot, data: dict, diag: dict,
     if tool_targets is not None:
         res = ident.tool_from_targets(res, tool_targets)
     return res
-
-
-def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_targets: Optional[np.ndarray] = None,
-        progress: Optional[Callable[[str], None]] = None, **options) -> tuple[dict, "ident.Identification"]:
-    """`kincal diagnose`: the diagnosis (``options``: those of diagnose()), the final model identified
-    on all the data, and in the folder ``out`` report.html with its figures, diagnosis.json and
-    model.json. Returns the diagnosis and the final identification."""
-    from .serial_report import write_report
-
-    say = progress or (lambda s: None)
-    report.check_folder(out)  # before the work, not after it
-    diag = diagnose(robot, data, progress=progress, **options)
-    say("identifying the final model on all the data")
-    model = final_identification(robot, data, diag, tool_targets)
-    diag["final_model"]["file"] = "model.json"
-    diag["final_model"]["parameters"] = [
-        {"effect": e.name, "joint": e.joint or None, "label": e.label,
-         "values": [v * sc for v, sc in zip(vals, e.file_scale)], "units": e.file_units}
-        for e, vals in model.robot.effects]
-    with report.staged_folder(out, owned=("step*.png", "residual_variables.png")) as folder:  # whole or nothing
-        write_report(robot, data, diag, folder, title=title, model_file="model.json")
-        _core.write_file_atomic(str(folder / "diagnosis.json"), strict_json.dumps(engine.contract_json(diag), indent=1) + "\n")
-        _core.write_file_atomic(str(folder / "model.json"), model.model_json())
-    return diag, model
-
-
-def summary(diag: dict, model: "ident.Identification", out: Union[str, Path], seconds: float) -> str:
-    """`kincal diagnose`'s summary of run()'s results: each named effect, the final verdict and the
-    files written in ``out``."""
-    folder = Path(out)
-    lines = []
-    for st in diag["steps"]:
-        j = f" joint {st['joint']}" if st["joint"] else ""
-        o = f" order {st['order']}" if st.get("order") else ""
-        lines.append(f"{st['effect']}{j}{o}: cross-validated RMS {st['rms_before_mm'] * 1000:.1f} -> "
-                     f"{st['rms_after_mm'] * 1000:.1f} um (F = {st['evidence']['F']:.3g})")
-    lines.append(f"final cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um, {engine.noise_phrase(diag)}: "
-                 f"{diag['verdict']} ({seconds:.1f} s); "
-                 f"report: {folder / 'report.html'}; model ({' + '.join(['geometry'] + model.effect_labels())}): "
-                 f"{folder / 'model.json'}")
-    if diag.get("residual_summary"):
-        lines.append(diag["residual_summary"])
-    return "\n".join(lines)

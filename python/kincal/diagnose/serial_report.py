@@ -12,7 +12,7 @@ from .. import _core
 from .. import report
 from .._core import Robot
 from . import residual_vars
-from ..stepwise import noise_phrase
+from ..stats.stepwise import noise_phrase
 from .serial import Spec, step_effect
 
 

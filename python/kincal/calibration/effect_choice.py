@@ -1,0 +1,495 @@
+"""Which effects a serial robot's model carries, chosen by the data: the candidate effects of the
+registry (joint_compliance, transmission_error, backlash, thermal_expansion, drift, joint_map, per
+joint where it concerns one), their refit (Ceres, C++ core) and their linearisation (the columns a
+candidate's parameters would add to the identification Jacobian at the current fit, every
+candidate's in one evaluation), for the stepwise search of kincal.stepwise.
+
+`kincal identify --effects auto` searches these candidates (every library effect that applies to
+the robot and the data's columns) with the diagnosis's significance rule (F test, 3% linear
+cross-validated gain), the model fitted once and each step taken on its linearisation, and, to
+report an honest figure, makes the same choice again inside every training fold of its validation
+(choose()). `kincal diagnose` searches the same candidates with the same rule, refitting the model
+and confirming the cross-validated RMS at every step, then scores what remains against every
+variable.
+
+Joint compliance is one candidate for every gravity-loaded joint (JointCompliance), in the form
+``--gravity`` gives: the torques from the model's link masses (``masses``, or ``auto`` on a model
+that has masses), or from mass moments fitted with it (``fit``, or ``auto`` without masses: its
+columns are the compliance columns at its own fit, where the bilinear deflection lies in their span).
+A periodic effect of a joint angle is credited with the smaller of its gain and its gain on held-out
+ranges of that angle. Candidates are scored on the robust pseudo-residual (robust_weights).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..stats import stepwise as engine
+from .._core import Robot
+from .fitting import FitOptions, folds as grouped_folds, gravity_fitted, point_errors, subset
+from ..stats.robust_scores import loss_threshold, robust_noise, robust_weights
+
+#: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
+MAX_MAP_ORDER = 8
+#: joint_map's smoothness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k (the
+#: penalty is lambda s / pi times the integral of the map's squared slope over a turn; s: the mean
+#: squared norm of the joint's order-1 columns, so lambda is relative to what the data see); the
+#: cross-validation chooses lambda among these, together with the order. A map the data see over
+#: part of a turn only stays smooth there and small beyond.
+MAP_SMOOTHING = (1e-1, 1e-2, 1e-3)
+#: joint_map's variant (order, smoothing) is chosen leaving out each of this many ranges of its angle
+VARIANT_BLOCKS = 5
+#: periodic errors of a joint angle: also scored holding out ranges of that angle (SerialProblem.score_folds)
+PERIODIC = ("transmission_error", "joint_map")
+#: the significance rule of a step (the diagnosis's): F-test p below ALPHA and a linear
+#: cross-validated gain above MIN_GAIN
+ALPHA, MIN_GAIN = 1e-6, 0.03
+
+
+class JointCompliance:
+    """The library's joint_compliance on every gravity-loaded joint (as ``--effects joint_compliance``):
+    one candidate, its gravity torques from the model's link masses (``gravity`` "masses") or from
+    mass moments fitted with it ("fit": a model without link masses, or --gravity fit)."""
+    name = "joint_compliance"
+    joint = 0
+    order = 0
+    harmonics: tuple = ()
+
+    def __init__(self, gravity: str = "masses"):
+        if gravity not in ("masses", "fit"):
+            raise ValueError(f"joint compliance's gravity is 'masses' or 'fit', not '{gravity}'")
+        self.gravity = gravity
+
+    @property
+    def label(self) -> str:
+        return "joint_compliance" if self.gravity == "masses" else "joint_compliance (fitted mass moments)"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, JointCompliance) and other.gravity == self.gravity
+
+    def __hash__(self) -> int:
+        return hash(self.label)
+
+    def __repr__(self) -> str:
+        return self.label
+
+
+def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
+    """Joints (from 1) where a joint-wise effect applies: the gravity-loaded ones (from the
+    identification layout) for an effect that needs gravity, every joint otherwise."""
+    if kind.gravity_loaded_only:
+        return list(_core.PointModel(robot, 1).layout.loaded)
+    return list(range(1, robot.dof + 1))
+
+
+def _needs_column(kind) -> str:
+    """The measurement-set key of the column an effect kind reads ('' when none)."""
+    return "dir" if kind.needs == "dir" else kind.needs
+
+
+def candidates(robot: Robot, data: dict, start: Sequence = (), gravity: str = "auto") -> tuple[list, list]:
+    """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
+    compliance as one JointCompliance in the form ``gravity`` gives) the data can support, and notes
+    on those skipped. Effects of ``start`` (the model the search starts from) are no candidates."""
+    out: list = []
+    notes: list = []
+    have = {(e.name, e.joint) for e in start}
+    for kind in _core.effect_kinds():
+        if kind.domain != "serial":
+            continue
+        col = _needs_column(kind)
+        if col == "dir" and col not in data:
+            notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
+            continue
+        if col == "temperature_c" and (col not in data or np.ptp(data[col]) <= 0.5):
+            notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
+            continue
+        if col == "time_s" and (col not in data or np.ptp(data[col]) <= 0):
+            notes.append(f"{kind.name} skipped: no time_s column, or it does not vary")
+            continue
+        if col and col not in data:
+            notes.append(f"{kind.name} skipped: the data have no {col} column")
+            continue
+        joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
+        if kind.name == "joint_compliance":  # one candidate: every gravity-loaded joint
+            if joints and not any(e.name == kind.name for e in start):
+                fitted = gravity_fitted(robot, gravity)
+                out.append(JointCompliance("fit" if fitted else "masses"))
+                if fitted:
+                    why = "--gravity fit" if gravity == "fit" else "the model has no link masses"
+                    notes.append(f"{kind.name} on joints {', '.join(map(str, joints))}: the gravity torques' mass "
+                                 f"moments fitted with it ({why})")
+            continue
+        if kind.name == "joint_map":  # the highest order: the engine chooses among its variants
+            out += [_core.Effect(kind.name, j, order=MAX_MAP_ORDER) for j in joints if (kind.name, j) not in have]
+        else:
+            out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
+    return out, notes
+
+
+def expand(effects: Sequence, robot: Robot) -> tuple[list, Optional[str]]:
+    """The core's effects of a model (JointCompliance as joint_compliance on every gravity-loaded
+    joint) and the gravity mode it needs (None: the options' own)."""
+    out: list = []
+    gravity = None
+    for e in effects:
+        if isinstance(e, JointCompliance):
+            gravity = e.gravity
+            out += [_core.Effect("joint_compliance", j)
+                    for j in applicable_joints(robot, _core.effect_kind("joint_compliance"))]
+        else:
+            out.append(e)
+    return out, gravity
+
+
+class Spec:
+    """The model under test: its effects (joint_compliance per joint, or JointCompliance) and the fit's
+    options (a FitOptions)."""
+
+    def __init__(self, robot: Robot, effects: Sequence = (), penalties: Sequence = (),
+                 fit: Optional[FitOptions] = None):
+        self.robot = robot
+        self.effects: list = list(effects)
+        self.penalties: list = list(penalties)  # (parameter name, weight): ridge penalties of the fit
+        self.fit_options = fit or FitOptions()
+
+    def with_(self, cand, penalties: Sequence = ()) -> "Spec":
+        return Spec(self.robot, self.effects + [cand], self.penalties + list(penalties), self.fit_options)
+
+    def penalties_of(self, effect) -> list:
+        """The penalties on an effect's parameters."""
+        names = {f"joint{effect.joint}.{n}" for n in getattr(effect, "parameter_names", ())}
+        return [p for p in self.penalties if p[0] in names]
+
+    def has(self, cand) -> bool:
+        return any(e.name == cand.name and e.joint == cand.joint for e in self.effects)
+
+    @property
+    def core_effects(self) -> list:
+        return expand(self.effects, self.robot)[0]
+
+    @property
+    def gravity(self) -> str:
+        return expand(self.effects, self.robot)[1] or self.fit_options.gravity
+
+    @property
+    def compliance(self) -> list:
+        return [e.joint for e in self.core_effects if e.name == "joint_compliance"]
+
+    def label(self) -> str:
+        return " + ".join(["geometry"] + [e.label for e in self.effects])
+
+    def fit(self, data: dict, covariance: bool = False) -> "_core.IdentifyResult":
+        eff, gravity = expand(self.effects, self.robot)
+        return self.fit_options.fit(self.robot, data, eff, covariance=covariance, penalties=self.penalties,
+                                    gravity=gravity)
+
+    def errors(self, res, data: dict) -> np.ndarray:
+        return point_errors(res, data)
+
+
+def _key(p) -> tuple:
+    return (p.kind, p.joint, p.target, p.name)
+
+
+def evaluate(res, data: dict, extra: Sequence) -> tuple:
+    """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
+    parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
+    parameter index of each of them that is the fit's, by index)."""
+    layout = res.layout
+    pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True)
+    new = pm.layout.parameters
+    old = {_key(p): p.index for p in layout.parameters}
+    # the fit's parameters by name, not by place: the calibrated model may carry one the fit's did not
+    # (a joint 1 whose identified tilt puts it under gravity gains a compliance, inserted before the
+    # targets); an extra effect may repeat one of the fit's (its names come again, after the fit's)
+    fit_of: dict = {}
+    taken: set = set()
+    for p in new:
+        k = old.get(_key(p))
+        if k is not None and k not in taken:
+            fit_of[p.index] = k
+            taken.add(k)
+    x = np.zeros(len(new))
+    fit_x = np.asarray(res.x)
+    for p in new:
+        # geometry, tool and base are corrections to the calibrated model (zero); compliances,
+        # targets and effect values are absolute
+        if p.kind not in ("joint_geometry", "tool", "base") and p.index in fit_of:
+            x[p.index] = fit_x[fit_of[p.index]]
+    r, J = pm.residuals(list(x), data, True)
+    J = np.asarray(J)
+    fixed = np.asarray(res.fixed)
+    cur = J[:, [i for i, k in fit_of.items() if not fixed[k]]]
+    return np.asarray(r), cur, J, new, fit_of
+
+
+def fitted_compliance_columns(res, data: dict, spec: "Spec") -> np.ndarray:
+    """The columns of JointCompliance("fit") for a model fitted without compliance (``res``, the model
+    ``spec``): the model with it is fitted (its torques' mass moments with it), and its compliance
+    columns are taken at that fit: each joint's deflection under the torques of the fitted moments.
+    The deflection is bilinear in the compliances and the moments, so at the fit it lies in the span
+    of these columns (the linearisation at zero moments sees no torque at all). Each column scaled to
+    unit norm. (The calibrated model of that fit carries the fitted moments as its masses.)"""
+    with_it = spec.with_(JointCompliance("fit")).fit(data)
+    _, _, J, new, _ = evaluate(with_it, data, [])
+    idx = [p.index for p in new if p.kind == "compliance"]
+    R = J[:, idx]
+    n = np.linalg.norm(R, axis=0)
+    return R[:, n > 0] / n[n > 0]
+
+
+class _Linearised:
+    """The model fitted on every point, linearised for the candidates: the residual r (dims n), the
+    current model's free columns and each candidate's columns at the fit, from one evaluation of the
+    identification Jacobian with every candidate's parameters appended (made on the first call); the
+    residual as the pseudo-residual of the fit's robust loss (robust_weights). ``step(cand)``: the
+    linearisation after a step taken without a refit."""
+
+    def __init__(self, res, data: dict, candidates: Sequence, robot: Robot, dims: int, fit: FitOptions,
+                 spec: Optional["Spec"] = None):
+        self.res, self.data, self.robot, self.dims, self.fit, self.spec = res, data, robot, dims, fit, spec
+        have = {(e.name, e.joint) for e in res.layout.effect_list}
+        self.extra = [c for c in candidates if c.name != "joint_compliance" and (c.name, c.joint) not in have]
+        self.cols: Optional[dict] = None
+        self.added: list = []  # the columns of the steps taken since the fit (unweighted)
+        self.r_now: Optional[np.ndarray] = None  # the residual after them (unweighted; None: the fit's)
+        self.scale: Optional[float] = None  # where the candidates' scores bend (from the residual's spread)
+        self.w: Optional[np.ndarray] = None
+        self._stacked: Optional[tuple] = None  # (the fit's columns, them with the added ones)
+
+    def raw(self, cand) -> tuple:
+        """The unweighted residual, current columns and candidate columns at the fit."""
+        if self.cols is None:
+            self.r, self.cur, self.J, self.new, self.fit_of = evaluate(self.res, self.data, self.extra)
+            self.cols = {}
+        key = (cand.name, cand.joint, tuple(cand.harmonics), getattr(cand, "gravity", ""))
+        if key not in self.cols:
+            if isinstance(cand, JointCompliance) and cand.gravity == "fit":
+                spec = self.spec or Spec(self.robot, list(self.res.layout.effect_list), fit=self.fit)
+                self.cols[key] = (self.r, self.cur, fitted_compliance_columns(self.res, self.data, spec))
+                return self.cols[key]
+            if cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
+                r, cur, J, new, fit_of = evaluate(self.res, self.data, [cand])  # not among the round's candidates
+            else:
+                r, cur, J, new, fit_of = self.r, self.cur, self.J, self.new, self.fit_of
+            kind = "compliance" if cand.name == "joint_compliance" else cand.name
+            idx = [p.index for p in new if p.kind == kind and (p.joint == cand.joint or isinstance(cand, JointCompliance))
+                   and (kind == "compliance" or (p.index not in fit_of and p.effect == cand))]
+            self.cols[key] = (r, cur, J[:, idx])
+        return self.cols[key]
+
+    def __call__(self, cand) -> tuple:
+        r, cur, R = self.raw(cand)
+        if self.r_now is not None:
+            r = self.r_now
+        if self.added:  # one array per linearisation: the search's basis of it is made once
+            if self._stacked is None or self._stacked[0] is not cur:
+                self._stacked = (cur, np.hstack([cur] + self.added))
+            cur = self._stacked[1]
+        if self.w is None:
+            self.w = self._weights(r, cur.shape[1])
+        return r * self.w, cur, R
+
+    def _weights(self, r: np.ndarray, p: int) -> np.ndarray:
+        """The pseudo-residuals' weights of the residual r (p parameters fitted): the fit's loss, bending
+        where the residual's own robust spread puts it (4.03 x; the fit's own bend, e.g. a fixed
+        0.1 mm, would clip the very structure a candidate is to explain when the model lacks it)."""
+        if self.scale is None:
+            self.scale = loss_threshold(robust_noise(r, self.dims, p), self.dims)
+        return robust_weights(r, self.dims, self.fit.loss, self.scale)
+
+    def step(self, cand) -> "_Linearised":
+        """The linearisation after ``cand`` was added without a refit: its columns join the model's,
+        the residual is what their joint fit leaves (one reweighted Gauss-Newton step of the robust
+        fit), and the robust loss's scale (when it comes from the data) and weights follow
+        that residual, as the refit's would."""
+        r, cur, R = self.raw(cand)
+        r = r if self.r_now is None else self.r_now
+        A = np.hstack([cur] + self.added + [R])
+        w = self.w if self.w is not None else self._weights(r, cur.shape[1] + sum(a.shape[1] for a in self.added))
+        sw = np.sqrt(w)  # iteratively reweighted least squares: the robust cost's Gauss-Newton step
+        delta, *_ = np.linalg.lstsq(A * sw[:, None], r * sw, rcond=None)
+        out = _Linearised.__new__(_Linearised)
+        out.__dict__.update(self.__dict__)
+        out.added = self.added + [R]
+        out._stacked = None
+        out.r_now = r - A @ delta
+        out.scale = None  # from the new residual's spread, as the refit's would be
+        out.w = None
+        return out
+
+
+class SerialProblem:
+    """The search problem of a serial robot (stepwise.Problem): its measurements, folds of poses
+    and the fitting options of every fit; ``fits``: every linearisation's fit, in order. ``dims``:
+    residual coordinates per row (3; 6 with measured orientations)."""
+
+    def __init__(self, robot: Robot, data: dict, folds: list, fit: FitOptions, candidates: Sequence = ()):
+        self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit
+        self.candidates = list(candidates)
+        self.penalty: dict = {}  # (name, joint, order) -> the penalties of the variant chosen
+        self.fits: list = []
+        self.dims = 6 if "abc" in data else 3
+        self.point_dims = 3
+        #: a residual below this (mm per coordinate) is the computation's, not the data's: noise-free data
+        self.resolution = 1e-6
+
+    def spec(self, effects: Sequence) -> Spec:
+        pen = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]
+        return Spec(self.robot, effects, pen, self.fit_options)
+
+    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+        spec = self.spec(effects)
+        res = spec.fit(subset(self.data, ~held))
+        return spec.errors(res, subset(self.data, held))
+
+    def linearise(self, effects: list) -> engine.Linearisation:
+        spec = self.spec(effects)
+        res = spec.fit(self.data)
+        self.fits.append((list(effects), res))
+        return _Linearised(res, self.data, self.candidates, self.robot, self.dims, self.fit_options, spec)
+
+    def variants(self, cand, R: np.ndarray) -> Optional[list]:
+        """joint_map's orders 1..K (its columns R: sine and cosine of each order, in order), each with
+        each smoothness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights).
+        The library's transmission_error is fitted as it always was, without a penalty."""
+        if cand.name != "joint_map":
+            return None
+        s = float(np.mean(np.sum(R[:, :2] ** 2, axis=0)))
+        kw = np.repeat(np.asarray(cand.harmonics, dtype=float), 2)
+        return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * kw[:2 * k])
+                for k in range(1, cand.order + 1) for lam in MAP_SMOOTHING]
+
+    def variant_folds(self, cand) -> list:
+        """joint_map's order and smoothing are chosen holding out, in turn, each of VARIANT_BLOCKS
+        contiguous ranges of the joint's angle (equal numbers of points):
+        a map must predict angles it has not seen, as it will on the next campaign."""
+        q = np.asarray(self.data["q_deg"], dtype=float)[:, cand.joint - 1]
+        edges = np.quantile(q, np.linspace(0.0, 1.0, VARIANT_BLOCKS + 1))
+        block = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, VARIANT_BLOCKS - 1)
+        return [block == b for b in range(VARIANT_BLOCKS)]
+
+    def size(self, effect) -> int:
+        """How many parameters an effect adds (none of them with a prior by default)."""
+        if isinstance(effect, JointCompliance):
+            layout = _core.PointModel(self.robot, 1, fit_gravity=effect.gravity == "fit").layout
+            return sum(p.kind in ("compliance", "gravity_moment") for p in layout.parameters)
+        return int(effect.size)
+
+    def admits(self, effects: Sequence, cand) -> bool:
+        """Whether the model with ``cand`` added keeps no more parameters without a prior than the data
+        have points (the core refuses such a fit): the starting fit's and every added effect's."""
+        if not self.fits:
+            return True
+        start_effects, res = self.fits[0]
+        free = np.asarray(res.fixed) == 0
+        unconstrained = int(np.sum(free & ~np.isfinite(np.asarray(res.prior_sd))))
+        added = sum(self.size(e) for e in list(effects)[len(start_effects):]) + self.size(cand)
+        return unconstrained + added < len(self.data["pose"])
+
+    def score_folds(self, cand) -> Optional[list]:
+        """The folds on which a candidate must also gain (besides the configurations'): for a periodic
+        error of a joint angle (transmission_error, joint_map), holding out in turn each of
+        VARIANT_BLOCKS ranges of that angle. Such an effect must predict angles it has not seen, as on
+        the next campaign: a sinusoid fitted over part of a turn that only mimics another effect there
+        (the gravity's) is not kept for the turn."""
+        return self.variant_folds(cand) if cand.name in PERIODIC else None
+
+    def variant_evidence(self, cand, i: int, gains: Sequence[float]) -> dict:
+        """A joint_map step's evidence: the order and smoothing chosen, and the best gain of each order
+        1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
+        g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
+        out: dict = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
+        if cand.name == "joint_map":
+            out["order"] = cand.order
+            out["order_range_cv_gain"] = [round(float(x), 6) for x in g.max(axis=1)]
+        return out
+
+    def chosen(self, cand, ridge: np.ndarray) -> None:
+        """The variant chosen for a candidate: its fits carry that penalty (weights in mm per rad)."""
+        names = [f"joint{cand.joint}.{n}" for n in cand.parameter_names]
+        self.penalty[(cand.name, cand.joint, cand.order)] = [(n, float(w)) for n, w in zip(names, ridge)]
+
+    def covered(self, cand, candidates: Sequence) -> bool:
+        """A joint_map of order 1 or 2 is the library's transmission_error (orders 1, 2) where that is a
+        candidate on the same joint: the library's name is kept."""
+        return cand.name == "joint_map" and cand.order <= 2 and any(
+            c.name == "transmission_error" and c.joint == cand.joint and set(range(1, cand.order + 1)) <= set(c.harmonics)
+            for c in candidates)
+
+    def describe(self, effect) -> dict:
+        d: dict = {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
+        if effect.name == "joint_map":
+            d["order"] = effect.order
+        if isinstance(effect, JointCompliance):
+            d["gravity"] = effect.gravity
+        return d
+
+    def label(self, effect) -> str:
+        return effect.label
+
+    def model_label(self, effects: list) -> str:
+        return self.spec(effects).label()
+
+
+@dataclass
+class Choice:
+    """What a choice of effects found on one data set: the effects (the starting ones and those
+    kept), the search (stepwise.Search), the candidates and the notes on those skipped, and the model
+    with the effects fitted on that data set (``fit``, an IdentifyResult; ``spec``: its Spec)."""
+    effects: list
+    search: engine.Search
+    candidates: list
+    notes: list
+    spec: Spec
+    fit: Any
+    problem: Optional[SerialProblem] = field(repr=False, default=None)
+
+
+def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k_folds: int = 5, seed: int = 0,
+           max_steps: int = 6, say: Callable[[str], None] = lambda s: None, fit_chosen: bool = True) -> Choice:
+    """`--effects auto` on one data set: the stepwise search over the candidates from the
+    ``start`` effects (the significance rule of the diagnosis: ALPHA, MIN_GAIN, on ``k_folds`` folds
+    of whole configurations), the starting model fitted once and each step's effect added to its
+    linearisation (stepwise.search's refit=False); then, with ``fit_chosen``, the model chosen
+    fitted on the data (``fit``; else None when a step was taken)."""
+    cands, notes = candidates(robot, data, start, fit.gravity)
+    problem = SerialProblem(robot, data, grouped_folds(data, k_folds, seed), fit, cands)
+    if not problem.folds:
+        spec = problem.spec(list(start))
+        return Choice(list(start), engine.Search(list(start), [], [], None, []), cands,
+                      notes + ["too few configurations to choose effects: the starting model kept"], spec,
+                      spec.fit(data), problem)
+    found = engine.search(problem, start, cands, alpha=ALPHA, min_gain=MIN_GAIN, max_steps=max_steps, say=say,
+                          confirm=False, listed=len(cands), refit=False)
+    spec = problem.spec(found.effects)
+    if found.linearised is not None:
+        res = found.linearised.res
+    else:
+        res = spec.fit(data) if fit_chosen else None
+    return Choice(found.effects, found, cands, notes, spec, res, problem)
+
+
+def start_fit(choice: Choice):
+    """The starting model fitted on the choice's data (the first linearisation's fit)."""
+    return choice.problem.fits[0][1] if choice.problem and choice.problem.fits else choice.fit
+
+
+def check_data(effects: Sequence, data: dict, robot: Robot) -> None:
+    """The data columns the effects read (the registry's ``needs``) are present: a clear error names
+    the file and the column otherwise."""
+    src = data.get("source", "<data>")
+    for e in effects:
+        need = _core.effect_kind(e.name).needs
+        if need == "dir" and "dir" not in data:
+            raise ValueError(f"{src}: {e.label} needs the dir1..dir{robot.dof} columns (the sign of each joint's "
+                             "last motion into the pose)")
+        if need == "temperature_c" and "temperature_c" not in data:
+            raise ValueError(f"{src}: {e.label} needs the temperature_c column")
+        if need == "time_s" and "time_s" not in data:
+            raise ValueError(f"{src}: {e.label} needs the time_s column (when each point was measured, s)")

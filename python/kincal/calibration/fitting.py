@@ -1,0 +1,151 @@
+"""The fitting options shared by every fit of a serial robot: `kincal identify`, `kincal diagnose`
+(and the effect choice of `identify --effects auto`, which is the diagnosis's first steps) fit with
+the same priors, robust loss, gravity, orientation weight and iteration cap, and the same defaults.
+
+One default each, measured on the real data the project has (BENCHMARKS.md, "One fitting engine"):
+- priors on the joint geometry (1 mm, 0.1 deg) and the tool (5 mm, 1 deg) at their overall width 1
+  (priors.DEFAULT_PRIOR_SD): what the data cannot determine stays at its prior and is listed, never a
+  refusal;
+- the robust loss (Huber) bends where the residuals' robust spread puts it (4.03 x the noise;
+  ``loss_scale_mm`` None): a fixed 0.1 mm predicted the UR10 series a little better from B, but bends
+  below the structure a model still lacks (a fit that misses an effect becomes an L1 fit, distorted,
+  slow to converge, and the diagnosis then misnames the effect), BENCHMARKS.md "One fitting engine";
+- ``gravity`` "auto": the model's link masses when it has any, else the mass moments fitted.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from .. import _core
+from ..stats import grouping
+from . import priors
+from .._core import Robot
+
+LOSSES = ("none", "huber", "cauchy")
+#: where the robust loss bends unless told (mm; None: from the residuals' robust spread; BENCHMARKS.md "One
+#: fitting engine")
+DEFAULT_LOSS_SCALE_MM: Optional[float] = None
+GRAVITY = ("auto", "masses", "fit")
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """How every fit of a campaign is made (the command line's fitting options).
+
+    ``loss_scale_mm``: where the robust loss bends (mm; None or 0: from the residuals' robust spread);
+    ``prior_sd``: prior standard deviations by kind in file units (None: priors.DEFAULT_PRIOR_SD, {}: no
+    priors); ``prior_scale``: times every prior sd (None: chosen by grouped cross-validation inside
+    each fit's own data); ``prior_model``: the priors' centre and the fits' start (default: the robot's
+    nominal model); ``gravity``: the compliances' gravity torques (auto, masses, fit)."""
+    loss: str = "huber"
+    loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM
+    prior_sd: Optional[dict] = None
+    prior_scale: Optional[float] = 1.0
+    prior_model: Optional[Robot] = None
+    gravity: str = "auto"
+    orientation_weight: float = 100.0
+    max_iterations: int = 100
+
+    def __post_init__(self):
+        if self.loss not in LOSSES:
+            raise ValueError(f"unknown loss '{self.loss}' ({', '.join(LOSSES)})")
+        if self.gravity not in GRAVITY:
+            raise ValueError(f"unknown gravity mode '{self.gravity}' ({', '.join(GRAVITY)})")
+        if self.loss_scale_mm is not None and not (self.loss_scale_mm >= 0 and math.isfinite(self.loss_scale_mm)):
+            raise ValueError(f"--loss-scale must be a finite number >= 0 (0: from the residuals), not "
+                             f"{self.loss_scale_mm}")
+        if self.max_iterations < 1:
+            raise ValueError(f"the iteration cap must be at least 1, not {self.max_iterations}")
+
+    def with_(self, **changes) -> "FitOptions":
+        return replace(self, **changes)
+
+    @property
+    def auto_prior_scale(self) -> bool:
+        return self.prior_scale is None
+
+    def core(self, effects: Sequence = (), *, covariance: bool = True, penalties: Sequence = (),
+             gravity: Optional[str] = None) -> "_core.IdentifyOptions":
+        """The core's IdentifyOptions for a model with ``effects`` (``gravity`` overrides the mode)."""
+        return options(effects, loss=self.loss, loss_scale_mm=self.loss_scale_mm or 0.0, covariance=covariance,
+                       orientation_weight=self.orientation_weight, max_iterations=self.max_iterations,
+                       penalties=penalties, prior_sd=self.prior_sd,
+                       prior_scale=1.0 if self.prior_scale is None else float(self.prior_scale),
+                       gravity=gravity or self.gravity)
+
+    def fitter(self, robot: Robot, seed: int = 0) -> priors.Fitter:
+        """The fit of a data set from the starting model (priors centred there; their width chosen per
+        fit by grouped cross-validation when ``prior_scale`` is None)."""
+        return priors.Fitter(robot, self.prior_model, auto_scale=self.auto_prior_scale, seed=seed)
+
+    def fit(self, robot: Robot, data: dict, effects: Sequence = (), *, covariance: bool = False,
+            penalties: Sequence = (), gravity: Optional[str] = None, seed: int = 0,
+            progress: Optional[Callable[[int, float], None]] = None) -> "_core.IdentifyResult":
+        """One fit of ``data`` with these options."""
+        return self.fitter(robot, seed)(data, self.core(effects, covariance=covariance, penalties=penalties,
+                                                         gravity=gravity), progress)
+
+
+def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
+            orientation_weight: float = 100.0, max_iterations: int = 100,
+            fix: Sequence[str] = (), penalties: Sequence = (), prior_sd: Optional[dict] = None,
+            prior_scale: float = 0.0, gravity: str = "auto") -> "_core.IdentifyOptions":
+    """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
+    joints on; without any, the compliances stay at their start value). ``penalties``: ridge
+    penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
+    joint_map smoothness penalty. ``prior_sd`` (kinds in file units, priors.DEFAULT_PRIOR_SD) times
+    ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals."""
+    effects = list(effects)
+    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss, gravity=gravity,
+                              loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
+                              effects=effects, covariance=covariance, orientation_weight=orientation_weight)
+    o.penalties = [(str(n), float(w)) for n, w in penalties]
+    o.prior_sd = priors.core_prior_sd(priors.DEFAULT_PRIOR_SD if prior_sd is None else prior_sd)
+    o.prior_scale = float(prior_scale) if prior_sd is None or prior_sd else 0.0
+    return o
+
+
+def subset(data: dict, mask: np.ndarray) -> dict:
+    """The rows ``mask`` of a measurement set (its other entries as they are)."""
+    return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()}
+
+
+def folds(data: dict, k: int, seed: int = 0) -> list:
+    """k masks of held-out rows, whole configurations per fold, as many as the configurations allow
+    (at least 2 configurations; none when fewer)."""
+    k = min(k, grouping.configurations(data).count)
+    return grouping.folds(data, k, seed) if k >= 2 else []
+
+
+def rms(e: np.ndarray) -> float:
+    """The root mean square of errors (of the 3-D distances, or of angles); NaN for none (undefined:
+    null in the files, strict_json)."""
+    return float(np.sqrt(np.mean(np.square(e)))) if len(e) else float("nan")
+
+
+def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
+    """Angle (deg) between the measured and the predicted tool orientation of every 6-D row (each
+    row seen from its setup's placement, the model's drift at its time)."""
+    return np.asarray(_core.orientation_errors(robot, data))
+
+
+def point_errors(res: "_core.IdentifyResult", data: dict) -> np.ndarray:
+    """3-D distance (mm) between each measured point and the fitted model's prediction."""
+    return np.asarray(_core.point_errors(res.robot, res.targets, data))
+
+
+def masses(robot: Robot) -> bool:
+    """Whether the robot's model has link masses (--gravity auto then uses them)."""
+    import json
+
+    return any(j["mass_kg"] > 0 for j in json.loads(robot.to_json())["nominal"]["joints"])
+
+
+def gravity_fitted(robot: Robot, gravity: str) -> bool:
+    """Whether the compliances' torques come from fitted mass moments (the core's rule)."""
+    return gravity == "fit" or (gravity == "auto" and not masses(robot))

@@ -1,0 +1,324 @@
+"""Planning a calibration campaign (`kincal plan`): the K robot configurations that determine the
+model's parameters best, inside the joint limits and the user's keep-out rules.
+
+Criterion: D-optimality. The identification Jacobian of every candidate configuration (the rows of
+its targets' points, at the nominal model) is computed in the C++ core; its columns are scaled to
+unit RMS over the candidates, and the parameters that no choice of candidates can determine (those
+the identifiability analysis of `kincal identify` fixes on the candidate pool, e.g. the tool frame
+beside the target offsets) are left out. A greedy search then adds, K times, the candidate that most
+increases log det of the information matrix M = sum J_i^T J_i (started at a small multiple of the
+identity: a faint prior that keeps the first steps well posed). The gain of candidate i is
+log det(I + J_i M^-1 J_i^T); with many candidates each step scores a random sample of them
+(stochastic greedy, see greedy_d_optimal): 100,000 candidates to 60 poses in seconds.
+
+Reported for the plan, on the unscaled parameters: the predicted standard deviation of each
+parameter (noise sigma per coordinate, covariance sigma^2 (J^T J)^-1), the predicted RMS uncertainty
+of a measured point at the candidates (the TCP uncertainty: what a held-out configuration's error
+will be, noise aside), and the observability indices of the literature: O1 = (s_1 ... s_m)^(1/m) /
+sqrt(n) over the singular values of the scaled Jacobian of the plan (n its rows), its condition
+number and its smallest singular value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from .. import _core
+from . import identify as ident
+from .._core import Robot
+
+
+@dataclass
+class KeepOut:
+    """Rules a candidate configuration must satisfy besides the joint limits.
+
+    ``min_sigma``: the smallest singular value of the tool's Jacobian (angular rows times the
+    robot's reach, so both are in mm per rad) at least this share of the largest (0..1): away from
+    singularities. ``box``: xmin, xmax, ymin, ymax, zmin, zmax (mm, base frame) the TCP stays in.
+    ``instrument``: the instrument's position (mm, base frame); then every target must be within
+    ``max_range`` (mm) of it and seen at most ``max_incidence_deg`` off the tool's z axis (the
+    reflector's normal)."""
+    min_sigma: float = 0.0
+    box: Optional[Sequence[float]] = None
+    instrument: Optional[Sequence[float]] = None
+    max_range: float = math.inf
+    max_incidence_deg: float = 180.0
+
+
+@dataclass
+class Plan:
+    """The chosen configurations (in path order) and what they promise."""
+    q_deg: np.ndarray
+    parameters: list                  #: names of the parameters the plan determines
+    stddev: np.ndarray                #: predicted standard deviation of each (its unit in ``units``)
+    units: list
+    left_out: list                    #: (name, reason) of the parameters no candidate determines
+    tcp_uncertainty_mm: float         #: predicted RMS error of a point predicted at the candidates
+    o1: float
+    condition_number: float
+    min_singular_value: float
+    candidates: int                   #: candidates after the keep-out rules
+    rejected: dict = field(default_factory=dict)  #: rule -> candidates it removed
+
+    def summary(self, noise_mm: float) -> str:
+        lines = [f"{len(self.q_deg)} configurations chosen from {self.candidates} candidates (D-optimal)"]
+        for rule, n in self.rejected.items():
+            lines.append(f"  {n} candidates removed: {rule}")
+        lines.append(f"observability: O1 {self.o1:.4g}, condition number {self.condition_number:.4g}, "
+                     f"smallest singular value {self.min_singular_value:.4g}")
+        lines.append(f"predicted TCP uncertainty (RMS over the candidates, noise {noise_mm:g} mm per "
+                     f"coordinate): {self.tcp_uncertainty_mm:.4f} mm")
+        if self.left_out:
+            lines.append("not determined by any candidate (held at the starting model):")
+            lines += [f"  {n:<22} {why}" for n, why in self.left_out]
+        lines.append("predicted standard deviation of each parameter:")
+        lines += [f"  {n:<22} {s:.3g} {u}" for n, s, u in zip(self.parameters, self.stddev, self.units)]
+        return "\n".join(lines)
+
+
+def random_candidates(robot: Robot, n: int, seed: int = 0) -> np.ndarray:
+    """n configurations drawn uniformly inside the joint limits (deg)."""
+    lim = np.asarray(robot.limits_deg, dtype=float)
+    return np.random.default_rng(seed).uniform(lim[:, 0], lim[:, 1], size=(n, robot.dof))
+
+
+def _tool_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """(n, 4, 4) tool frames (mm) in the base frame at the nominal model (R = Rz(a) Ry(b) Rx(c))."""
+    pose = np.asarray(_core.fk(robot, q, False, False)).reshape(-1, 6)
+    a, b, c = np.radians(pose[:, 3]), np.radians(pose[:, 4]), np.radians(pose[:, 5])
+    ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
+    f = np.zeros((len(pose), 4, 4))
+    f[:, 0, 0], f[:, 0, 1], f[:, 0, 2] = ca * cb, ca * sb * sc - sa * cc, ca * sb * cc + sa * sc
+    f[:, 1, 0], f[:, 1, 1], f[:, 1, 2] = sa * cb, sa * sb * sc + ca * cc, sa * sb * cc - ca * sc
+    f[:, 2, 0], f[:, 2, 1], f[:, 2, 2] = -sb, cb * sc, cb * cc
+    f[:, :3, 3] = pose[:, :3]
+    f[:, 3, 3] = 1.0
+    return f
+
+
+def keep_out(robot: Robot, q: np.ndarray, targets: np.ndarray, rules: KeepOut) -> tuple[np.ndarray, dict]:
+    """Boolean mask of the candidates inside the joint limits and every rule, and how many each
+    rule removed."""
+    lim = np.asarray(robot.limits_deg, dtype=float)
+    ok = np.all((q >= lim[:, 0]) & (q <= lim[:, 1]), axis=1)
+    rejected = {"outside the joint limits": int(np.sum(~ok))}
+    frames = _tool_frames(robot, q)
+    if rules.min_sigma > 0:
+        reach = float(np.max(np.linalg.norm(frames[:, :3, 3], axis=1)))
+        J = np.array([_core.jacobian(robot, qi, False) for qi in q])  # (n, 6, dof): linear, then angular rows
+        J = np.concatenate([J[:, :3], J[:, 3:] * reach], axis=1)
+        s = np.linalg.svd(J, compute_uv=False)
+        bad = s[:, -1] < rules.min_sigma * s[:, 0]
+        rejected[f"near a singularity (smallest/largest singular value below {rules.min_sigma:g})"] = int(np.sum(bad & ok))
+        ok &= ~bad
+    if rules.box is not None:
+        b = np.asarray(rules.box, dtype=float).reshape(3, 2)
+        p = frames[:, :3, 3]
+        bad = np.any((p < b[:, 0]) | (p > b[:, 1]), axis=1)
+        rejected["TCP outside the workspace box"] = int(np.sum(bad & ok))
+        ok &= ~bad
+    if rules.instrument is not None:
+        inst = np.asarray(rules.instrument, dtype=float)
+        pts = frames[:, None, :3, :3] @ targets[None, :, :, None]
+        pts = pts[..., 0] + frames[:, None, :3, 3]                      # (n, targets, 3)
+        d = inst[None, None, :] - pts
+        dist = np.linalg.norm(d, axis=2)
+        normal = frames[:, None, :3, 2]
+        cos = np.sum(d * normal, axis=2) / np.maximum(dist, 1e-9)
+        bad = np.any(dist > rules.max_range, axis=1)
+        rejected[f"a target beyond the instrument's range ({rules.max_range:g} mm)"] = int(np.sum(bad & ok))
+        ok &= ~bad
+        bad = np.any(cos < math.cos(math.radians(rules.max_incidence_deg)), axis=1)
+        rejected[f"a target seen more than {rules.max_incidence_deg:g} deg off its normal"] = int(np.sum(bad & ok))
+        ok &= ~bad
+    return ok, {k: v for k, v in rejected.items() if v}
+
+
+def _campaign(robot: Robot, q: np.ndarray, targets: np.ndarray) -> dict:
+    """A noise-free campaign at the nominal model (the instrument at the base), for the Jacobian."""
+    n, t = len(q), len(targets)
+    frames = _tool_frames(robot, q)
+    pts = (frames[:, None, :3, :3] @ targets[None, :, :, None])[..., 0] + frames[:, None, :3, 3]
+    rows = n * t
+    return {"pose": np.repeat(np.arange(n, dtype=np.int32), t), "q_deg": np.repeat(q, t, axis=0),
+            "xyz": pts.reshape(rows, 3), "target": np.tile(np.arange(t, dtype=np.int32), n),
+            "payload_kg": np.full(rows, np.nan), "line": np.zeros(rows, dtype=np.int32), "source": "<plan>"}
+
+
+def _jacobian(robot: Robot, q: np.ndarray, targets: np.ndarray, effects: list) -> tuple[np.ndarray, list]:
+    """The identification Jacobian (rows: pose-major, target, coordinate) at the nominal model with
+    the targets at their offsets, and its parameters."""
+    data = _campaign(robot, q, targets)
+    pm = _core.PointModel(robot, len(targets), [e for e in effects if e.name != "joint_compliance"])
+    params = list(pm.layout.parameters)
+    x = np.asarray(pm.start(data), dtype=float)
+    for p in params:
+        if p.kind == "target":          # target<k>.x, .y, .z: absolute offsets on the tool
+            x[p.index] = targets[p.target]["xyz".index(p.name[-1])]
+    _, J = pm.residuals(list(x), data, True)
+    return np.asarray(J), params
+
+
+def _free_columns(robot: Robot, q: np.ndarray, targets: np.ndarray, effects: list, params: list,
+                  seed: int) -> tuple[np.ndarray, list]:
+    """The columns no candidate set can leave undetermined: identify's identifiability analysis on
+    (up to 2,000 of) the candidates; the others with identify's reason."""
+    rng = np.random.default_rng(seed)
+    sub = q[rng.choice(len(q), size=min(len(q), 2000), replace=False)]
+    data = _campaign(robot, sub, targets)
+    res = _core.identify(robot, data, ident.options(effects, loss="none", max_iterations=0, covariance=False))
+    fixed = np.asarray(res.fixed)
+    compliance = any(e.name == "joint_compliance" for e in effects)
+    free, left = [], []
+    for p, fx, why in zip(res.layout.parameters, fixed, res.fixed_reason):
+        if p.kind == "compliance" and not compliance:
+            continue
+        if fx:
+            left.append((p.name, why))
+        else:
+            free.append(p.index)
+    return np.asarray(free, dtype=int), left
+
+
+def greedy_d_optimal(J: np.ndarray, rows_per: int, k: int, ridge: float = 1e-3, epsilon: float = 0.01,
+                     seed: int = 0, progress: Optional[Callable[[int, int], None]] = None) -> list[int]:
+    """Indices of k candidates (J: candidates' rows in blocks of rows_per, columns scaled) chosen one
+    at a time for the largest gain log det(I + J_i M^-1 J_i^T), M = ridge I + the chosen J_i^T J_i.
+
+    Each step scores a random sample of the candidates left, of size (n / k) ln(1 / epsilon) but at
+    least 2,000 (all of them when fewer): the "stochastic greedy" of Mirzasoleiman et al. (AAAI 2015),
+    within 1 - 1/e - epsilon of the optimum in expectation for this submodular criterion, and the
+    plain greedy when the sample is every candidate. M^-1 follows each choice by the Woodbury
+    identity; a gain is log det of a small matrix from the rows times the Cholesky factor of M^-1."""
+    n, p = J.shape[0] // rows_per, J.shape[1]
+    Jb = J.reshape(n, rows_per, p)
+    Jb32 = Jb.astype(np.float32)   # for scoring only: the ranking needs no more digits
+    eye = np.eye(rows_per)
+    rng = np.random.default_rng(seed)
+    sample = min(n, max(2000, int(math.ceil(n / k * math.log(1.0 / epsilon)))))
+    Minv = np.eye(p) / ridge
+    left = np.ones(n, dtype=bool)
+    chosen: list[int] = []
+    for step in range(k):
+        if progress:
+            progress(step, k)
+        pool = np.flatnonzero(left)
+        idx = pool if len(pool) <= sample else np.sort(rng.choice(pool, size=sample, replace=False))
+        L = np.linalg.cholesky(Minv).astype(np.float32)
+        A = (Jb32[idx].reshape(-1, p) @ L).reshape(len(idx), rows_per, p)
+        C = np.linalg.cholesky(eye.astype(np.float32) + A @ np.transpose(A, (0, 2, 1)))
+        gain = 2.0 * np.sum(np.log(np.diagonal(C, axis1=1, axis2=2)), axis=1)
+        best = int(idx[int(np.argmax(gain))])
+        chosen.append(best)
+        left[best] = False
+        Jc = Jb[best]
+        U = Minv @ Jc.T                                    # Woodbury: M'^-1 = M^-1 - U (I + J U)^-1 U^T
+        Minv = Minv - U @ np.linalg.solve(eye + Jc @ U, U.T)
+        Minv = 0.5 * (Minv + Minv.T)
+    return chosen
+
+
+def path_order(q: np.ndarray) -> np.ndarray:
+    """An order of the configurations for a short robot path: nearest neighbour in joint space,
+    starting from the one nearest to the middle of the set."""
+    left = list(range(len(q)))
+    cur = int(np.argmin(np.linalg.norm(q - q.mean(axis=0), axis=1)))
+    order = [cur]
+    left.remove(cur)
+    while left:
+        d = np.linalg.norm(q[left] - q[cur], axis=1)
+        cur = left.pop(int(np.argmin(d)))
+        order.append(cur)
+    return np.asarray(order)
+
+
+def plan(robot: Robot, k: int, *, targets: np.ndarray, effects: Sequence = ("joint_compliance",),
+         candidates: Optional[np.ndarray] = None, n_candidates: int = 5000, rules: KeepOut = KeepOut(),
+         noise_mm: float = 0.02, seed: int = 0,
+         progress: Optional[Callable[[int, int], None]] = None) -> Plan:
+    """The K configurations of a campaign (see the module's text). ``targets``: the reflectors'
+    offsets on the tool (mm, one row each); ``candidates``: the configurations to choose from (deg),
+    or ``n_candidates`` random ones inside the joint limits."""
+    targets = np.asarray(targets, dtype=float).reshape(-1, 3)
+    effects = ident.check_effects(effects, robot)
+    if noise_mm <= 0 or not math.isfinite(noise_mm):
+        raise ValueError(f"--noise must be a positive number of mm, not {noise_mm}")
+    q = random_candidates(robot, n_candidates, seed) if candidates is None else np.asarray(candidates, dtype=float)
+    if q.ndim != 2 or q.shape[1] != robot.dof:
+        raise ValueError(f"the candidates need {robot.dof} joint angles each")
+    ok, rejected = keep_out(robot, q, targets, rules)
+    q = q[ok]
+    if k < 1:
+        raise ValueError(f"--poses must be at least 1, not {k}")
+    if len(q) < k:
+        raise ValueError(f"only {len(q)} candidates satisfy the joint limits and the keep-out rules, fewer than "
+                         f"the {k} poses asked for (" + "; ".join(f"{v} {r}" for r, v in rejected.items()) + ")")
+    J, params = _jacobian(robot, q, targets, list(effects))
+    free, left = _free_columns(robot, q, targets, list(effects), params, seed)
+    J = J[:, free]
+    # columns scaled to unit RMS per candidate: a candidate's rows are O(1), the ridge a faint prior
+    scale = np.linalg.norm(J, axis=0) / math.sqrt(len(q))
+    if np.any(scale == 0):
+        raise ValueError("a parameter has no effect on any candidate")
+    rows_per = 3 * len(targets)
+    chosen = greedy_d_optimal(J / scale, rows_per, k, seed=seed, progress=progress)
+    chosen = np.asarray(chosen)[path_order(q[chosen])]
+    rows = (chosen[:, None] * rows_per + np.arange(rows_per)[None, :]).ravel()
+    Jp = J[rows]
+    s = np.linalg.svd(Jp / scale, compute_uv=False)
+    info = Jp.T @ Jp
+    cov = noise_mm ** 2 * np.linalg.pinv(info)
+    # predicted error of a point at the candidates (up to 20,000 of them): the rows' variance, as the
+    # RMS of the point's error
+    some = np.random.default_rng(seed + 1).choice(len(q), size=min(len(q), 20000), replace=False)
+    Js = J[(some[:, None] * rows_per + np.arange(rows_per)[None, :]).ravel()]
+    var_rows = np.sum((Js @ cov) * Js, axis=1)
+    tcp = math.sqrt(float(np.sum(var_rows)) / (len(var_rows) / 3))
+    m = len(s)
+    o1 = float(np.exp(np.mean(np.log(np.maximum(s, 1e-300))))) / math.sqrt(Jp.shape[0])
+    free_params = [params[i] for i in free]
+    return Plan(q_deg=q[chosen], parameters=[p.name for p in free_params], stddev=np.sqrt(np.diag(cov)),
+                units=[p.unit for p in free_params], left_out=left, tcp_uncertainty_mm=tcp, o1=o1,
+                condition_number=float(s[0] / s[-1]) if m and s[-1] > 0 else math.inf,
+                min_singular_value=float(s[-1]) if m else 0.0, candidates=int(len(q)), rejected=rejected)
+
+
+def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
+    """Choose ``poses`` of the candidate campaign's poses that maximise observability: greedy
+    D-optimal design on the nominal model's identification Jacobian (unit-scaled columns of the
+    parameters a generic campaign identifies), each step adding the pose that most increases
+    log det of the information matrix. Returns the chosen rows."""
+    n_targets = int(np.max(candidates["target"])) + 1
+    res = _core.identify(robot, candidates, _core.IdentifyOptions(compliance=compliance, loss="none", max_iterations=0,
+                                                                  covariance=False))
+    free = ~np.asarray(res.fixed)
+    pm = _core.PointModel(robot, n_targets)
+    _, J = pm.residuals(list(res.x), candidates, True)
+    J = np.asarray(J)[:, free]
+    J = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
+    ids = np.unique(candidates["pose"])
+    if poses >= len(ids):
+        return candidates
+    rows_of = {int(i): np.repeat(np.flatnonzero(candidates["pose"] == i) * 3, 3) + np.tile([0, 1, 2],
+               int(np.sum(candidates["pose"] == i))) for i in ids}
+    p = J.shape[1]
+    info = 1e-6 * np.eye(p)
+    chosen: list[int] = []
+    left = [int(i) for i in ids]
+    for _ in range(poses):
+        inv = np.linalg.inv(info)
+        best, gain = left[0], -np.inf
+        for i in left:
+            Ji = J[rows_of[i]]
+            # log det(I + Ji inv Ji^T): the information this pose adds
+            g = np.linalg.slogdet(np.eye(len(Ji)) + Ji @ inv @ Ji.T)[1]
+            if g > gain:
+                best, gain = i, g
+        chosen.append(best)
+        left.remove(best)
+        info += J[rows_of[best]].T @ J[rows_of[best]]
+    return ident.subset(candidates, np.isin(candidates["pose"], chosen))

@@ -1,0 +1,75 @@
+"""The tool frame (TCP) placed from known target offsets after an identification, and what a model
+records of where its TCP comes from (the model file's top-level "tcp": "measured" by 6-D rows,
+"tool-targets", or "nominal" when reflectors alone could not place it)."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+from .. import _core
+from ..io import strict_json
+from .._core import Robot
+
+
+def tool_from_targets(robot: Robot, targets: np.ndarray, known: np.ndarray) -> Robot:
+    """Reflectors alone cannot tell where the TCP is: the tool frame is redundant with the target
+    offsets and stays nominal in the fit. Given the targets' offsets in the tool frame as designed
+    or measured on a CMM (``known``, one row per target, mm), the tool frame of an identified
+    ``robot`` whose fit placed the targets at ``targets`` is moved so that they sit where they should:
+    a rigid fit (Horn) for three or more targets, a translation for one or two. Returns the robot with
+    the moved tool (with ``known`` as its targets, the predicted reflector points do not change)."""
+    known = np.asarray(known, dtype=float).reshape(-1, 3)
+    ident_t = np.asarray(targets, dtype=float)
+    if len(known) != len(ident_t):
+        raise ValueError(f"{len(known)} known target offsets for {len(ident_t)} identified targets")
+    # identified t_k (tool frame M) = T known_k: then M' = M T puts known_k at the same points
+    if len(known) >= 3 and np.linalg.matrix_rank(known - known.mean(axis=0), tol=1e-6) >= 2:
+        ca, cb = known.mean(axis=0), ident_t.mean(axis=0)
+        h = (known - ca).T @ (ident_t - cb)
+        u, _, vt = np.linalg.svd(h)
+        d = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
+        r = vt.T @ d @ u.T
+        t = cb - r @ ca
+    else:
+        r, t = np.eye(3), (ident_t - known).mean(axis=0)
+    doc = json.loads(robot.to_json())
+    tool = doc["calibrated"]["tool"]
+    m_r = _core.abc_to_rotation(np.asarray(tool["abc_deg"], dtype=float))
+    m_t = np.asarray(tool["xyz_mm"], dtype=float)
+    new_r, new_t = m_r @ r, m_t + m_r @ t
+    tool["xyz_mm"] = new_t.tolist()
+    tool["abc_deg"] = _abc_of(new_r)
+    doc["tcp"] = "tool-targets"
+    return Robot.from_json(strict_json.dumps(doc), "<identified>")
+
+
+def _abc_of(r: np.ndarray) -> list:
+    """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c) (the core's, exact at the pole)."""
+    return [float(v) for v in _core.rotation_to_abc(np.asarray(r, dtype=float))]
+
+
+#: the summary's line on the TCP, by the model's "tcp"
+_TCP_LINES = {
+    "measured": "TCP: measured (the frame the 6-D rows measure is the tool frame, identified with the rest)",
+    "tool-targets": "TCP: placed by --tool-targets (the targets' known offsets in the tool frame)",
+    "nominal": "TCP: nominal (reflectors only place themselves, not the tool frame; --tool-targets or a 6-D row "
+               "measures it)",
+}
+
+
+def tcp_summary_line(robot: Robot) -> list:
+    """The identification summary's line on where the TCP comes from (none when not recorded)."""
+    line = _TCP_LINES.get(robot.tcp)
+    return [line] if line else []
+
+
+def warn_nominal_tcp(robot: Robot, source: str, program: str = "kincal") -> None:
+    """One warning line on stderr for a model whose TCP is nominal (not measured); nothing otherwise
+    (the TCP measured or placed, or a model that does not record it: older files, built-in robots,
+    URDFs)."""
+    w = robot.tcp_warning(str(source))
+    if w:
+        print(f"{program}: warning: {w}", file=sys.stderr)

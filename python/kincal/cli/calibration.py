@@ -1,0 +1,183 @@
+"""`kincal simulate`, `identify`, `validate` and `diagnose`: simulated campaigns, identification, its
+check on new measurements and the diagnosis of what a model misses (kincal.calibration,
+kincal.diagnose). Parsing and calling only."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+from .. import _core, diagnose as diagnosis, fivebar, load_robot
+from ..calibration import identify as ident
+from ..io import strict_json
+from ..io.urdf import spec_urdf, urdf_left_out
+from .. import report
+from .options import (effect_opts, effects_arg, fit_options, fit_opts, harmonics_option, loss_opts, progress,
+                      robot_of, robot_opts, say, step_progress, tool_targets)
+
+
+def cmd_simulate(args) -> None:
+    robot = robot_of(args)
+    if args.truth:
+        truth = load_robot(args.truth)
+        if truth.dof != robot.dof:
+            raise ValueError(f"{args.truth}: {truth.dof} joints but {args.robot} has {robot.dof}")
+    else:
+        truth = ident.default_truth(robot, seed=args.seed)
+    pool = args.poses * (10 if args.select == "observability" else 1)
+    hidden = [ident.parse_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide]
+    data = ident.simulate(truth, pool, seed=args.seed, noise_mm=args.noise, targets=args.targets,
+                          outlier_fraction=args.outliers, outlier_mm=args.outlier_mm, effects=hidden,
+                          orientation_noise_deg=args.orientation_noise, duration_h=args.duration)
+    if args.truth_out and not args.truth:  # the truth as measured: its hidden effects too (not the
+        # instrument's drift, a property of the measurement that no robot model carries)
+        acting = [e for e in hidden if e[0].name != "drift"]
+        _core.write_file_atomic(args.truth_out, (truth.with_effects(acting, 20.0) if acting else truth).to_json())
+    if args.select == "observability":
+        from ..calibration import plan
+        data = plan.select_observable(robot, data, args.poses)
+    data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
+    _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
+    print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
+
+
+def cmd_identify(args) -> None:
+    robot = robot_of(args)
+    data = ident.read_measurements(args.data, robot)
+    effects = effects_arg(args, robot, data)
+    if args.holdout is not None and args.folds is not None:
+        raise ValueError("--holdout and --folds: give one (a split, or cross-validation)")
+    known = tool_targets(args.tool_targets, data, args.data)
+    fit = fit_options(args, robot)
+    res = ident.identify(robot, data, effects=effects, fit=fit, harmonics=args.harmonics,
+                         holdout=args.holdout, k_folds=5 if args.folds is None else args.folds, seed=args.seed,
+                         progress=progress("identify"),
+                         fold_progress=step_progress("cross-validation, fold"),
+                         hold_out_setups=args.hold_out_setups)
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    if known is not None:
+        res = ident.tool_from_targets(res, known)
+    text = res.model_json()
+    if args.urdf:
+        cal = json.loads(text)["calibrated"]
+        _core.write_file_atomic(args.urdf, spec_urdf(cal, cal.get("name", "calibrated").replace(" ", "_")))
+        left = urdf_left_out(cal)
+        if left:
+            print(f"kincal identify: {args.urdf}: URDF carries geometry only; left out: {', '.join(left)} "
+                  f"(in {args.out})", file=sys.stderr)
+    _core.write_file_atomic(args.out, text)
+    print(res.summary())
+
+
+def cmd_validate(args) -> None:
+    robot = load_robot(args.model)
+    data = ident.read_measurements(args.data, robot)
+    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
+    v["model"] = str(args.model)
+    _core.write_file_atomic(args.out, strict_json.dumps(v, indent=1, sort_keys=True) + "\n")
+    print(ident.validation_summary(v))
+
+
+def _diagnose_fivebar(args) -> None:
+    pts = fivebar.read_table(args.data)
+    report.check_folder(args.out)
+    diag = fivebar.diagnose(pts, folds=args.folds, seed=args.seed, noise_mm=args.noise, say=say)
+    fivebar.write_diagnosis(pts, diag, args.out, title=f"kincal diagnose: {Path(args.data).name} (five-bar hidden robot)")
+    print(fivebar.diagnosis_summary(diag))
+
+
+def cmd_diagnose(args) -> None:
+    if args.robot == "fivebar":
+        _diagnose_fivebar(args)
+        return
+    robot = robot_of(args)
+    data = ident.read_measurements(args.data, robot)
+    start = effects_arg(args, robot, data)
+    if start == "auto":
+        raise ValueError("--effects auto: the diagnosis chooses its effects itself; --effects gives the model it "
+                         "starts from (default: the geometry alone)")
+    known = tool_targets(args.tool_targets, data, args.data)
+    fit = fit_options(args, robot)
+    t0 = time.perf_counter()
+    diag, model = diagnosis.run(robot, data, args.out, title=f"kincal diagnose: {Path(args.data).name}",
+                                tool_targets=known, progress=say, folds=args.folds, seed=args.seed,
+                                noise_mm=args.noise, effects=start, fit=fit)
+    print(diagnosis.summary(diag, model, args.out, time.perf_counter() - t0))
+
+
+def add_commands(sub) -> None:
+    """simulate, identify and validate on the command line's subparsers ``sub``."""
+    sp = sub.add_parser("simulate", help="a simulated measurement campaign on a true model")
+    robot_opts(sp)
+    sp.add_argument("--truth", help="model JSON of the true robot (default: realistic errors drawn with --seed: "
+                                    "1 mm, 0.05 deg, joint compliance about 0.003 deg/kNm)")
+    sp.add_argument("--truth-out", help="write the drawn true model here (when --truth is not given)")
+    sp.add_argument("--poses", type=int, required=True, help="number of robot configurations")
+    sp.add_argument("--out", required=True, help="measurement CSV")
+    sp.add_argument("--targets", type=int, default=3, help="reflectors on the tool (1..4)")
+    sp.add_argument("--noise", type=float, default=0.02, help="instrument noise per coordinate (mm)")
+    sp.add_argument("--outliers", type=float, default=0.0, help="share of points with a gross error")
+    sp.add_argument("--outlier-mm", type=float, default=5.0, help="size of a gross error (mm)")
+    sp.add_argument("--orientation-noise", type=float, default=None, metavar="DEG",
+                    help="measure the tool frame's orientation too (a 6-D probe), with this noise (deg)")
+    sp.add_argument("--select", choices=["random", "observability"], default="random",
+                    help="poses drawn at random inside the limits, or the most observable of 10 times as many")
+    sp.add_argument("--hide", action="append", default=[], metavar="NAME:JOINT:VALUES",
+                    help="an effect in the truth: transmission_error:J:s1,c1,s2,c2 (deg; a sine and a cosine "
+                         "amplitude per order of --harmonics), joint_map:J:s1,c1,..,sK,cK (deg; orders 1..K), "
+                         "backlash:J:b (deg per direction sign), thermal_expansion:0:alpha (1/C, about 20 C), "
+                         "drift:0:vx,vy,vz,wx,wy,wz (the instrument's drift: mm/h and deg/h about the campaign's "
+                         "mean time; 3 h unless --duration); repeatable")
+    sp.add_argument("--duration", type=float, metavar="HOURS",
+                    help="a time_s column: the campaign runs from 0 to HOURS in pose order")
+    harmonics_option(sp, "a hidden transmission_error")
+    sp.add_argument("--seed", type=int, default=1)
+    sp.set_defaults(func=cmd_simulate)
+
+    sp = sub.add_parser("identify", help="parameter identification from measurements")
+    robot_opts(sp)
+    sp.add_argument("--data", required=True, help="measurement CSV (pose, q1..qN, x, y, z[, target, payload_kg, "
+                                                  "time_s, config, setup]; a setup column: one placement each)")
+    sp.add_argument("--out", required=True, help="model JSON")
+    effect_opts(sp, "auto", "non-geometric effects to identify; 'auto': each library effect that applies is tried "
+                "and kept only when it lowers the grouped cross-validated RMS (the diagnosis's rule; chosen again in "
+                "each training fold of the validation)")
+    fit_opts(sp)
+    sp.add_argument("--holdout", type=float, default=None,
+                    help="validate on a held-out share of the configurations instead of cross-validation (the "
+                         "model then excludes those rows)")
+    sp.add_argument("--folds", type=int, default=None,
+                    help="k-fold cross-validation of the figures, whole configurations per fold (default 5; 0: "
+                         "none); the model is fitted on every row")
+    sp.add_argument("--hold-out-setups", action="store_true", help="validate by holding out each setup (instrument "
+                    "placement) whole, its placement and targets refitted, instead of folds")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
+    sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
+    sp.set_defaults(func=cmd_identify)
+
+    sp = sub.add_parser("validate", help="check a calibration on new measurements (placements and targets refitted)")
+    sp.add_argument("--model", required=True, help="model JSON (kincal identify or diagnose), or any --robot")
+    sp.add_argument("--data", required=True, help="measurement CSV of the new campaign (a setup column: one "
+                                                  "placement per setup)")
+    sp.add_argument("--out", required=True, help="V.json: points, rms_mm, mean_mm, max_mm, before_rms_mm, ...")
+    loss_opts(sp)
+    sp.set_defaults(func=cmd_validate)
+
+
+def add_diagnose(sub) -> None:
+    """diagnose on the command line's subparsers ``sub``."""
+    sp = sub.add_parser("diagnose", help="find the effect a model misses, add it, show the gap shrink")
+    robot_opts(sp)
+    sp.add_argument("--data", required=True, help="measurement CSV (with dir1..dirN, temperature_c when present); "
+                                                  "with --robot fivebar a table with the columns of Table I")
+    sp.add_argument("--out", required=True, help="folder for diagnosis.json, report.html, figures and model.json "
+                                                 "(the final model, for compensate)")
+    sp.add_argument("--folds", type=int, default=5, help="folds of the cross-validation (whole configurations per fold)")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
+    sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
+    effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")
+    fit_opts(sp)
+    sp.set_defaults(func=cmd_diagnose)

@@ -1,0 +1,149 @@
+"""What the `kincal` commands share: the robot, effect, loss and fitting option groups, their
+parsers, and the progress lines on stderr. Parsing only; the commands are in the modules beside."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Optional
+
+import numpy as np
+
+from .. import _core, load_robot
+from ..calibration import identify as ident
+from ..calibration import priors
+from ..calibration.fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, masses
+
+
+def joint_convention_option(sp) -> None:
+    sp.add_argument("--joint-convention", choices=["fanuc"],
+                    help="how the controller numbers the joints of a URDF or built-in robot (a model JSON carries "
+                         "its own): fanuc, J3 is the forearm's angle to the horizontal; every joint angle in the "
+                         "files is then the controller's")
+
+
+def robot_opts(sp) -> None:
+    sp.add_argument("--robot", required=True, help="built-in name (kr500), URDF file or model JSON")
+    sp.add_argument("--base", help="URDF: base link of the chain (default: the root link)")
+    sp.add_argument("--tip", help="URDF: tip link of the chain (default: the only leaf)")
+    joint_convention_option(sp)
+
+
+def robot_of(args) -> _core.Robot:
+    """The robot of --robot (with --base, --tip, --joint-convention where the command has them)."""
+    return load_robot(args.robot, getattr(args, "base", None), getattr(args, "tip", None),
+                      getattr(args, "joint_convention", None))
+
+
+def harmonics(text: str) -> list:
+    """--harmonics 1,2,3: transmission_error's harmonic orders."""
+    try:
+        h = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected harmonic orders such as 1,2,3, not '{text}'") from None
+    if not h or any(k < 1 for k in h) or len(set(h)) != len(h):
+        raise argparse.ArgumentTypeError(f"harmonic orders must be distinct positive integers, not '{text}'")
+    return h
+
+
+def harmonics_option(sp, what: str) -> None:
+    sp.add_argument("--harmonics", type=harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
+                    help=f"harmonic orders of {what} (default 1,2)")
+
+
+def effect_opts(sp, default: str, what: str) -> None:
+    names = ", ".join(k.name for k in _core.effect_kinds() if k.domain == "serial")
+    sp.add_argument("--effects", default=default,
+                    help=f"{what}, comma separated: NAME (every joint where it applies) or NAME:J (joint J); "
+                         f"joint_map:J:K a joint_map of order K (default {ident.DEFAULT_MAP_ORDER}); "
+                         f"'none' for the geometry alone (default: {default}; known: {names})")
+    harmonics_option(sp, "transmission_error")
+
+
+def loss_opts(sp, scale: Optional[float] = 0.1) -> None:
+    sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
+    sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
+                    + (f"{scale})" if scale else "from the residuals' robust spread)"))
+
+
+def fit_opts(sp) -> None:
+    """The fitting options of identify and diagnose: one group, one default each (kincal.calibration.fitting)."""
+    loss_opts(sp, DEFAULT_LOSS_SCALE_MM)
+    sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated "
+                    "geometry (e.g. last year's calibration; default: the starting model)")
+    sp.add_argument("--prior-sd", metavar="KIND=SD,..", help="prior standard deviations over the defaults "
+                    f"({', '.join(f'{k}={v:g}' for k, v in priors.DEFAULT_PRIOR_SD.items())}; also base_mm, "
+                    "base_deg, target_mm, an effect's name); 'none': no priors (what the data cannot determine "
+                    "is then refused)")
+    sp.add_argument("--prior-scale", default="1", help="times every prior sd, or 'auto' (grouped cross-validation)")
+    sp.add_argument("--gravity", choices=["auto", "masses", "fit"], default="auto", help="the compliances' "
+                    "gravity torques: the model's masses, or mass moments identified (fit); auto: fit when it "
+                    "has no masses")
+    sp.add_argument("--max-iterations", type=int, default=100, metavar="N",
+                    help="the cap of each Levenberg-Marquardt solve (default 100)")
+    sp.add_argument("--tool-targets", metavar="CSV",
+                    help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
+                         "order): places the tool frame (TCP), which reflectors alone cannot")
+    sp.add_argument("--orientation-weight", type=float, default=100.0, metavar="MM_PER_RAD",
+                    help="with measured orientations (a,b,c): mm of position residual worth one rad (default "
+                         "100: 0.02 mm against 0.011 deg of noise)")
+
+
+def fit_options(args, robot: _core.Robot) -> FitOptions:
+    """The fitting options of identify and diagnose (one group of options, one default each)."""
+    prior_model = load_robot(args.prior_model) if args.prior_model else None
+    if prior_model is not None and prior_model.dof != robot.dof:
+        raise ValueError(f"{args.prior_model}: {prior_model.dof} joints but the robot has {robot.dof}")
+    if args.gravity == "masses" and not masses(robot):
+        raise ValueError(f"--gravity masses: the model {args.robot} has no link masses (no inertial data); use "
+                         "--gravity fit (or auto)")
+    return FitOptions(loss=args.loss, loss_scale_mm=args.loss_scale or None,
+                      prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
+                      prior_scale=priors.parse_prior_scale(args.prior_scale), gravity=args.gravity,
+                      orientation_weight=args.orientation_weight, max_iterations=args.max_iterations)
+
+
+def effects_arg(args, robot: _core.Robot, data: dict):
+    """--effects: "auto" (identify's default) or a list (checked against the data's columns)."""
+    if args.effects.strip() == "auto":
+        return "auto"
+    effects = ident.parse_effects(args.effects, robot, args.harmonics)
+    ident.check_data_for(effects, dict(data, source=args.data), robot)
+    return effects
+
+
+def tool_targets(path: Optional[str], data: dict, data_path: str) -> Optional[np.ndarray]:
+    """--tool-targets: x,y,z of each target of the measurements in the tool frame, one row each
+    (checked before any fit: an error names the file and both counts)."""
+    if not path:
+        return None
+    known = _core.read_csv_columns(path, ["x", "y", "z"])
+    n = int(np.max(data["target"])) + 1
+    if len(known) != n:
+        raise ValueError(f"{path}: {len(known)} rows, but {data_path} measures {n} target(s) (one row of x,y,z per "
+                         "target in the tool frame, in target order)")
+    return known
+
+
+def progress(label: str):
+    """A one-line progress report of a solver's iterations on stderr (quiet when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(iteration: int, cost: float) -> None:
+        print(f"\r{label}: iteration {iteration}, cost {cost:.6g}   ", end="", file=sys.stderr, flush=True)
+    return report
+
+
+def step_progress(label: str):
+    """A one-line report of a loop's steps on stderr (quiet when not a terminal)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(step: int, steps: int) -> None:
+        print(f"\r{label}: {step + 1} of {steps}   ", end="", file=sys.stderr, flush=True)
+    return report
+
+
+def say(text: str) -> None:
+    print(text, file=sys.stderr, flush=True)

@@ -1,0 +1,1 @@
+"""Files in and out: strict JSON, CSV text, URDF chains, public data sets."""

@@ -84,6 +84,8 @@ NativeOptions native_options(const std::vector<double>& program_tool, const std:
 #define KINCAL_COMP_OPTIONS options(comp, instr, fd, delta, eps, it, cs, residual, temp, initial, keep)
 
 void define_compensation(py::module_& m) {
+  m.def("parse_initial_direction", &parse_initial_direction, py::arg("text"),
+        "--initial-direction's text as signs (+1 or -1, one for all joints or one each; empty: none)");
   m.def(
       "compensate_poses",
       [](const Robot& r, const RowMatrix& poses, KINCAL_COMP_PARAMS, const std::optional<Eigen::VectorXd>& temps) {

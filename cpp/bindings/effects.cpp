@@ -3,6 +3,9 @@
 #include "common.hpp"
 
 #include <pybind11/operators.h>
+#include <pybind11/stl.h>
+
+#include <optional>
 
 #include "kincal/effects/effects.hpp"
 #include "kincal/identify/identify.hpp"
@@ -22,6 +25,19 @@ void define_effects(py::module_& m) {
       .def("__repr__", [](const EffectKind& k) { return "<EffectKind " + k.name + ">"; });
   m.def("effect_kinds", &effect_kinds, py::return_value_policy::copy, "Every effect kind, in the diagnosis's order");
   m.def("effect_kind", &effect_kind, py::arg("name"), py::return_value_policy::copy);
+  m.def(
+      "joint_basis",
+      [](const Effect& e, const Eigen::VectorXd& q_rad, std::optional<Eigen::VectorXd> dir) {
+        if (e.name != "transmission_error" && e.name != "joint_map" && e.name != "backlash")
+          throw InputError(e.name + " is no joint-angle effect (transmission_error, joint_map, backlash)");
+        if (dir && dir->size() != q_rad.size()) throw InputError("joint_basis: one dir per angle");
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> b(q_rad.size(), e.size());
+        for (Eigen::Index i = 0; i < q_rad.size(); ++i)
+          joint_basis(e, q_rad[i], dir ? (*dir)[i] : 1.0, b.row(i).data());
+        return b;
+      },
+      py::arg("effect"), py::arg("q_rad"), py::arg("dir") = py::none(),
+      "The basis of a joint-angle effect at each angle (n x size): dq = sum_k p_k b_k(q, dir), the core's own");
 
   py::class_<Effect>(m, "Effect", "An effect on one joint (or link), or on the whole robot")
       .def(py::init([](const std::string& name, int joint, std::vector<int> harmonics, int order) {

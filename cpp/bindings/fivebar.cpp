@@ -12,6 +12,12 @@ namespace {
 
 using Rows2 = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 
+Rows2 rows_of(const std::vector<Vec2>& v) {
+  Rows2 out(static_cast<Eigen::Index>(v.size()), 2);
+  for (size_t i = 0; i < v.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  return out;
+}
+
 py::dict points_to(const std::vector<FiveBarPoint>& pts) {
   const size_t n = pts.size();
   Eigen::VectorXi id(n), line(n);
@@ -130,18 +136,18 @@ void define_fivebar(py::module_& m) {
   m.def(
       "fivebar_command",
       [](const FiveBar& f, const ErrorMatrix* e, const Rows2& xy) {
-        FiveBarCorrector corr(f, e);
-        Rows2 out(xy.rows(), 2);
-        for (Eigen::Index i = 0; i < xy.rows(); ++i) {
-          double t1, t2;
-          if (!corr.command(xy.row(i).transpose(), t1, t2))
-            throw InputError("row " + std::to_string(i + 1) + ": (" + std::to_string(xy(i, 0)) + ", " +
-                             std::to_string(xy(i, 1)) + ") is out of the hidden robot's reach");
-          out.row(i) << t1, t2;
-        }
-        return out;
+        std::vector<Vec2> pts(static_cast<size_t>(xy.rows()));
+        for (Eigen::Index i = 0; i < xy.rows(); ++i) pts[static_cast<size_t>(i)] = xy.row(i).transpose();
+        return rows_of(fivebar_commands(f, e, pts, [](size_t i) { return "row " + std::to_string(i + 1); }));
       },
       py::arg("model"), py::arg("matrix"), py::arg("xy"), "joint commands (deg) for desired points, in order");
+  m.def(
+      "fivebar_command_file",
+      [](const FiveBar& f, const ErrorMatrix* e, const std::string& path) {
+        return rows_of(fivebar_command_file(f, e, path));
+      },
+      py::arg("model"), py::arg("matrix"), py::arg("path"),
+      "joint commands (deg) for the desired points of a CSV with x,y (mm); errors name file:line");
   m.def(
       "fivebar_fit_nonlinear",
       [](const py::dict& pts, const FiveBar& start) {

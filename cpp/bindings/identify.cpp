@@ -164,6 +164,9 @@ IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
 }  // namespace
 
 void define_identify(py::module_& m) {
+  m.def("default_prior_sd", &default_prior_sd,
+        "The priors' default standard deviations by kind, in the core's units (mm, rad): the one home of "
+        "these defaults");
   m.def(
       "simulate",
       [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,

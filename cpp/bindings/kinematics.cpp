@@ -1,7 +1,8 @@
 #include "common.hpp"
 
-#include "kincal/ik/ik.hpp"
 #include "kincal/compensation/program.hpp"
+#include "kincal/core/rigid.hpp"
+#include "kincal/ik/ik.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <kdl/chainfksolverpos_recursive.hpp>
@@ -71,6 +72,16 @@ void define_kinematics(py::module_& m) {
       py::arg("dir") = py::none(), py::arg("temperature_c") = py::none(),
       "Tool poses x,y,z,a,b,c (mm, deg) for joint angles in degrees (N x dof), every effect of the model\n"
       "acting: dir (N x dof signs, backlash) and temperature_c (N, thermal expansion) when it needs them");
+  m.def(
+      "rigid_fit",
+      [](const RowMatrix& a, const RowMatrix& b) {
+        if (a.cols() != 3 || b.cols() != 3 || a.rows() != b.rows())
+          throw InputError("rigid_fit: two point sets of the same count, x,y,z each");
+        return Eigen::Matrix4d(rigid_fit(a.transpose(), b.transpose()).matrix());
+      },
+      py::arg("a"), py::arg("b"),
+      "The rigid transform (4 x 4) that best maps the points a (n x 3) onto b (Horn); a translation only\n"
+      "when the points do not span a plane");
   m.def(
       "motion_directions",
       [](const RowMatrix& q_deg, const std::vector<double>& initial) {

@@ -18,6 +18,11 @@ void define_model(py::module_& m) {
       .def_static("load", &load_robot, py::arg("name_or_path"), "A built-in name or a model JSON file")
       .def_static("from_json", &robot_from_json, py::arg("text"), py::arg("source") = "<json>")
       .def("to_json", [](const Robot& r) { return robot_to_json(r); })
+      .def("with_joint_convention", [](const Robot& r, const std::string& source, const std::string& convention) {
+             return with_joint_convention(r, source, convention);
+           }, py::arg("source"), py::arg("convention"),
+           "The robot read from source numbered as its controller numbers the joints (fanuc; '': the model's own); "
+           "a model JSON carries its own")
       .def_property_readonly("dof", [](const Robot& r) { return r.nominal->dof(); })
       .def_property_readonly("identified", &Robot::identified)
       .def_property_readonly("name", [](const Robot& r) { return r.nominal->spec().name; })

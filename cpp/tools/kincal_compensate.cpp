@@ -105,35 +105,6 @@ int run_fivebar(const std::string& fit_path, const std::string& matrix_path, con
   return 0;
 }
 
-/// The robot of --model, with --joint-convention for a built-in robot (a model JSON carries its own).
-kincal::Robot robot_with_convention(const std::string& model, const std::string& convention) {
-  kincal::Robot robot = kincal::load_robot(model);
-  if (convention.empty()) return robot;
-  if (model.size() >= 5 && model.compare(model.size() - 5, 5, ".json") == 0)
-    throw kincal::InputError(model + ": a model JSON carries its joint convention (\"joint_convention\"); "
-                             "--joint-convention is for a built-in robot");
-  auto m = std::make_shared<kincal::Model>(kincal::with_joint_convention(robot.nominal->spec(), convention));
-  return kincal::Robot{m, m};
-}
-
-/// "+1", "-1" or six comma-separated signs; empty: none given
-std::vector<double> parse_directions(const std::string& text) {
-  std::vector<double> out;
-  if (text.empty()) return out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end;
-    const double v = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0' || (v != 1.0 && v != -1.0))
-      throw kincal::InputError("--initial-direction: '" + item + "' is not +1 or -1");
-    out.push_back(v);
-  }
-  if (out.size() != 1 && out.size() != 6)
-    throw kincal::InputError("--initial-direction needs one sign for all joints or six (q1..q6)");
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -229,8 +200,8 @@ int main(int argc, char** argv) {
     if (residual == "abc") opt.comp.residual = kincal::Residual::Abc;
     if (temperature) opt.temperature_c = *temperature;
     opt.keep_branch = keep_branch;
-    opt.initial_direction = parse_directions(initial_direction);
-    const kincal::Robot robot = robot_with_convention(model, joint_convention);
+    opt.initial_direction = kincal::parse_initial_direction(initial_direction);
+    const kincal::Robot robot = kincal::with_joint_convention(kincal::load_robot(model), model, joint_convention);
     if (opt.instrument_frame && !robot.identified())
       throw kincal::InputError(model + ": --frame instrument needs an identified model (kincal identify)");
     const std::string tcp = kincal::tcp_warning(robot, model);  // a model whose TCP was not measured

@@ -16,7 +16,6 @@ VDI/DGQ 3441), ``fivebar``, ``report``, ``io`` (JSON, CSV, URDF, public data set
 from __future__ import annotations
 
 import importlib
-import json
 import warnings
 from pathlib import Path
 from typing import Optional, Sequence, Union
@@ -24,7 +23,6 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from .io import strict_json
 from ._core import Robot
 from .io.urdf import urdf_model_json
 
@@ -38,7 +36,7 @@ MOVED = {
     "grouping": "stats.grouping", "stepwise": "stats.stepwise", "robust_scores": "stats.robust_scores",
     "feed": "programs.feed", "kinematics_files": "programs.kinematics_files",
     "accuracy": "standards.accuracy", "iso9283_plan": "standards.iso9283_plan", "accuracy_report": "standards.report",
-    "datasets": "io.datasets", "csv_text": "io.csv_text", "urdf": "io.urdf",
+    "datasets": "io.datasets", "csv_text": "io.csv_text", "urdf": "io.urdf", "strict_json": "io.strict_json",
     "accuracy_demo": "demo.accuracy",
 }
 
@@ -64,17 +62,8 @@ def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: 
     ``joint_convention`` (``fanuc``) says how the controller numbers the joints (a URDF's or built-in
     robot's; a model JSON carries its own)."""
     s = str(name_or_path)
-    text = urdf_model_json(s, base, tip) if s.lower().endswith(".urdf") else None
-    if joint_convention:
-        if text is None and s.lower().endswith(".json"):
-            raise ValueError(f"{s}: a model JSON carries its joint convention (\"joint_convention\"); "
-                             f"--joint-convention is for a URDF or a built-in robot")
-        o = json.loads(text if text is not None else Robot.load(s).to_json())
-        o["joint_convention"] = joint_convention
-        text = strict_json.dumps(o)
-    if text is not None:
-        return Robot.from_json(text, s)
-    return Robot.load(s)
+    robot = Robot.from_json(urdf_model_json(s, base, tip), s) if s.lower().endswith(".urdf") else Robot.load(s)
+    return robot.with_joint_convention(s, joint_convention or "")
 
 
 def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "base",

@@ -121,7 +121,7 @@ def test_standalone_corrector_matches_python(tmp_path):
     assert abs(float(lines[1].split(",")[0]) - qa["theta1_deg"][0]) < 1e-9
 
 
-@pytest.mark.parametrize("case", ["unreachable", "offgrid", "badfit"])
+@pytest.mark.parametrize("case", ["unreachable", "quoted", "offgrid", "badfit"])
 def test_hidden_robot_bad_input(tmp_path, case):
     fit = tmp_path / "fit.json"
     fit.write_text(json.dumps({"a": 150, "b": 150, "c": 150, "d": 150}))
@@ -131,6 +131,11 @@ def test_hidden_robot_bad_input(tmp_path, case):
         r = run("kincal", "hidden-robot", "command", "--fit", str(fit), "--targets", str(tmp_path / "xy.csv"),
                 "--out", str(out))
         msg = "xy.csv:3: (500.000000, 0.000000) is out of the hidden robot's reach"  # its second row
+    elif case == "quoted":  # a quoted field holding a line break: the core's CSV reader counts the lines
+        (tmp_path / "xy.csv").write_text('x,y,note\n200,0,"first\nsecond line"\n\n500,0,far\n')
+        r = run("kincal", "hidden-robot", "command", "--fit", str(fit), "--targets", str(tmp_path / "xy.csv"),
+                "--out", str(out))
+        msg = "xy.csv:5: (500.000000, 0.000000) is out of the hidden robot's reach"  # the row on line 5
     elif case == "offgrid":
         (tmp_path / "g.csv").write_text("point,theta1_deg,theta2_deg,x_desired_mm,y_desired_mm,x_measured_mm,y_measured_mm\n"
                                         "1,0,0,0,0,0,0\n2,0,0,5,0,5,0\n3,0,0,0,5,0,5\n4,0,0,5.5,5,5,5\n")

@@ -1,5 +1,6 @@
 #include "kincal/compensation/program.hpp"
 
+#include "kincal/io/csv.hpp"
 #include "kincal/io/file.hpp"
 #include "kincal/io/programs.hpp"
 #include "kincal/kinematics/kinematics.hpp"
@@ -192,11 +193,29 @@ std::vector<Vec6> motion_directions(const std::vector<Vec6>& q, const std::vecto
 }
 
 Vec6 initial_directions(const std::vector<double>& v) {
-  if (v.size() == 1) return Vec6::Constant(v[0]);
-  if (v.size() != 6) throw InputError("--initial-direction needs one sign for every joint, or one for all");
+  if (v.size() != 1 && v.size() != 6)
+    throw InputError("--initial-direction needs one sign for every joint, or one for all");
   for (double x : v)
     if (x != 1.0 && x != -1.0) throw InputError("--initial-direction: the directions must be +1 or -1");
-  return Eigen::Map<const Vec6>(v.data());
+  return v.size() == 1 ? Vec6::Constant(v[0]) : Vec6(Eigen::Map<const Vec6>(v.data()));
+}
+
+std::vector<double> parse_initial_direction(const std::string& text) {
+  std::vector<double> out;
+  if (text.empty()) return out;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    double v = 0;
+    if (parse_number(item.data(), item.data() + item.size(), v) != NumberParse::Ok)
+      throw InputError("--initial-direction " + text + ": '" + item + "' is not +1 or -1");
+    out.push_back(v);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  initial_directions(out);  // the rule: one sign for all joints or one per joint, each +1 or -1
+  return out;
 }
 
 ProgramCursor::ProgramCursor(const Robot& robot, const ProgramOptions& opt, const Vec6& dir0)

@@ -316,6 +316,26 @@ bool FiveBarCorrector::command(const Vec2& p, double& t1_deg, double& t2_deg) {
   return true;
 }
 
+std::vector<Vec2> fivebar_commands(const FiveBar& m, const ErrorMatrix* matrix, const std::vector<Vec2>& xy,
+                                   const std::function<std::string(size_t)>& where) {
+  FiveBarCorrector corr(m, matrix);
+  std::vector<Vec2> out(xy.size());
+  for (size_t i = 0; i < xy.size(); ++i)
+    if (!corr.command(xy[i], out[i][0], out[i][1]))
+      throw InputError(where(i) + ": (" + std::to_string(xy[i][0]) + ", " + std::to_string(xy[i][1]) +
+                       ") is out of the hidden robot's reach");
+  return out;
+}
+
+std::vector<Vec2> fivebar_command_file(const FiveBar& m, const ErrorMatrix* matrix, const std::string& path) {
+  const CsvTable t = read_csv(path);
+  if (t.cells.empty()) throw InputError(path + ": no rows");
+  const int cx = t.require("x"), cy = t.require("y");
+  std::vector<Vec2> xy(t.cells.size());
+  for (size_t r = 0; r < t.cells.size(); ++r) xy[r] = Vec2(t.number(r, cx), t.number(r, cy));
+  return fivebar_commands(m, matrix, xy, [&t](size_t i) { return t.where(i); });
+}
+
 std::string fivebar_to_json(const FiveBar& m) {
   return json{{"a", m.a}, {"b", m.b}, {"c", m.c}, {"d", m.d}}.dump();
 }

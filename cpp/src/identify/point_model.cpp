@@ -4,6 +4,7 @@
 // row and of a whole measurement set.
 #include "kincal/identify/point_model.hpp"
 
+#include "kincal/core/rigid.hpp"
 #include "kincal/identify/so3.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
@@ -409,13 +410,9 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
       a.col(k) = fk_compliant(nominal_, data.rows[rows[k]].q_deg * kDeg).translation();
       b.col(k) = data.rows[rows[k]].xyz;
     }
-    const Vec3 ca = a.rowwise().mean(), cb = b.rowwise().mean();
-    const Mat3 h = (a.colwise() - ca) * (b.colwise() - cb).transpose();
-    Eigen::JacobiSVD<Mat3> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Mat3 d = Mat3::Identity();
-    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-    const Mat3 r = svd.matrixV() * d * svd.matrixU().transpose();
-    const Vec3 t = cb - r * ca;
+    const Eigen::Isometry3d fit = rigid_fit(a, b);
+    const Mat3 r = fit.linear();
+    const Vec3 t = fit.translation();
     const Placement& pl = place_[static_cast<size_t>(s)];
     const Vec3 dt = t - pl.t0;
     const Vec3 phi = so3::log(pl.r0.transpose() * r);

@@ -339,4 +339,13 @@ Robot load_robot(const std::string& name) {
   return Robot{m, m};
 }
 
+Robot with_joint_convention(const Robot& robot, const std::string& source, const std::string& convention) {
+  if (convention.empty()) return robot;
+  if (source.size() >= 5 && source.compare(source.size() - 5, 5, ".json") == 0)
+    throw InputError(source + ": a model JSON carries its joint convention (\"joint_convention\"); "
+                     "--joint-convention is for a URDF or a built-in robot");
+  auto m = std::make_shared<Model>(with_joint_convention(robot.nominal->spec(), convention));
+  return Robot{m, m};
+}
+
 }  // namespace kincal

@@ -23,8 +23,10 @@ from .._core import Robot
 #: prior standard deviations by kind (file units): a robot maker's tolerances for the joint geometry,
 #: a tool known to a few mm; none for the compliances (their size per kN m differs 100-fold between
 #: robots: a 0.01 deg/kNm prior cost 6% held out on the UR10 data), the base frames, the targets and
-#: the extra effects (wide: the data determine them)
-DEFAULT_PRIOR_SD = {"joint_mm": 1.0, "joint_deg": 0.1, "tool_mm": 5.0, "tool_deg": 1.0}
+#: the extra effects (wide: the data determine them). The core holds them (default_prior_sd, in mm and
+#: rad); here in the file's units (deg)
+DEFAULT_PRIOR_SD = {(k[:-4] + "_deg" if k.endswith("_rad") else k): (math.degrees(v) if k.endswith("_rad") else v)
+                    for k, v in _core.default_prior_sd()}
 #: the overall widths `--prior-scale auto` chooses from, by grouped cross-validation
 AUTO_SCALES = (0.1, 0.3, 1.0, 3.0, 10.0)
 _GEOMETRIC = ("joint_mm", "joint_deg", "compliance", "tool_mm", "tool_deg", "base_mm", "base_deg", "target_mm")

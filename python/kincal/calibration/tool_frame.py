@@ -26,15 +26,8 @@ def tool_from_targets(robot: Robot, targets: np.ndarray, known: np.ndarray) -> R
     if len(known) != len(ident_t):
         raise ValueError(f"{len(known)} known target offsets for {len(ident_t)} identified targets")
     # identified t_k (tool frame M) = T known_k: then M' = M T puts known_k at the same points
-    if len(known) >= 3 and np.linalg.matrix_rank(known - known.mean(axis=0), tol=1e-6) >= 2:
-        ca, cb = known.mean(axis=0), ident_t.mean(axis=0)
-        h = (known - ca).T @ (ident_t - cb)
-        u, _, vt = np.linalg.svd(h)
-        d = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
-        r = vt.T @ d @ u.T
-        t = cb - r @ ca
-    else:
-        r, t = np.eye(3), (ident_t - known).mean(axis=0)
+    fit = _core.rigid_fit(known, ident_t)  # Horn; a translation for one or two targets, or collinear ones
+    r, t = fit[:3, :3], fit[:3, 3]
     doc = json.loads(robot.to_json())
     tool = doc["calibrated"]["tool"]
     m_r = _core.abc_to_rotation(np.asarray(tool["abc_deg"], dtype=float))

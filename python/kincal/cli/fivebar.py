@@ -3,7 +3,6 @@ commands, the simulated over-constrained 6-bar), for kincal.cli."""
 
 from __future__ import annotations
 
-import re
 import sys
 
 from .. import _core
@@ -30,29 +29,10 @@ def cmd_hr_matrix(args) -> None:
           f"measured errors up to {e.max() * 1000:.1f} um")
 
 
-def _line_of_row(path: str, row: int) -> int:
-    """The line of a CSV file that holds its data row ``row`` (from 1; blank lines and the header
-    are no rows)."""
-    seen = -1  # the header is the first line that is not blank
-    with open(path, encoding="utf-8-sig") as f:
-        for line, text in enumerate(f, start=1):
-            if text.strip():
-                seen += 1
-                if seen == row:
-                    return line
-    return row + 1
-
-
 def cmd_hr_command(args) -> None:
     model = fivebar.load_fit(args.fit)
     matrix = fivebar.load_matrix(args.matrix) if args.matrix else None
-    xy = _core.read_csv_columns(args.targets, ["x", "y"])
-    try:
-        q = fivebar.command(model, xy, matrix)
-    except ValueError as e:  # the core's "row K: ..." said at the file's line of that row
-        m = re.match(r"row (\d+): (.*)", str(e))
-        raise ValueError(f"{args.targets}:{_line_of_row(args.targets, int(m.group(1)))}: {m.group(2)}" if m else
-                         f"{args.targets}: {e}") from None
+    q = _core.fivebar_command_file(model, matrix, args.targets)  # a point out of reach: file:line
     _core.write_file_atomic(args.out, format_rows(["theta1_deg", "theta2_deg"], q))
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
@@ -131,24 +130,12 @@ def compensate_backup(robot, args, comp_kwargs: dict) -> None:
         raise ValueError(f"{res['failed']} program(s) not written (the others are):\n  " + "\n  ".join(lines))
 
 
-def _directions(text: Optional[str]) -> list:
-    """--initial-direction: +1, -1, or one sign per joint, comma separated."""
-    if text is None:
-        return []
-    try:
-        v = [float(x) for x in text.split(",")]
-    except ValueError:
-        raise ValueError(f"--initial-direction {text}: expected +1, -1 or s1,..,s6") from None
-    if len(v) not in (1, 6) or any(x not in (1.0, -1.0) for x in v):
-        raise ValueError(f"--initial-direction {text}: one sign (+1 or -1) for all joints, or one per joint")
-    return v
-
-
 def _comp_kwargs(args) -> dict:
     return dict(compensate=not args.nominal, instrument=args.frame == "instrument",
                 finite_difference=args.finite_difference, delta=args.delta, epsilon=args.epsilon,
                 max_iterations=args.max_iterations, corrected_start=not args.paper_start, residual=args.residual,
-                temperature_c=args.temperature, initial_direction=_directions(args.initial_direction),
+                temperature_c=args.temperature,
+                initial_direction=_core.parse_initial_direction(args.initial_direction or ""),
                 keep_branch=args.keep_branch)
 
 

@@ -44,8 +44,7 @@ def _basis(effect, t1: np.ndarray, t2: np.ndarray) -> np.ndarray:
     if _acts_on(effect) == "link_length":
         b = np.c_[np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)]
     else:
-        t = t1 if effect.joint == 1 else t2
-        b = np.column_stack([f(k * t) for k in effect.harmonics for f in (np.sin, np.cos)])
+        b = _core.joint_basis(effect, np.asarray(t1 if effect.joint == 1 else t2, dtype=float))  # the core's basis
     if b.shape[1] != effect.size:
         raise ValueError(f"{effect.label}: {effect.size} parameters but the five-bar has {b.shape[1]} basis functions")
     return b

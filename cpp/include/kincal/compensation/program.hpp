@@ -80,6 +80,10 @@ std::vector<Vec6> motion_directions(const std::vector<Vec6>& q_deg, const std::v
 /// Each joint's direction into the first pose from ProgramOptions::initial_direction (one sign for
 /// every joint, or one for all); InputError when it is neither or a sign is not +-1.
 Vec6 initial_directions(const std::vector<double>& v);
+/// --initial-direction's text: "+1", "-1" or one sign per joint, comma separated (empty: none given),
+/// checked by initial_directions' rule; InputError naming the option otherwise. The one reader of
+/// the option for kincal-compensate and the kincal command.
+std::vector<double> parse_initial_direction(const std::string& text);
 
 /// A program compensated pose after pose, in order (compensate_poses and StreamCompensator): the
 /// reference of the next pose (the last result; the robot's home first) and the effect context

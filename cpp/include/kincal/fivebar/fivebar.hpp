@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,14 @@ class FiveBarCorrector {
   double ref_[2];
   bool have_ref_ = false;
 };
+
+/// Joint commands (deg: theta1, theta2) for desired points, in order (the corrector's branch carried
+/// from one to the next). A point out of reach or singular is an InputError "WHERE: (x, y) is out of
+/// the hidden robot's reach", where(i) naming the i-th point (its row, or file:line).
+std::vector<Vec2> fivebar_commands(const FiveBar& m, const ErrorMatrix* matrix, const std::vector<Vec2>& xy,
+                                   const std::function<std::string(size_t)>& where);
+/// fivebar_commands for the desired points of a CSV file (columns x, y in mm): errors name file:line.
+std::vector<Vec2> fivebar_command_file(const FiveBar& m, const ErrorMatrix* matrix, const std::string& path);
 
 std::string fivebar_to_json(const FiveBar& m);
 FiveBar fivebar_from_json(const std::string& text, const std::string& source);

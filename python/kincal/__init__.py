@@ -18,13 +18,17 @@ from __future__ import annotations
 import importlib
 import warnings
 from pathlib import Path
-from typing import Optional, Sequence, Union
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import numpy as np
 
 from . import _core
 from ._core import Robot
 from .io.urdf import urdf_model_json
+
+if TYPE_CHECKING:
+    from .typing_ import FloatArray
 
 #: the modules of the flat layout of 0.1 and where they are now; reachable by the old name, with a
 #: DeprecationWarning, for one release
@@ -41,7 +45,7 @@ MOVED = {
 }
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> ModuleType:
     """The old flat modules by their old names (MOVED), with a DeprecationWarning."""
     if name in MOVED:
         warnings.warn(f"kincal.{name} is now kincal.{MOVED[name]}; the old name goes in the next release",
@@ -67,7 +71,7 @@ def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: 
 
 
 def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "base",
-       dir: Optional[ArrayLike] = None, temperature_c: Union[None, float, Sequence[float]] = None) -> np.ndarray:
+       dir: Optional[ArrayLike] = None, temperature_c: Union[None, float, Sequence[float]] = None) -> FloatArray:
     """Tool poses (N x 6: x,y,z mm, a,b,c deg) for joint angles in degrees (N x dof), every effect
     of the model acting: ``dir`` (N x dof signs +-1, the direction of each joint's last motion into
     the pose) when it has backlash, ``temperature_c`` (one value or N) when it has thermal expansion."""
@@ -80,7 +84,7 @@ def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "ba
 
 
 def run_program(robot: Robot, q_deg: ArrayLike, *, initial_direction: Union[None, float, Sequence[float]] = None,
-                temperature_c: Union[None, float, Sequence[float]] = None, frame: str = "base") -> np.ndarray:
+                temperature_c: Union[None, float, Sequence[float]] = None, frame: str = "base") -> FloatArray:
     """The tool poses a robot reaches when it runs a joint program (N x 6 joint angles in degrees,
     in order): each joint's direction into each pose is the sign of its commanded change, held while
     it stands still (the first pose's from ``initial_direction``, default the direction of the first
@@ -91,12 +95,12 @@ def run_program(robot: Robot, q_deg: ArrayLike, *, initial_direction: Union[None
     return fk(robot, q, frame=frame, dir=d, temperature_c=temperature_c)
 
 
-def jacobian(robot: Robot, q_deg: Sequence[float], calibrated: bool = True) -> np.ndarray:
+def jacobian(robot: Robot, q_deg: Sequence[float], calibrated: bool = True) -> FloatArray:
     """6 x dof geometric Jacobian at the tool point (linear mm/rad, angular rad/rad), base frame."""
     return _core.jacobian(robot, np.asarray(q_deg, dtype=float), calibrated)
 
 
-def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] = None) -> list:
+def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] = None) -> list[dict[str, Any]]:
     """Every closed-form solution of the nominal model for one pose x,y,z,a,b,c (up to 8).
 
     Each is a dict with ``q_deg``, ``within_limits``, ``wrist_singular``, ``shoulder_singular``;
@@ -108,7 +112,7 @@ def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finit
                delta: float = 1e-8, epsilon: float = 1e-15, max_iterations: int = 20,
                corrected_start: bool = True, frame: str = "base", residual: str = "rotation_vector",
                temperature_c: Union[None, float, Sequence[float]] = None,
-               initial_direction: Union[None, float, Sequence[float]] = None, keep_branch: bool = False) -> dict:
+               initial_direction: Union[None, float, Sequence[float]] = None, keep_branch: bool = False) -> dict[str, Any]:
     """Machine coordinates for desired tool poses (N x 6, in program order) on the robot's calibrated
     model, every effect it carries acting: backlash with the directions of the program's own
     commanded motion (the first pose's from ``initial_direction``, default the direction of the
@@ -127,7 +131,7 @@ def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finit
 
 
 def line_program(start: Sequence[float] = (2000.0, -740.0, 500.0), direction: Sequence[float] = (0.0, 1.0, 0.0),
-                 count: int = 297, step_mm: float = 5.0, abc: Sequence[float] = (180.0, 0.0, 180.0)) -> np.ndarray:
+                 count: int = 297, step_mm: float = 5.0, abc: Sequence[float] = (180.0, 0.0, 180.0)) -> FloatArray:
     """The Samak paper's use case: a straight tool path of ``count`` poses ``step_mm`` apart at
     constant orientation (297 x 5 mm, about 1500 mm, tool pointing down)."""
     d = np.asarray(direction, dtype=float)

@@ -468,7 +468,7 @@ def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k
     found = engine.search(problem, start, cands, alpha=ALPHA, min_gain=MIN_GAIN, max_steps=max_steps, say=say,
                           confirm=False, listed=len(cands), refit=False)
     spec = problem.spec(found.effects)
-    if found.linearised is not None:
+    if isinstance(found.linearised, _Linearised):  # no step taken: the starting fit is the model's
         res = found.linearised.res
     else:
         res = spec.fit(data) if fit_chosen else None

@@ -19,13 +19,13 @@ def format_rows(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
     return "\n".join(out) + "\n"
 
 
-def header(path: str) -> list:
+def header(path: str) -> list[str]:
     """The column names of a CSV file (stripped; empty for an empty file)."""
     with open(path, newline="", encoding="utf-8-sig") as f:  # a leading BOM (Excel) is no part of a name
         return [h.strip() for h in next(csv.reader(f), [])]
 
 
-def text_columns(path: str, names: Sequence[str]) -> dict:
+def text_columns(path: str, names: Sequence[str]) -> dict[str, list[str]]:
     """The columns of ``names`` a CSV has (e.g. pose, target), as texts row by row (blank lines
     skipped); the names it lacks are left out."""
     with open(path, newline="", encoding="utf-8-sig") as f:  # a leading BOM (Excel) is no part of a name

@@ -3,16 +3,20 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._core import abc_to_rotation, rotation_to_abc
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
+
 UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
              "wrist_3_joint"]
 
 
-def read_ipa(path: str | Path, orientation: bool = False) -> dict:
+def read_ipa(path: str | Path, orientation: bool = False) -> dict[str, Any]:
     """A series of the UR10 laser-tracker data of Landgraf et al. (CASE 2021; ../shared/data/
     ipa-robot-accuracy): ';' separated, ',' decimal mark, joints in rad, the T-Mac probe's position
     in the tracker frame in mm. Returns a measurement set (one target: the probe) with the
@@ -61,7 +65,7 @@ def read_ipa(path: str | Path, orientation: bool = False) -> dict:
     return out
 
 
-def _abc_of_xyz_intrinsic(rx: float, ry: float, rz: float) -> np.ndarray:
+def _abc_of_xyz_intrinsic(rx: float, ry: float, rz: float) -> FloatArray:
     """KUKA ABC (deg) of the rotation Rx(rx) Ry(ry) Rz(rz) (intrinsic XYZ Euler angles, rad)."""
     # intrinsic X, Y, Z is the product Rx Ry Rz; each factor is a KUKA rotation with one angle set
     r = (abc_to_rotation(np.array([0.0, 0.0, np.degrees(rx)]))

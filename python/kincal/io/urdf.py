@@ -10,14 +10,18 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterable
 
 import numpy as np
 
 from .._core import rotation_to_abc
 from . import strict_json
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def _floats(text: str | None, n: int, where: str) -> np.ndarray:
+
+def _floats(text: str | None, n: int, where: str) -> FloatArray:
     if text is None:
         return np.zeros(n)
     try:
@@ -29,7 +33,7 @@ def _floats(text: str | None, n: int, where: str) -> np.ndarray:
     return v
 
 
-def _rpy(r: float, p: float, y: float) -> np.ndarray:
+def _rpy(r: float, p: float, y: float) -> FloatArray:
     cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
     return np.array(
         [
@@ -40,7 +44,7 @@ def _rpy(r: float, p: float, y: float) -> np.ndarray:
     )
 
 
-def _origin(el: ET.Element | None, where: str) -> np.ndarray:
+def _origin(el: ET.Element | None, where: str) -> FloatArray:
     t = np.eye(4)
     if el is not None:
         t[:3, :3] = _rpy(*_floats(el.get("rpy"), 3, where + " rpy"))
@@ -48,7 +52,7 @@ def _origin(el: ET.Element | None, where: str) -> np.ndarray:
     return t
 
 
-def _abc(r: np.ndarray) -> list[float]:
+def _abc(r: FloatArray) -> list[float]:
     """KUKA ABC (deg) of a rotation matrix (the core's, exact at the pole)."""
     return [float(v) for v in rotation_to_abc(np.asarray(r, dtype=float))]
 
@@ -62,7 +66,7 @@ def _link_of(joint: ET.Element, tag: str, path: str) -> str:
     return name
 
 
-def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None) -> dict:
+def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None) -> dict[str, Any]:
     """The kincal geometry (model JSON "nominal" section) of a URDF serial chain."""
     path = str(path)
     try:
@@ -77,7 +81,7 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
     links = {str(l.get("name")): l for l in root.findall("link")}
     joints = root.findall("joint")
     by_child: dict[str, ET.Element] = {}
-    children: dict[str, list] = {}
+    children: dict[str, list[ET.Element]] = {}
     for j in joints:
         by_child[_link_of(j, "child", path)] = j
         children.setdefault(_link_of(j, "parent", path), []).append(j)
@@ -113,9 +117,9 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
     chain.reverse()
 
     t = np.eye(4)
-    out_joints: list[dict] = []
+    out_joints: list[dict[str, Any]] = []
 
-    def inertial(link_name: str, frame: np.ndarray):
+    def inertial(link_name: str, frame: FloatArray) -> tuple[float, FloatArray]:
         el = links[link_name].find("inertial")
         if el is None:
             return 0.0, frame[:3, 3] * 1000.0
@@ -182,7 +186,7 @@ def urdf_model_json(path: str | Path, base: str | None = None, tip: str | None =
     return strict_json.dumps({"format": "kincal-model", "version": 1, "nominal": urdf_spec(path, base, tip)})
 
 
-def urdf_left_out(spec: dict) -> list:
+def urdf_left_out(spec: dict[str, Any]) -> list[str]:
     """Labels of the effects of a model JSON section that a URDF cannot carry (every one: URDF is
     geometry, masses and limits), e.g. ``joint_compliance(joint 2)``."""
     out = []
@@ -191,14 +195,14 @@ def urdf_left_out(spec: dict) -> list:
     return out
 
 
-def spec_urdf(spec: dict, name: str = "kincal_calibrated") -> str:
+def spec_urdf(spec: dict[str, Any], name: str = "kincal_calibrated") -> str:
     """A URDF of a kincal geometry (a model JSON "nominal" or "calibrated" section).
 
     Every link frame keeps the base orientation at the zero configuration and sits on its joint's
     axis at the model's point of that axis (near the nominal one, so no absurd origins); each joint
     turns about its axis given in that frame. The chain's FK is then exactly the model's product of
     exponentials. The tool is a fixed joint to `tool0`; masses and centres of mass are kept."""
-    def f(v) -> str:
+    def f(v: Iterable[float]) -> str:
         return " ".join(repr(float(x)) for x in v)
 
     out = ['<?xml version="1.0"?>', f'<robot name="{name}">']

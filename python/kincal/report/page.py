@@ -11,9 +11,12 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Sequence, Union
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence, Union
 
 from .. import _core
+
+if TYPE_CHECKING:
+    from matplotlib.colors import LogNorm
 
 STYLE = """body{font-family:sans-serif;max-width:980px;margin:2em auto;color:#222;line-height:1.4}
 table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:3px 8px}
@@ -56,7 +59,7 @@ def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], numeric: bool = 
     return f"<table{cls}><tr>{h}</tr>{b}</table>"
 
 
-def error_norm(values: Any):
+def error_norm(values: Any) -> LogNorm:
     """The colour scale of error maps drawn side by side (before and after a calibration or a
     diagnosis): logarithmic and shared, so a map of microns beside one of millimetres is neither
     one colour nor misread as the same size; from the largest finite value down to the smallest

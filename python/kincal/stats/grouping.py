@@ -13,8 +13,12 @@ configuration, whatever the other rule says.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray, IntArray
 
 #: joint angles that agree within this (deg) on every joint are one configuration
 JOINT_TOLERANCE_DEG = 1e-3
@@ -24,12 +28,12 @@ JOINT_TOLERANCE_DEG = 1e-3
 class Configurations:
     """The configuration (group) of every row: ``codes`` (0..count-1, in order of first appearance),
     ``count`` and ``rule`` (how they were found, in words for the summary and the JSON)."""
-    codes: np.ndarray
+    codes: IntArray
     count: int
     rule: str
 
 
-def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _components(n: int, a: IntArray, b: IntArray) -> IntArray:
     """Connected components of n nodes joined by the edges (a[i], b[i]), labelled in order of first
     appearance. Each node takes the smallest label among its edges' ends, and then its label's label
     (pointer jumping), until nothing changes: every label stays a node of the same component, and at
@@ -52,7 +56,7 @@ def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return order[inverse]
 
 
-def _equal_joints(q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+def _equal_joints(q: FloatArray, tol: float) -> tuple[IntArray, IntArray]:
     """Pairs of rows (i, j) whose joint angles agree within tol on every joint. Rows are sorted by a
     weighted mean of their angles (weights positive, summing to 1: rows that agree within tol on
     every joint agree within tol on it, and distinct configurations sharing one joint's angle, as on
@@ -76,7 +80,7 @@ def _equal_joints(q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(a_out), np.concatenate(b_out)
 
 
-def configurations(data: dict, tol_deg: float = JOINT_TOLERANCE_DEG) -> Configurations:
+def configurations(data: dict[str, Any], tol_deg: float = JOINT_TOLERANCE_DEG) -> Configurations:
     """The configuration of every row of a measurement set (see the module's text)."""
     pose = np.asarray(data["pose"])
     n = len(pose)
@@ -100,7 +104,7 @@ def configurations(data: dict, tol_deg: float = JOINT_TOLERANCE_DEG) -> Configur
     return Configurations(codes, int(codes.max()) + 1, rule)
 
 
-def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
+def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
     """k boolean masks of held-out rows: whole configurations dealt at random into k folds."""
     cfg = configurations(data)
     if k > cfg.count:
@@ -112,7 +116,7 @@ def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
     return [fold_of[cfg.codes] == i for i in range(k)]
 
 
-def split(data: dict, share: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def split(data: dict[str, Any], share: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
     """Boolean row masks (fitted, held out): a random share of the configurations is held out whole."""
     cfg = configurations(data)
     n_out = int(round(share * cfg.count))
@@ -121,7 +125,7 @@ def split(data: dict, share: float, seed: int = 0) -> tuple[np.ndarray, np.ndarr
     return ~held, held
 
 
-def describe(data: dict, scheme: str) -> dict:
+def describe(data: dict[str, Any], scheme: str) -> dict[str, Any]:
     """The validation scheme for a summary and a JSON: ``scheme`` (e.g. "5-fold"), the grouping rule
     and the number of configurations."""
     cfg = configurations(data)

@@ -5,11 +5,15 @@ it (the core's robust_noise and loss_threshold, priors.cpp, as Python sees them)
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def robust_weights(r: np.ndarray, dims: int, loss: str, scale_mm: float) -> np.ndarray:
+
+def robust_weights(r: FloatArray, dims: int, loss: str, scale_mm: float) -> FloatArray:
     """The robust loss's weights at a fit, one per residual coordinate: each row (``dims``
     coordinates) weighed as the fit's loss weighs its residual norm (Huber: scale / norm beyond the
     scale; Cauchy: 1 / (1 + (norm / scale)^2)); ones without a robust loss. The candidates are scored
@@ -25,7 +29,7 @@ def robust_weights(r: np.ndarray, dims: int, loss: str, scale_mm: float) -> np.n
     return np.repeat(w, dims)
 
 
-def robust_noise(r: np.ndarray, dims: int, p: int) -> float:
+def robust_noise(r: FloatArray, dims: int, p: int) -> float:
     """The residuals' robust spread per coordinate (the core's robust_noise: 1.4826 x the median
     absolute deviation of the position coordinates, for p parameters)."""
     v = np.asarray(r).reshape(-1, dims)[:, :3].ravel()

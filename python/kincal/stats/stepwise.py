@@ -30,13 +30,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Optional, Protocol, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Generic, Optional, Protocol, Sequence, TypeVar
 
 import numpy as np
 
-from .. import _core
 from ..io import strict_json
 from .fdist import f_survival
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 #: how many of a round's candidates (best cross-validated gain first) the history lists and the
 #: verdict weighs
@@ -46,11 +48,26 @@ LISTED = 8
 #: more than this share of the best order's
 ORDER_MARGIN = 0.01
 
+
+class EffectLike(Protocol):
+    """What the engine reads of an effect: its name and its joint (0: none; a _core.Effect, or a
+    mechanism's own candidate such as the serial robot's JointCompliance)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def joint(self) -> int: ...
+
+
+#: the effects of one mechanism's search (its candidates and its model's effects)
+E = TypeVar("E", bound=EffectLike)
+
 #: residual r (dims per point), the current model's free columns Jc and a candidate's columns R
-Linearisation = Callable[["_core.Effect"], tuple[np.ndarray, np.ndarray, np.ndarray]]
+Linearisation = Callable[[E], "tuple[FloatArray, FloatArray, FloatArray]"]
 
 
-class Problem(Protocol):
+class Problem(Protocol[E]):
     """What the engine needs of a mechanism and its measurements."""
 
     @property
@@ -59,32 +76,32 @@ class Problem(Protocol):
         ...
 
     @property
-    def folds(self) -> Sequence[np.ndarray]:
+    def folds(self) -> Sequence[BoolArray]:
         """Boolean masks of the held-out points, one per fold (a partition of the points)."""
         ...
 
-    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+    def held_errors(self, effects: list[E], held: BoolArray) -> FloatArray:
         """Errors (one row per point) of the held points, the model with ``effects`` fitted on the others."""
         ...
 
-    def linearise(self, effects: list) -> Linearisation:
+    def linearise(self, effects: list[E]) -> Linearisation[E]:
         """The model with ``effects`` fitted on every point, linearised for each candidate."""
         ...
 
-    def describe(self, effect: "_core.Effect") -> dict:
+    def describe(self, effect: E) -> dict[str, Any]:
         """The names of an effect in diagnosis.json: ``{"effect": NAME, "joint": k or None, ...}``."""
         ...
 
-    def label(self, effect: "_core.Effect") -> str:
+    def label(self, effect: E) -> str:
         """An effect in words (e.g. "backlash(joint 2)")."""
         ...
 
-    def model_label(self, effects: list) -> str:
+    def model_label(self, effects: list[E]) -> str:
         """The model with ``effects`` in words (e.g. "geometry + backlash(joint 2)")."""
         ...
 
 
-def cv_rms(problem: Problem, effects: list) -> float:
+def cv_rms(problem: Problem[E], effects: list[E]) -> float:
     """Cross-validated RMS point error (mm): fit on the other folds, predict each fold."""
     sq, n = 0.0, 0
     for held in problem.folds:
@@ -94,7 +111,7 @@ def cv_rms(problem: Problem, effects: list) -> float:
     return math.sqrt(sq / n)
 
 
-def _basis(Jc: np.ndarray) -> np.ndarray:
+def _basis(Jc: FloatArray) -> FloatArray:
     """An orthonormal basis of the span of the current model's columns (those of a rank-deficient
     set that add nothing left out). From the eigen-decomposition of the small Gram matrix of the
     unit-scaled columns, orthonormalised twice ("twice is enough"): a tall QR in a multi-threaded
@@ -102,7 +119,7 @@ def _basis(Jc: np.ndarray) -> np.ndarray:
     if Jc.shape[1] == 0:
         return np.zeros((Jc.shape[0], 0))
     n = np.linalg.norm(Jc, axis=0)
-    Q = Jc[:, n > 0] / n[n > 0]
+    Q: FloatArray = Jc[:, n > 0] / n[n > 0]
     for _ in range(2):
         w, V = np.linalg.eigh(Q.T @ Q)
         keep = w > 1e-12 * max(float(w[-1]), 1e-300)
@@ -110,15 +127,15 @@ def _basis(Jc: np.ndarray) -> np.ndarray:
     return Q
 
 
-def _projected(Q: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _projected(Q: FloatArray, R: FloatArray) -> tuple[FloatArray, BoolArray]:
     """R projected off the span of Q, and which columns survive (those the span does not absorb)."""
     Rp = R - Q @ (Q.T @ R)
     keep = np.linalg.norm(Rp, axis=0) > 1e-9 * max(1.0, float(np.linalg.norm(R)))
     return Rp, keep
 
 
-def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.ndarray],
-          Q: Optional[np.ndarray] = None, ridge: Optional[np.ndarray] = None) -> dict:
+def score(r: FloatArray, Jc: FloatArray, R: FloatArray, row_folds: Sequence[BoolArray],
+          Q: Optional[FloatArray] = None, ridge: Optional[FloatArray] = None) -> dict[str, Any]:
     """F-test and cross-validated linear gain of regressors R on residual r, both off the span of Jc
     (the current model's columns refitted with the candidate's: a robust fit leaves part of r in
     their span; ``row_folds``: the held-out residual rows of each fold; ``Q``: an orthonormal basis
@@ -154,8 +171,8 @@ def score(r: np.ndarray, Jc: np.ndarray, R: np.ndarray, row_folds: Sequence[np.n
             "cv_ss_before": before, "cv_ss_after": after}
 
 
-def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, np.ndarray]],
-                   row_folds: Sequence[np.ndarray], Q: np.ndarray) -> tuple[int, list]:
+def choose_variant(r: FloatArray, R: FloatArray, variants: Sequence[tuple[int, FloatArray]],
+                   row_folds: Sequence[BoolArray], Q: FloatArray) -> tuple[int, list[float]]:
     """The variant of nested regressors (each: the first ``m`` columns of R and a ridge weight per
     column; off the span of Q) by cross-validation: the held-out residual sum of squares of each;
     the first listed within ORDER_MARGIN of the best. Returns its index and the cross-validated gain
@@ -163,7 +180,7 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
     r = r - Q @ (Q.T @ r)  # as score(): the current model refitted on its linearisation too
     Rp, keep = _projected(Q, R)
     G, g = Rp.T @ Rp, Rp.T @ r
-    groups: dict = {}  # variants of the same columns, solved together
+    groups: dict[int, list[int]] = {}  # variants of the same columns, solved together
     for i, (m, ridge) in enumerate(variants):
         groups.setdefault(m, []).append(i)
     solved = []  # per group of variants: its variants, the columns kept and each variant's ridge on the diagonal
@@ -196,24 +213,24 @@ def choose_variant(r: np.ndarray, R: np.ndarray, variants: Sequence[tuple[int, n
 
 
 @dataclass
-class Search:
+class Search(Generic[E]):
     """What the search found: the effects added to the starting ones (in order) and the model's
     cross-validated RMS (None without the refits' confirmation); ``history`` (each model, its CV RMS
     and its LISTED best candidates), ``last_scores`` (the LISTED best candidates of the last round,
     best gain first; empty when the search stopped at its step limit); ``linearised``: the last
     linearisation (the model with ``effects`` fitted on every point, unless the search stopped at
     its step limit: then None)."""
-    effects: list
-    steps: list
-    history: list
+    effects: list[E]
+    steps: list[dict[str, Any]]
+    history: list[dict[str, Any]]
     cv_rms_mm: Optional[float]
-    last_scores: list
-    linearised: Any = None
+    last_scores: list[dict[str, Any]]
+    linearised: Optional[Linearisation[E]] = None
 
 
-def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: float = 1e-6, min_gain: float = 0.03,
+def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, alpha: float = 1e-6, min_gain: float = 0.03,
            max_steps: int = 6, say: Callable[[str], None] = lambda s: None, confirm: bool = True,
-           cur: Optional[float] = None, listed: int = LISTED, refit: bool = True) -> Search:
+           cur: Optional[float] = None, listed: int = LISTED, refit: bool = True) -> Search[E]:
     """The greedy search from the model with the ``start`` effects: at most ``max_steps`` effects of
     ``candidates`` added, each significant (F-test p below ``alpha``), gaining more than ``min_gain``
     in the linear cross-validation, and (with ``confirm``) lowering the refitted model's
@@ -243,7 +260,7 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             regressors = problem.linearise(effects)
         scored = []
         r_rms = None
-        basis: tuple = (None, None)  # the current model's columns and their orthonormal basis
+        basis: Optional[tuple[FloatArray, FloatArray]] = None  # the current model's columns and their orthonormal basis
         for c in candidates:
             if any(e.name == c.name and e.joint == c.joint for e in effects):
                 continue
@@ -252,9 +269,9 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
             r, Jc, R = regressors(c)
             if r_rms is None:
                 r_rms = float(np.sqrt(np.mean(np.asarray(r) ** 2))) if len(r) else 0.0
-            if basis[0] is not Jc:
+            if basis is None or basis[0] is not Jc:
                 basis = (Jc, _basis(Jc))
-            order: dict = {}
+            order: dict[str, Any] = {}
             ridge = None
             nested = variants(c, R) if variants else None
             if nested:
@@ -320,30 +337,31 @@ def search(problem: Problem, start: Sequence, candidates: Sequence, *, alpha: fl
                   linearised=None if steps and not refit else regressors)
 
 
-def _credited(s: dict) -> float:
+def _credited(s: dict[str, Any]) -> float:
     """The gain a candidate is credited with: its cross-validated gain, or what it gains on the
     Problem's own folds for it (a periodic effect on held-out ranges of its angle) when less."""
-    return min(s["cv_gain"], s.get("extrapolation_cv_gain", math.inf))
+    credited: float = min(s["cv_gain"], s.get("extrapolation_cv_gain", math.inf))
+    return credited
 
 
-class _Stepped:
+class _Stepped(Generic[E]):
     """The linearisation after a step taken without a refit (search's ``refit=False``): the step's
     candidate columns R join the model's Jc, and the residual is what their joint linear
     least-squares fit leaves of r (one Gauss-Newton step from the last fit); every candidate's
     columns stay those of the last fit."""
 
-    def __init__(self, base: Linearisation, r: np.ndarray, Jc: np.ndarray, R: np.ndarray):
+    def __init__(self, base: Linearisation[E], r: FloatArray, Jc: FloatArray, R: FloatArray) -> None:
         self.base = base
         self.Jc = np.hstack([Jc, R])
         Q = _basis(self.Jc)
         self.r = r - Q @ (Q.T @ r)
 
-    def __call__(self, cand) -> tuple:
+    def __call__(self, cand: E) -> tuple[FloatArray, FloatArray, FloatArray]:
         return self.r, self.Jc, self.base(cand)[2]
 
 
-def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int, noise_mm: Optional[float],
-             alpha: float = 1e-6, say: Callable[[str], None] = lambda s: None) -> dict:
+def conclude(problem: Problem[E], found: Search[E], errors: FloatArray, n_params: int, noise_mm: Optional[float],
+             alpha: float = 1e-6, say: Callable[[str], None] = lambda s: None) -> dict[str, Any]:
     """The verdict on what remains, from the final model's point errors fitted on every point
     (``errors``, ``n_params`` free parameters). noise_rms_mm: with ``noise_mm`` (the instrument's
     noise per coordinate, if known) its RMS per point; otherwise the final fit's own scatter, an
@@ -374,7 +392,7 @@ def conclude(problem: Problem, found: Search, errors: np.ndarray, n_params: int,
     return out
 
 
-def noise_phrase(diag: dict) -> str:
+def noise_phrase(diag: dict[str, Any]) -> str:
     """How a summary or report names the noise a verdict compares with: the instrument's, when given,
     or else the final fit's own scatter, which only bounds it (it also holds what no model explains)."""
     if diag["noise_known"]:
@@ -385,7 +403,8 @@ def noise_phrase(diag: dict) -> str:
             f"--noise gives it)")
 
 
-def contract_json(diag: dict) -> dict:
+def contract_json(diag: dict[str, Any]) -> dict[str, Any]:
     """diagnosis.json: the contract's keys and the evidence, without the fitted objects (an infinite
     F statistic, from a perfect fit, is written as null: JSON has no infinity)."""
-    return strict_json.finite_or_none({k: v for k, v in diag.items() if not k.startswith("_")})
+    out: dict[str, Any] = strict_json.finite_or_none({k: v for k, v in diag.items() if not k.startswith("_")})
+    return out

@@ -5,17 +5,23 @@ geometry beside the chosen model's."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any, Optional
+
 from .. import _core
 from . import effect_choice
 from .fitting import rms
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val: dict, k_folds: int) -> dict:
+
+def choice_report(top: effect_choice.Choice, fold_choices: list[Optional[effect_choice.Choice]],
+                  e: dict[str, FloatArray], val: dict[str, Any], k_folds: int) -> dict[str, Any]:
     """What `--effects auto` tried and kept: each candidate with its F-test, its linear
     cross-validated gain and RMS in the last round (kept: in the step that took it), how many of
     the validation's training folds kept each effect, and the held-out RMS of the starting model
     (the geometry) beside the chosen one's."""
-    tried: dict = {}
+    tried: dict[str, dict[str, Any]] = {}
     kept_labels = {x.label for x in top.effects}
     last = len(top.search.history) - 1
     for i, h in enumerate(top.search.history):
@@ -32,11 +38,11 @@ def choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val:
         if label in tried:
             tried[label]["kept"] = True
             tried[label]["step"] = k + 1
-    counts: dict = {}
+    counts: dict[str, int] = {}
     for ch in fold_choices:
         for x in (ch.effects if ch is not None else []):
             counts[x.label] = counts.get(x.label, 0) + 1
-    out = {"mode": "auto", "rule": f"F-test p < {effect_choice.ALPHA:g} and linear cross-validated gain > "
+    out: dict[str, Any] = {"mode": "auto", "rule": f"F-test p < {effect_choice.ALPHA:g} and linear cross-validated gain > "
                                    f"{effect_choice.MIN_GAIN:.0%} (the diagnosis's), on {k_folds} folds of "
                                    "whole configurations",
            "kept": kept, "tried": sorted(tried.values(), key=lambda t: (not t["kept"], t.get("step", 0), -t["cv_gain"])),
@@ -48,7 +54,7 @@ def choice_report(top: "effect_choice.Choice", fold_choices: list, e: dict, val:
     return out
 
 
-def _label_of(c: dict) -> str:
+def _label_of(c: dict[str, Any]) -> str:
     """A scored candidate's label (as _core.Effect.label names it)."""
     if c.get("gravity"):
         return effect_choice.JointCompliance(c["gravity"]).label
@@ -57,7 +63,7 @@ def _label_of(c: dict) -> str:
     return _core.Effect(c["effect"], c["joint"] or 0).label
 
 
-def choice_lines(ch: dict) -> list:
+def choice_lines(ch: dict[str, Any]) -> list[str]:
     """The summary's lines on `--effects auto`: every candidate tried, with its test and its
     cross-validated RMS, what was kept, how often the training folds kept it, and the held-out RMS
     of the geometry beside the chosen model's."""

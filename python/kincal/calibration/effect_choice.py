@@ -23,7 +23,7 @@ ranges of that angle. Candidates are scored on the robust pseudo-residual (robus
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -32,6 +32,9 @@ from ..stats import stepwise as engine
 from .._core import Robot
 from .fitting import FitOptions, folds as grouped_folds, gravity_fitted, point_errors, subset
 from ..stats.robust_scores import loss_threshold, robust_noise, robust_weights
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 #: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
 MAX_MAP_ORDER = 8
@@ -57,9 +60,9 @@ class JointCompliance:
     name = "joint_compliance"
     joint = 0
     order = 0
-    harmonics: tuple = ()
+    harmonics: tuple[int, ...] = ()
 
-    def __init__(self, gravity: str = "masses"):
+    def __init__(self, gravity: str = "masses") -> None:
         if gravity not in ("masses", "fit"):
             raise ValueError(f"joint compliance's gravity is 'masses' or 'fit', not '{gravity}'")
         self.gravity = gravity
@@ -68,7 +71,7 @@ class JointCompliance:
     def label(self) -> str:
         return "joint_compliance" if self.gravity == "masses" else "joint_compliance (fitted mass moments)"
 
-    def __eq__(self, other) -> bool:
+    def __eq__(self, other: object) -> bool:
         return isinstance(other, JointCompliance) and other.gravity == self.gravity
 
     def __hash__(self) -> int:
@@ -78,7 +81,12 @@ class JointCompliance:
         return self.label
 
 
-def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
+#: a candidate of the serial robot's search, and an effect of its model: an effect of the core's
+#: registry, or joint compliance on every gravity-loaded joint as one
+Candidate = Union[_core.Effect, JointCompliance]
+
+
+def applicable_joints(robot: Robot, kind: _core.EffectKind) -> list[int]:
     """Joints (from 1) where a joint-wise effect applies: the gravity-loaded ones (from the
     identification layout) for an effect that needs gravity, every joint otherwise."""
     if kind.gravity_loaded_only:
@@ -86,17 +94,18 @@ def applicable_joints(robot: Robot, kind: "_core.EffectKind") -> list:
     return list(range(1, robot.dof + 1))
 
 
-def _needs_column(kind) -> str:
+def _needs_column(kind: _core.EffectKind) -> str:
     """The measurement-set key of the column an effect kind reads ('' when none)."""
     return "dir" if kind.needs == "dir" else kind.needs
 
 
-def candidates(robot: Robot, data: dict, start: Sequence = (), gravity: str = "auto") -> tuple[list, list]:
+def candidates(robot: Robot, data: dict[str, Any], start: Sequence[Candidate] = (),
+               gravity: str = "auto") -> tuple[list[Candidate], list[str]]:
     """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
     compliance as one JointCompliance in the form ``gravity`` gives) the data can support, and notes
     on those skipped. Effects of ``start`` (the model the search starts from) are no candidates."""
-    out: list = []
-    notes: list = []
+    out: list[Candidate] = []
+    notes: list[str] = []
     have = {(e.name, e.joint) for e in start}
     for kind in _core.effect_kinds():
         if kind.domain != "serial":
@@ -131,10 +140,10 @@ def candidates(robot: Robot, data: dict, start: Sequence = (), gravity: str = "a
     return out, notes
 
 
-def expand(effects: Sequence, robot: Robot) -> tuple[list, Optional[str]]:
+def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effect], Optional[str]]:
     """The core's effects of a model (JointCompliance as joint_compliance on every gravity-loaded
     joint) and the gravity mode it needs (None: the options' own)."""
-    out: list = []
+    out: list[_core.Effect] = []
     gravity = None
     for e in effects:
         if isinstance(e, JointCompliance):
@@ -150,26 +159,26 @@ class Spec:
     """The model under test: its effects (joint_compliance per joint, or JointCompliance) and the fit's
     options (a FitOptions)."""
 
-    def __init__(self, robot: Robot, effects: Sequence = (), penalties: Sequence = (),
-                 fit: Optional[FitOptions] = None):
+    def __init__(self, robot: Robot, effects: Sequence[Candidate] = (), penalties: Sequence[tuple[str, float]] = (),
+                 fit: Optional[FitOptions] = None) -> None:
         self.robot = robot
-        self.effects: list = list(effects)
-        self.penalties: list = list(penalties)  # (parameter name, weight): ridge penalties of the fit
+        self.effects: list[Candidate] = list(effects)
+        self.penalties: list[tuple[str, float]] = list(penalties)  # (parameter name, weight): ridge penalties of the fit
         self.fit_options = fit or FitOptions()
 
-    def with_(self, cand, penalties: Sequence = ()) -> "Spec":
+    def with_(self, cand: Candidate, penalties: Sequence[tuple[str, float]] = ()) -> Spec:
         return Spec(self.robot, self.effects + [cand], self.penalties + list(penalties), self.fit_options)
 
-    def penalties_of(self, effect) -> list:
+    def penalties_of(self, effect: Candidate) -> list[tuple[str, float]]:
         """The penalties on an effect's parameters."""
         names = {f"joint{effect.joint}.{n}" for n in getattr(effect, "parameter_names", ())}
         return [p for p in self.penalties if p[0] in names]
 
-    def has(self, cand) -> bool:
+    def has(self, cand: Candidate) -> bool:
         return any(e.name == cand.name and e.joint == cand.joint for e in self.effects)
 
     @property
-    def core_effects(self) -> list:
+    def core_effects(self) -> list[_core.Effect]:
         return expand(self.effects, self.robot)[0]
 
     @property
@@ -177,26 +186,27 @@ class Spec:
         return expand(self.effects, self.robot)[1] or self.fit_options.gravity
 
     @property
-    def compliance(self) -> list:
+    def compliance(self) -> list[int]:
         return [e.joint for e in self.core_effects if e.name == "joint_compliance"]
 
     def label(self) -> str:
         return " + ".join(["geometry"] + [e.label for e in self.effects])
 
-    def fit(self, data: dict, covariance: bool = False) -> "_core.IdentifyResult":
+    def fit(self, data: dict[str, Any], covariance: bool = False) -> _core.IdentifyResult:
         eff, gravity = expand(self.effects, self.robot)
         return self.fit_options.fit(self.robot, data, eff, covariance=covariance, penalties=self.penalties,
                                     gravity=gravity)
 
-    def errors(self, res, data: dict) -> np.ndarray:
+    def errors(self, res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
         return point_errors(res, data)
 
 
-def _key(p) -> tuple:
+def _key(p: _core.Parameter) -> tuple[str, int, int, str]:
     return (p.kind, p.joint, p.target, p.name)
 
 
-def evaluate(res, data: dict, extra: Sequence) -> tuple:
+def evaluate(res: _core.IdentifyResult, data: dict[str, Any], extra: Sequence[_core.Effect]
+             ) -> tuple[FloatArray, FloatArray, FloatArray, list[_core.Parameter], dict[int, int]]:
     """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
     parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
     parameter index of each of them that is the fit's, by index)."""
@@ -207,8 +217,8 @@ def evaluate(res, data: dict, extra: Sequence) -> tuple:
     # the fit's parameters by name, not by place: the calibrated model may carry one the fit's did not
     # (a joint 1 whose identified tilt puts it under gravity gains a compliance, inserted before the
     # targets); an extra effect may repeat one of the fit's (its names come again, after the fit's)
-    fit_of: dict = {}
-    taken: set = set()
+    fit_of: dict[int, int] = {}
+    taken: set[int] = set()
     for p in new:
         k = old.get(_key(p))
         if k is not None and k not in taken:
@@ -228,7 +238,7 @@ def evaluate(res, data: dict, extra: Sequence) -> tuple:
     return np.asarray(r), cur, J, new, fit_of
 
 
-def fitted_compliance_columns(res, data: dict, spec: "Spec") -> np.ndarray:
+def fitted_compliance_columns(res: _core.IdentifyResult, data: dict[str, Any], spec: Spec) -> FloatArray:
     """The columns of JointCompliance("fit") for a model fitted without compliance (``res``, the model
     ``spec``): the model with it is fitted (its torques' mass moments with it), and its compliance
     columns are taken at that fit: each joint's deflection under the torques of the fitted moments.
@@ -240,7 +250,8 @@ def fitted_compliance_columns(res, data: dict, spec: "Spec") -> np.ndarray:
     idx = [p.index for p in new if p.kind == "compliance"]
     R = J[:, idx]
     n = np.linalg.norm(R, axis=0)
-    return R[:, n > 0] / n[n > 0]
+    cols: FloatArray = R[:, n > 0] / n[n > 0]
+    return cols
 
 
 class _Linearised:
@@ -250,19 +261,20 @@ class _Linearised:
     residual as the pseudo-residual of the fit's robust loss (robust_weights). ``step(cand)``: the
     linearisation after a step taken without a refit."""
 
-    def __init__(self, res, data: dict, candidates: Sequence, robot: Robot, dims: int, fit: FitOptions,
-                 spec: Optional["Spec"] = None):
+    def __init__(self, res: _core.IdentifyResult, data: dict[str, Any], candidates: Sequence[Candidate], robot: Robot,
+                 dims: int, fit: FitOptions, spec: Optional[Spec] = None) -> None:
         self.res, self.data, self.robot, self.dims, self.fit, self.spec = res, data, robot, dims, fit, spec
         have = {(e.name, e.joint) for e in res.layout.effect_list}
-        self.extra = [c for c in candidates if c.name != "joint_compliance" and (c.name, c.joint) not in have]
-        self.cols: Optional[dict] = None
-        self.added: list = []  # the columns of the steps taken since the fit (unweighted)
-        self.r_now: Optional[np.ndarray] = None  # the residual after them (unweighted; None: the fit's)
+        self.extra = [c for c in candidates if isinstance(c, _core.Effect) and c.name != "joint_compliance"
+                      and (c.name, c.joint) not in have]
+        self.cols: Optional[dict[tuple[str, int, tuple[int, ...], str], tuple[FloatArray, FloatArray, FloatArray]]] = None
+        self.added: list[FloatArray] = []  # the columns of the steps taken since the fit (unweighted)
+        self.r_now: Optional[FloatArray] = None  # the residual after them (unweighted; None: the fit's)
         self.scale: Optional[float] = None  # where the candidates' scores bend (from the residual's spread)
-        self.w: Optional[np.ndarray] = None
-        self._stacked: Optional[tuple] = None  # (the fit's columns, them with the added ones)
+        self.w: Optional[FloatArray] = None
+        self._stacked: Optional[tuple[FloatArray, FloatArray]] = None  # (the fit's columns, them with the added ones)
 
-    def raw(self, cand) -> tuple:
+    def raw(self, cand: Candidate) -> tuple[FloatArray, FloatArray, FloatArray]:
         """The unweighted residual, current columns and candidate columns at the fit."""
         if self.cols is None:
             self.r, self.cur, self.J, self.new, self.fit_of = evaluate(self.res, self.data, self.extra)
@@ -273,7 +285,7 @@ class _Linearised:
                 spec = self.spec or Spec(self.robot, list(self.res.layout.effect_list), fit=self.fit)
                 self.cols[key] = (self.r, self.cur, fitted_compliance_columns(self.res, self.data, spec))
                 return self.cols[key]
-            if cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
+            if isinstance(cand, _core.Effect) and cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
                 r, cur, J, new, fit_of = evaluate(self.res, self.data, [cand])  # not among the round's candidates
             else:
                 r, cur, J, new, fit_of = self.r, self.cur, self.J, self.new, self.fit_of
@@ -283,7 +295,7 @@ class _Linearised:
             self.cols[key] = (r, cur, J[:, idx])
         return self.cols[key]
 
-    def __call__(self, cand) -> tuple:
+    def __call__(self, cand: Candidate) -> tuple[FloatArray, FloatArray, FloatArray]:
         r, cur, R = self.raw(cand)
         if self.r_now is not None:
             r = self.r_now
@@ -295,7 +307,7 @@ class _Linearised:
             self.w = self._weights(r, cur.shape[1])
         return r * self.w, cur, R
 
-    def _weights(self, r: np.ndarray, p: int) -> np.ndarray:
+    def _weights(self, r: FloatArray, p: int) -> FloatArray:
         """The pseudo-residuals' weights of the residual r (p parameters fitted): the fit's loss, bending
         where the residual's own robust spread puts it (4.03 x; the fit's own bend, e.g. a fixed
         0.1 mm, would clip the very structure a candidate is to explain when the model lacks it)."""
@@ -303,7 +315,7 @@ class _Linearised:
             self.scale = loss_threshold(robust_noise(r, self.dims, p), self.dims)
         return robust_weights(r, self.dims, self.fit.loss, self.scale)
 
-    def step(self, cand) -> "_Linearised":
+    def step(self, cand: Candidate) -> _Linearised:
         """The linearisation after ``cand`` was added without a refit: its columns join the model's,
         the residual is what their joint fit leaves (one reweighted Gauss-Newton step of the robust
         fit), and the robust loss's scale (when it comes from the data) and weights follow
@@ -329,32 +341,33 @@ class SerialProblem:
     and the fitting options of every fit; ``fits``: every linearisation's fit, in order. ``dims``:
     residual coordinates per row (3; 6 with measured orientations)."""
 
-    def __init__(self, robot: Robot, data: dict, folds: list, fit: FitOptions, candidates: Sequence = ()):
+    def __init__(self, robot: Robot, data: dict[str, Any], folds: list[BoolArray], fit: FitOptions,
+                 candidates: Sequence[Candidate] = ()) -> None:
         self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit
         self.candidates = list(candidates)
-        self.penalty: dict = {}  # (name, joint, order) -> the penalties of the variant chosen
-        self.fits: list = []
+        self.penalty: dict[tuple[str, int, int], list[tuple[str, float]]] = {}  # (name, joint, order) -> the penalties of the variant chosen
+        self.fits: list[tuple[list[Candidate], _core.IdentifyResult]] = []
         self.dims = 6 if "abc" in data else 3
         self.point_dims = 3
         #: a residual below this (mm per coordinate) is the computation's, not the data's: noise-free data
         self.resolution = 1e-6
 
-    def spec(self, effects: Sequence) -> Spec:
+    def spec(self, effects: Sequence[Candidate]) -> Spec:
         pen = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]
         return Spec(self.robot, effects, pen, self.fit_options)
 
-    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+    def held_errors(self, effects: list[Candidate], held: BoolArray) -> FloatArray:
         spec = self.spec(effects)
         res = spec.fit(subset(self.data, ~held))
         return spec.errors(res, subset(self.data, held))
 
-    def linearise(self, effects: list) -> engine.Linearisation:
+    def linearise(self, effects: list[Candidate]) -> _Linearised:
         spec = self.spec(effects)
         res = spec.fit(self.data)
         self.fits.append((list(effects), res))
         return _Linearised(res, self.data, self.candidates, self.robot, self.dims, self.fit_options, spec)
 
-    def variants(self, cand, R: np.ndarray) -> Optional[list]:
+    def variants(self, cand: Candidate, R: FloatArray) -> Optional[list[tuple[_core.Effect, int, FloatArray]]]:
         """joint_map's orders 1..K (its columns R: sine and cosine of each order, in order), each with
         each smoothness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights).
         The library's transmission_error is fitted as it always was, without a penalty."""
@@ -365,7 +378,7 @@ class SerialProblem:
         return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * kw[:2 * k])
                 for k in range(1, cand.order + 1) for lam in MAP_SMOOTHING]
 
-    def variant_folds(self, cand) -> list:
+    def variant_folds(self, cand: Candidate) -> list[BoolArray]:
         """joint_map's order and smoothing are chosen holding out, in turn, each of VARIANT_BLOCKS
         contiguous ranges of the joint's angle (equal numbers of points):
         a map must predict angles it has not seen, as it will on the next campaign."""
@@ -374,14 +387,14 @@ class SerialProblem:
         block = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, VARIANT_BLOCKS - 1)
         return [block == b for b in range(VARIANT_BLOCKS)]
 
-    def size(self, effect) -> int:
+    def size(self, effect: Candidate) -> int:
         """How many parameters an effect adds (none of them with a prior by default)."""
         if isinstance(effect, JointCompliance):
             layout = _core.PointModel(self.robot, 1, fit_gravity=effect.gravity == "fit").layout
             return sum(p.kind in ("compliance", "gravity_moment") for p in layout.parameters)
         return int(effect.size)
 
-    def admits(self, effects: Sequence, cand) -> bool:
+    def admits(self, effects: Sequence[Candidate], cand: Candidate) -> bool:
         """Whether the model with ``cand`` added keeps no more parameters without a prior than the data
         have points (the core refuses such a fit): the starting fit's and every added effect's."""
         if not self.fits:
@@ -392,7 +405,7 @@ class SerialProblem:
         added = sum(self.size(e) for e in list(effects)[len(start_effects):]) + self.size(cand)
         return unconstrained + added < len(self.data["pose"])
 
-    def score_folds(self, cand) -> Optional[list]:
+    def score_folds(self, cand: Candidate) -> Optional[list[BoolArray]]:
         """The folds on which a candidate must also gain (besides the configurations'): for a periodic
         error of a joint angle (transmission_error, joint_map), holding out in turn each of
         VARIANT_BLOCKS ranges of that angle. Such an effect must predict angles it has not seen, as on
@@ -400,40 +413,40 @@ class SerialProblem:
         (the gravity's) is not kept for the turn."""
         return self.variant_folds(cand) if cand.name in PERIODIC else None
 
-    def variant_evidence(self, cand, i: int, gains: Sequence[float]) -> dict:
+    def variant_evidence(self, cand: Candidate, i: int, gains: Sequence[float]) -> dict[str, Any]:
         """A joint_map step's evidence: the order and smoothing chosen, and the best gain of each order
         1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
         g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
-        out: dict = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
+        out: dict[str, Any] = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
         if cand.name == "joint_map":
             out["order"] = cand.order
             out["order_range_cv_gain"] = [round(float(x), 6) for x in g.max(axis=1)]
         return out
 
-    def chosen(self, cand, ridge: np.ndarray) -> None:
+    def chosen(self, cand: _core.Effect, ridge: FloatArray) -> None:
         """The variant chosen for a candidate: its fits carry that penalty (weights in mm per rad)."""
         names = [f"joint{cand.joint}.{n}" for n in cand.parameter_names]
         self.penalty[(cand.name, cand.joint, cand.order)] = [(n, float(w)) for n, w in zip(names, ridge)]
 
-    def covered(self, cand, candidates: Sequence) -> bool:
+    def covered(self, cand: Candidate, candidates: Sequence[Candidate]) -> bool:
         """A joint_map of order 1 or 2 is the library's transmission_error (orders 1, 2) where that is a
         candidate on the same joint: the library's name is kept."""
         return cand.name == "joint_map" and cand.order <= 2 and any(
             c.name == "transmission_error" and c.joint == cand.joint and set(range(1, cand.order + 1)) <= set(c.harmonics)
             for c in candidates)
 
-    def describe(self, effect) -> dict:
-        d: dict = {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
+    def describe(self, effect: Candidate) -> dict[str, Any]:
+        d: dict[str, Any] = {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
         if effect.name == "joint_map":
             d["order"] = effect.order
         if isinstance(effect, JointCompliance):
             d["gravity"] = effect.gravity
         return d
 
-    def label(self, effect) -> str:
+    def label(self, effect: Candidate) -> str:
         return effect.label
 
-    def model_label(self, effects: list) -> str:
+    def model_label(self, effects: list[Candidate]) -> str:
         return self.spec(effects).label()
 
 
@@ -442,16 +455,16 @@ class Choice:
     """What a choice of effects found on one data set: the effects (the starting ones and those
     kept), the search (stepwise.Search), the candidates and the notes on those skipped, and the model
     with the effects fitted on that data set (``fit``, an IdentifyResult; ``spec``: its Spec)."""
-    effects: list
-    search: engine.Search
-    candidates: list
-    notes: list
+    effects: list[Candidate]
+    search: engine.Search[Candidate]
+    candidates: list[Candidate]
+    notes: list[str]
     spec: Spec
-    fit: Any
+    fit: Optional[_core.IdentifyResult]
     problem: Optional[SerialProblem] = field(repr=False, default=None)
 
 
-def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k_folds: int = 5, seed: int = 0,
+def choose(robot: Robot, data: dict[str, Any], fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5, seed: int = 0,
            max_steps: int = 6, say: Callable[[str], None] = lambda s: None, fit_chosen: bool = True) -> Choice:
     """`--effects auto` on one data set: the stepwise search over the candidates from the
     ``start`` effects (the significance rule of the diagnosis: ALPHA, MIN_GAIN, on ``k_folds`` folds
@@ -468,6 +481,7 @@ def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k
     found = engine.search(problem, start, cands, alpha=ALPHA, min_gain=MIN_GAIN, max_steps=max_steps, say=say,
                           confirm=False, listed=len(cands), refit=False)
     spec = problem.spec(found.effects)
+    res: Optional[_core.IdentifyResult]
     if isinstance(found.linearised, _Linearised):  # no step taken: the starting fit is the model's
         res = found.linearised.res
     else:
@@ -475,12 +489,16 @@ def choose(robot: Robot, data: dict, fit: FitOptions, *, start: Sequence = (), k
     return Choice(found.effects, found, cands, notes, spec, res, problem)
 
 
-def start_fit(choice: Choice):
-    """The starting model fitted on the choice's data (the first linearisation's fit)."""
-    return choice.problem.fits[0][1] if choice.problem and choice.problem.fits else choice.fit
+def start_fit(choice: Choice) -> _core.IdentifyResult:
+    """The starting model fitted on the choice's data (the first linearisation's fit; a choice made
+    without a search carries its fit)."""
+    if choice.problem and choice.problem.fits:
+        return choice.problem.fits[0][1]
+    assert choice.fit is not None, "a choice without a search carries its fit"
+    return choice.fit
 
 
-def check_data(effects: Sequence, data: dict, robot: Robot) -> None:
+def check_data(effects: Sequence[Candidate], data: dict[str, Any], robot: Robot) -> None:
     """The data columns the effects read (the registry's ``needs``) are present: a clear error names
     the file and the column otherwise."""
     src = data.get("source", "<data>")

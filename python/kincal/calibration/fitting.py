@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -25,6 +25,9 @@ from .. import _core
 from ..stats import grouping
 from . import priors
 from .._core import Robot
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 LOSSES = ("none", "huber", "cauchy")
 #: where the robust loss bends unless told (mm; None: from the residuals' robust spread; BENCHMARKS.md "One
@@ -44,14 +47,14 @@ class FitOptions:
     nominal model); ``gravity``: the compliances' gravity torques (auto, masses, fit)."""
     loss: str = "huber"
     loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM
-    prior_sd: Optional[dict] = None
+    prior_sd: Optional[dict[str, float]] = None
     prior_scale: Optional[float] = 1.0
     prior_model: Optional[Robot] = None
     gravity: str = "auto"
     orientation_weight: float = 100.0
     max_iterations: int = 100
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.loss not in LOSSES:
             raise ValueError(f"unknown loss '{self.loss}' ({', '.join(LOSSES)})")
         if self.gravity not in GRAVITY:
@@ -62,15 +65,15 @@ class FitOptions:
         if self.max_iterations < 1:
             raise ValueError(f"the iteration cap must be at least 1, not {self.max_iterations}")
 
-    def with_(self, **changes) -> "FitOptions":
+    def with_(self, **changes: Any) -> FitOptions:
         return replace(self, **changes)
 
     @property
     def auto_prior_scale(self) -> bool:
         return self.prior_scale is None
 
-    def core(self, effects: Sequence = (), *, covariance: bool = True, penalties: Sequence = (),
-             gravity: Optional[str] = None) -> "_core.IdentifyOptions":
+    def core(self, effects: Sequence[_core.Effect] = (), *, covariance: bool = True,
+             penalties: Sequence[tuple[str, float]] = (), gravity: Optional[str] = None) -> _core.IdentifyOptions:
         """The core's IdentifyOptions for a model with ``effects`` (``gravity`` overrides the mode)."""
         return options(effects, loss=self.loss, loss_scale_mm=self.loss_scale_mm or 0.0, covariance=covariance,
                        orientation_weight=self.orientation_weight, max_iterations=self.max_iterations,
@@ -83,18 +86,19 @@ class FitOptions:
         fit by grouped cross-validation when ``prior_scale`` is None)."""
         return priors.Fitter(robot, self.prior_model, auto_scale=self.auto_prior_scale, seed=seed)
 
-    def fit(self, robot: Robot, data: dict, effects: Sequence = (), *, covariance: bool = False,
-            penalties: Sequence = (), gravity: Optional[str] = None, seed: int = 0,
-            progress: Optional[Callable[[int, float], None]] = None) -> "_core.IdentifyResult":
+    def fit(self, robot: Robot, data: dict[str, Any], effects: Sequence[_core.Effect] = (), *, covariance: bool = False,
+            penalties: Sequence[tuple[str, float]] = (), gravity: Optional[str] = None, seed: int = 0,
+            progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         """One fit of ``data`` with these options."""
         return self.fitter(robot, seed)(data, self.core(effects, covariance=covariance, penalties=penalties,
                                                          gravity=gravity), progress)
 
 
-def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float = 0.1, covariance: bool = True,
-            orientation_weight: float = 100.0, max_iterations: int = 100,
-            fix: Sequence[str] = (), penalties: Sequence = (), prior_sd: Optional[dict] = None,
-            prior_scale: float = 0.0, gravity: str = "auto") -> "_core.IdentifyOptions":
+def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_scale_mm: float = 0.1,
+            covariance: bool = True, orientation_weight: float = 100.0, max_iterations: int = 100,
+            fix: Sequence[str] = (), penalties: Sequence[tuple[str, float]] = (),
+            prior_sd: Optional[dict[str, float]] = None, prior_scale: float = 0.0,
+            gravity: str = "auto") -> _core.IdentifyOptions:
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
@@ -110,31 +114,31 @@ def options(effects: Sequence = (), *, loss: str = "huber", loss_scale_mm: float
     return o
 
 
-def subset(data: dict, mask: np.ndarray) -> dict:
+def subset(data: dict[str, Any], mask: BoolArray) -> dict[str, Any]:
     """The rows ``mask`` of a measurement set (its other entries as they are)."""
     return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()}
 
 
-def folds(data: dict, k: int, seed: int = 0) -> list:
+def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
     """k masks of held-out rows, whole configurations per fold, as many as the configurations allow
     (at least 2 configurations; none when fewer)."""
     k = min(k, grouping.configurations(data).count)
     return grouping.folds(data, k, seed) if k >= 2 else []
 
 
-def rms(e: np.ndarray) -> float:
+def rms(e: FloatArray) -> float:
     """The root mean square of errors (of the 3-D distances, or of angles); NaN for none (undefined:
     null in the files, strict_json)."""
     return float(np.sqrt(np.mean(np.square(e)))) if len(e) else float("nan")
 
 
-def orientation_errors_deg(robot: Robot, data: dict) -> np.ndarray:
+def orientation_errors_deg(robot: Robot, data: dict[str, Any]) -> FloatArray:
     """Angle (deg) between the measured and the predicted tool orientation of every 6-D row (each
     row seen from its setup's placement, the model's drift at its time)."""
     return np.asarray(_core.orientation_errors(robot, data))
 
 
-def point_errors(res: "_core.IdentifyResult", data: dict) -> np.ndarray:
+def point_errors(res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
     """3-D distance (mm) between each measured point and the fitted model's prediction."""
     return np.asarray(_core.point_errors(res.robot, res.targets, data))
 

@@ -12,12 +12,14 @@ only compliance x moment, so one compliance is held as the scale and the written
 
 from __future__ import annotations
 
+from typing import Any
+
 from .. import _core
 
 MODES = ("auto", "masses", "fit")
 
 
-def _held_scale(fit: "_core.IdentifyResult") -> dict | None:
+def _held_scale(fit: _core.IdentifyResult) -> dict[str, Any] | None:
     """The compliance held as the scale of the fitted moments (name, value), if one is."""
     for p, x, fx, why in zip(fit.layout.parameters, fit.x, fit.fixed, fit.fixed_reason):
         if p.kind == "compliance" and fx and why.startswith("the scale of the fitted mass moments"):
@@ -25,12 +27,12 @@ def _held_scale(fit: "_core.IdentifyResult") -> dict | None:
     return None
 
 
-def report(fit: "_core.IdentifyResult") -> dict:
+def report(fit: _core.IdentifyResult) -> dict[str, Any]:
     """The model JSON's ``identification.gravity``: the source of the gravity torques and, when fitted,
     the held scale and what the written masses mean."""
     if fit.layout.gravity != "fit":
         return {"source": "masses", "text": "the model's link masses and centres of mass"}
-    out: dict = {"source": "fit",
+    out: dict[str, Any] = {"source": "fit",
                  "text": "no mass table: each link's first moment across its joint's axis identified with the "
                          "compliances (compliance x moment is what the points see)",
                  "link_masses": "effective (1 kg per fitted link, centre of mass placed to give the identified "
@@ -42,7 +44,7 @@ def report(fit: "_core.IdentifyResult") -> dict:
     return out
 
 
-def summary_line(fit: "_core.IdentifyResult") -> str:
+def summary_line(fit: _core.IdentifyResult) -> str:
     """One line of the identify summary saying where the gravity torques came from."""
     if fit.layout.gravity != "fit":
         return "gravity torques of the compliances: from the model's link masses (--gravity masses)"

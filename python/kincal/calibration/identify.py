@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field, replace
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -22,13 +22,20 @@ from ..io import strict_json
 from .._core import Robot
 from .choice_report import choice_lines, choice_report
 from .tool_frame import tcp_summary_line, tool_from_targets as place
-from .effect_choice import applicable_joints, check_data as check_data_for  # noqa: F401  (as before)
-from .fitting import (DEFAULT_LOSS_SCALE_MM, FitOptions, options, orientation_errors_deg,  # noqa: F401  (as before)
-                      rms, subset)
-from .setups import drift_report, setup_frames, validation_figures, validation_summary  # noqa: F401
-from .setups import _refit_placements, validate  # noqa: F401  (kincal.identify.validate, as before)
-from .simulation import (DEFAULT_HARMONICS, DEFAULT_INSTRUMENT, DEFAULT_TARGETS,  # noqa: F401  (as before)
-                         default_truth, parse_hidden_effect, simulate)
+from .effect_choice import Candidate, applicable_joints, check_data as check_data_for
+from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, orientation_errors_deg, point_errors, rms, subset
+from .setups import _refit_placements, drift_report, setup_frames
+from .simulation import DEFAULT_HARMONICS
+# the names kincal.identify had before the calibration package, re-exported (`X as X`: explicitly, for mypy)
+from .fitting import options as options
+from .setups import (validate as validate, validation_figures as validation_figures,
+                     validation_summary as validation_summary)
+from .simulation import (DEFAULT_INSTRUMENT as DEFAULT_INSTRUMENT, DEFAULT_TARGETS as DEFAULT_TARGETS,
+                         default_truth as default_truth, parse_hidden_effect as parse_hidden_effect,
+                         simulate as simulate)
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 #: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
 DEFAULT_MAP_ORDER = 4
@@ -37,7 +44,7 @@ CHOICE_FOLDS = 5
 
 
 def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS,
-                  option: str = "--effects") -> list:
+                  option: str = "--effects") -> list[_core.Effect]:
     """The effects of ``--effects``: comma separated ``NAME`` (every joint where it applies: joint
     compliance only on the gravity-loaded joints) or ``NAME:J`` (joint J, from 1); ``joint_map:J:K``
     gives joint_map's order K (default DEFAULT_MAP_ORDER); ``none`` or an empty text is the geometry
@@ -48,7 +55,7 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
         return []
     serial = [k for k in _core.effect_kinds() if k.domain == "serial"]
     known = ", ".join(k.name for k in serial)
-    out: list = []
+    out: list[_core.Effect] = []
     for item in items:
         name, _, joint = item.partition(":")
         name = name.strip()
@@ -93,26 +100,26 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     return out
 
 
-def read_measurements(path: str, robot: Robot) -> dict:
+def read_measurements(path: str, robot: Robot) -> dict[str, Any]:
     """The measurement CSV of the contract (errors name file:line and cause)."""
     return _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
 
 
-def measurements_csv(data: dict, dof: int) -> str:
+def measurements_csv(data: dict[str, Any], dof: int) -> str:
     return _core.format_measurements(data, dof)
 
 
-def split_poses(data: dict, holdout: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def split_poses(data: dict[str, Any], holdout: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
     """Row masks (fit, held out): a share of the configurations held out whole (grouping.split)."""
     return grouping.split(data, holdout, seed)
 
 
-def folds(data: dict, k: int, seed: int = 0) -> list[np.ndarray]:
+def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
     """k masks of held-out rows, whole configurations per fold (grouping.folds)."""
     return grouping.folds(data, k, seed)
 
 
-def _figures(e: np.ndarray, when: str, unit: str) -> dict:
+def _figures(e: FloatArray, when: str, unit: str) -> dict[str, float]:
     """RMS, mean (the Samak paper's figure) and max of errors: {when}_rms_{unit}, ..."""
     return {f"{when}_rms_{unit}": rms(e), f"{when}_mean_{unit}": float(np.mean(e)), f"{when}_max_{unit}": float(np.max(e))}
 
@@ -122,14 +129,15 @@ class Identification:
     """What `kincal identify` found: the calibrated robot (with its identified effects), targets, the
     core's result (``fit``: an IdentifyResult) and the validation. ``effects``: the effects asked for."""
     robot: Robot
-    targets: np.ndarray
-    fit: "_core.IdentifyResult"
-    effects: list
-    validation: dict = field(default_factory=dict)
-    fit_info: dict = field(default_factory=dict)  #: priors.report(): the priors and the loss
-    worst: list = field(default_factory=list)  #: priors.down_weighted(): the most down-weighted rows
+    targets: FloatArray
+    fit: _core.IdentifyResult
+    effects: list[_core.Effect]
+    validation: dict[str, Any] = field(default_factory=dict)
+    fit_info: dict[str, Any] = field(default_factory=dict)  #: priors.report(): the priors and the loss
+    #: priors.down_weighted(): the most down-weighted rows
+    worst: list[tuple[int, int, float, float]] = field(default_factory=list)
 
-    def parameters(self) -> list:
+    def parameters(self) -> list[dict[str, Any]]:
         """Every parameter of the fit in the model file's units (angles in degrees: the core's radians
         converted), with its standard deviation, prior and why it was held, if it was."""
         f = self.fit
@@ -143,7 +151,7 @@ class Identification:
                 for p, v, s, fx, r, ap, ps in zip(f.layout.parameters, f.x, f.stddev, f.fixed, f.fixed_reason,
                                                   f.at_prior, f.prior_sd)]
 
-    def effect_labels(self) -> list:
+    def effect_labels(self) -> list[str]:
         return [e.label for e in self.effects]
 
     def model_json(self) -> str:
@@ -234,12 +242,13 @@ class Identification:
         return "\n".join(lines)
 
 
-def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> list:
+def check_effects(effects: Union[str, Iterable[Union[str, Candidate]]], robot: Robot,
+                  harmonics: Sequence[int] = DEFAULT_HARMONICS) -> list[Candidate]:
     """Effects as _core.Effect: a text of --effects, or a list of Effect objects and/or texts
     (``NAME`` or ``NAME:J``), checked against the registry and the robot."""
     if isinstance(effects, str):
-        return parse_effects(effects, robot, harmonics)
-    out: list = []
+        return list(parse_effects(effects, robot, harmonics))
+    out: list[Candidate] = []
     for e in effects:
         if isinstance(e, effect_choice.JointCompliance):
             out.append(e)
@@ -251,7 +260,7 @@ def check_effects(effects, robot: Robot, harmonics: Sequence[int] = DEFAULT_HARM
     return out
 
 
-def _errors(r: "_core.IdentifyResult", h: dict) -> dict:
+def _errors(r: _core.IdentifyResult, h: dict[str, Any]) -> dict[str, FloatArray]:
     """Position (and, with measured orientations, orientation) errors of the rows h: before (the
     nominal geometry, frames fitted) and after (the identified model r)."""
     out = {"ea": _core.point_errors(r.robot, r.targets, h), "eb": _core.point_errors(r.nominal_fitted,
@@ -263,13 +272,21 @@ def _errors(r: "_core.IdentifyResult", h: dict) -> dict:
     return out
 
 
-def _fold_errors(model_of: Callable, data: dict, held_masks, progress: Optional[Callable[[int, int], None]],
-                 refit: Optional[Callable] = None) -> tuple[dict, list]:
+#: a training set's model: the model fitted on it and its effect choice (None: the effects were given)
+ModelOf = Callable[[dict[str, Any]], "tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]"]
+#: the errors of a setup held out whole, on the model fitted on the others (_setup_refit)
+SetupRefit = Callable[[Robot, dict[str, Any]], "dict[str, FloatArray]"]
+
+
+def _fold_errors(model_of: ModelOf, data: dict[str, Any], held_masks: Sequence[BoolArray],
+                 progress: Optional[Callable[[int, int], None]], refit: Optional[SetupRefit] = None
+                 ) -> tuple[dict[str, FloatArray], list[Optional[effect_choice.Choice]]]:
     """_errors of every held-out row, each fold predicted by the model fitted without it
     (``model_of(train)``: (result, choice or None)); with ``refit`` (a setup held out whole) the held
     rows' placement and targets are refitted on them first. Returns the errors and each fold's
     choice."""
-    parts, choices = [], []
+    parts: list[dict[str, FloatArray]] = []
+    choices: list[Optional[effect_choice.Choice]] = []
     for i, held in enumerate(held_masks):
         if progress:
             progress(i, len(held_masks))
@@ -284,22 +301,25 @@ def _fold_errors(model_of: Callable, data: dict, held_masks, progress: Optional[
             continue
         part = _errors(model, subset(data, held))
         if choice is not None:  # the starting model fitted on the same rows: its held-out figure, for free
-            part["e0"] = effect_choice.point_errors(effect_choice.start_fit(choice), subset(data, held))
+            part["e0"] = point_errors(effect_choice.start_fit(choice), subset(data, held))
         parts.append(part)
     keys = dict.fromkeys(k for p in parts for k in p)  # a fold of reflector rows only has no orientation
     return {k: np.concatenate([p[k] for p in parts if k in p]) for k in keys}, choices
 
 
-def _setup_refit(loss: str, loss_scale_mm: float) -> Callable:
+def _setup_refit(loss: str, loss_scale_mm: float) -> SetupRefit:
     """The errors of a setup held out whole: its placement and targets refitted on its rows
     (validate()'s refit) on the model fitted on the other setups."""
-    def refit(robot: Robot, held: dict) -> dict:
+    def refit(robot: Robot, held: dict[str, Any]) -> dict[str, FloatArray]:
         ea, eb, oa, ob, _ = _refit_placements(robot, held, loss, loss_scale_mm)
-        return dict(ea=ea, eb=eb, **({"oa": oa, "ob": ob} if oa is not None else {}))
+        out = {"ea": ea, "eb": eb}
+        if oa is not None and ob is not None:  # measured orientations: both, or neither
+            out.update(oa=oa, ob=ob)
+        return out
     return refit
 
 
-def _fit_options(fit: Optional[FitOptions], **kw) -> FitOptions:
+def _fit_options(fit: Optional[FitOptions], **kw: Any) -> FitOptions:
     """The fitting options: ``fit`` when given, else made of identify()'s keywords (prior_scale
     "auto" or None: chosen by grouped cross-validation)."""
     if fit is not None:
@@ -309,13 +329,15 @@ def _fit_options(fit: Optional[FitOptions], **kw) -> FitOptions:
     return FitOptions(**kw)
 
 
-def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptions] = None, loss: str = "huber",
-             loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM, prior_sd: Optional[dict] = None, prior_scale=1.0,
+def identify(robot: Robot, data: dict[str, Any], *, effects: Union[str, Sequence[Union[str, Candidate]]] = "auto",
+             fit: Optional[FitOptions] = None, loss: str = "huber",
+             loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM, prior_sd: Optional[dict[str, float]] = None,
+             prior_scale: Union[float, str, None] = 1.0,
              prior_model: Optional[Robot] = None, holdout: Optional[float] = None, k_folds: int = 5, seed: int = 0,
              progress: Optional[Callable[[int, float], None]] = None,
              orientation_weight: float = 100.0, harmonics: Sequence[int] = DEFAULT_HARMONICS,
              fold_progress: Optional[Callable[[int, int], None]] = None,
-             penalties: Sequence = (), hold_out_setups: bool = False, gravity: str = "auto",
+             penalties: Sequence[tuple[str, float]] = (), hold_out_setups: bool = False, gravity: str = "auto",
              max_iterations: int = 100, say: Optional[Callable[[str], None]] = None) -> Identification:
     """Identify the robot's parameters from measurements.
 
@@ -357,15 +379,17 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
     holdout = holdout or None  # a share of 0 holds nothing out
     core_effects, gravity_of = effect_choice.expand(effects, robot)
 
-    def model_of(train: dict) -> tuple:
+    def model_of(train: dict[str, Any]) -> tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]:
         """The model of a training set: its effects chosen on it (auto), then fitted on it."""
         if auto:
             ch = effect_choice.choose(robot, train, fit, k_folds=CHOICE_FOLDS, seed=seed)
+            assert ch.fit is not None  # fit_chosen: the model chosen is fitted
             return ch.fit, ch
         return fit.fit(robot, train, core_effects, penalties=penalties, gravity=gravity_of, seed=seed), None
 
     every_row = np.ones(len(data["pose"]), dtype=bool)
-    refit = None
+    refit: Optional[SetupRefit] = None
+    val: dict[str, Any]
     if hold_out_setups:
         codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
         if len(np.unique(codes)) < 2:
@@ -388,8 +412,8 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
         fit_mask, masks = every_row, []
         val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
     # folds: each predicted by a model fitted (its effects chosen) without it; a split: by the delivered model
-    e: dict = {}
-    fold_choices: list = []
+    e: dict[str, FloatArray] = {}
+    fold_choices: list[Optional[effect_choice.Choice]] = []
     if masks and holdout is None:
         e, fold_choices = _fold_errors(model_of, data, masks, fold_progress, refit)
     train = subset(data, fit_mask)
@@ -406,7 +430,7 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
     if holdout is not None and val["held_rows"]:
         e = _errors(r, subset(data, ~fit_mask))
         if top is not None:
-            e["e0"] = effect_choice.point_errors(effect_choice.start_fit(top), subset(data, ~fit_mask))
+            e["e0"] = point_errors(effect_choice.start_fit(top), subset(data, ~fit_mask))
     if e:
         val.update(_figures(e["eb"], "before", "mm"), **_figures(e["ea"], "after", "mm"))
         if "oa" in e:
@@ -424,7 +448,7 @@ def identify(robot: Robot, data: dict, *, effects="auto", fit: Optional[FitOptio
                           validation=val, fit_info=info, worst=priors.down_weighted(r, train))
 
 
-def tool_from_targets(result: Identification, known: np.ndarray) -> Identification:
+def tool_from_targets(result: Identification, known: FloatArray) -> Identification:
     """The tool frame placed from known target offsets (tool_frame.tool_from_targets); the known
     offsets become the targets."""
     known = np.asarray(known, dtype=float).reshape(-1, 3)

@@ -23,13 +23,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core
 from . import identify as ident
 from .._core import Robot
+from .fitting import options, subset
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray, IntArray
 
 
 @dataclass
@@ -52,17 +56,17 @@ class KeepOut:
 @dataclass
 class Plan:
     """The chosen configurations (in path order) and what they promise."""
-    q_deg: np.ndarray
-    parameters: list                  #: names of the parameters the plan determines
-    stddev: np.ndarray                #: predicted standard deviation of each (its unit in ``units``)
-    units: list
-    left_out: list                    #: (name, reason) of the parameters no candidate determines
+    q_deg: FloatArray
+    parameters: list[str]             #: names of the parameters the plan determines
+    stddev: FloatArray                #: predicted standard deviation of each (its unit in ``units``)
+    units: list[str]
+    left_out: list[tuple[str, str]]   #: (name, reason) of the parameters no candidate determines
     tcp_uncertainty_mm: float         #: predicted RMS error of a point predicted at the candidates
     o1: float
     condition_number: float
     min_singular_value: float
     candidates: int                   #: candidates after the keep-out rules
-    rejected: dict = field(default_factory=dict)  #: rule -> candidates it removed
+    rejected: dict[str, int] = field(default_factory=dict)  #: rule -> candidates it removed
 
     def summary(self, noise_mm: float) -> str:
         lines = [f"{len(self.q_deg)} configurations chosen from {self.candidates} candidates (D-optimal)"]
@@ -80,13 +84,13 @@ class Plan:
         return "\n".join(lines)
 
 
-def random_candidates(robot: Robot, n: int, seed: int = 0) -> np.ndarray:
+def random_candidates(robot: Robot, n: int, seed: int = 0) -> FloatArray:
     """n configurations drawn uniformly inside the joint limits (deg)."""
     lim = np.asarray(robot.limits_deg, dtype=float)
     return np.random.default_rng(seed).uniform(lim[:, 0], lim[:, 1], size=(n, robot.dof))
 
 
-def _tool_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
+def _tool_frames(robot: Robot, q: FloatArray) -> FloatArray:
     """(n, 4, 4) tool frames (mm) in the base frame at the nominal model (R = Rz(a) Ry(b) Rx(c))."""
     pose = np.asarray(_core.fk(robot, q, False, False)).reshape(-1, 6)
     a, b, c = np.radians(pose[:, 3]), np.radians(pose[:, 4]), np.radians(pose[:, 5])
@@ -100,7 +104,7 @@ def _tool_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
     return f
 
 
-def keep_out(robot: Robot, q: np.ndarray, targets: np.ndarray, rules: KeepOut) -> tuple[np.ndarray, dict]:
+def keep_out(robot: Robot, q: FloatArray, targets: FloatArray, rules: KeepOut) -> tuple[BoolArray, dict[str, int]]:
     """Boolean mask of the candidates inside the joint limits and every rule, and how many each
     rule removed."""
     lim = np.asarray(robot.limits_deg, dtype=float)
@@ -138,7 +142,7 @@ def keep_out(robot: Robot, q: np.ndarray, targets: np.ndarray, rules: KeepOut) -
     return ok, {k: v for k, v in rejected.items() if v}
 
 
-def _campaign(robot: Robot, q: np.ndarray, targets: np.ndarray) -> dict:
+def _campaign(robot: Robot, q: FloatArray, targets: FloatArray) -> dict[str, Any]:
     """A noise-free campaign at the nominal model (the instrument at the base), for the Jacobian."""
     n, t = len(q), len(targets)
     frames = _tool_frames(robot, q)
@@ -149,7 +153,8 @@ def _campaign(robot: Robot, q: np.ndarray, targets: np.ndarray) -> dict:
             "payload_kg": np.full(rows, np.nan), "line": np.zeros(rows, dtype=np.int32), "source": "<plan>"}
 
 
-def _jacobian(robot: Robot, q: np.ndarray, targets: np.ndarray, effects: list) -> tuple[np.ndarray, list]:
+def _jacobian(robot: Robot, q: FloatArray, targets: FloatArray, effects: list[_core.Effect]
+              ) -> tuple[FloatArray, list[_core.Parameter]]:
     """The identification Jacobian (rows: pose-major, target, coordinate) at the nominal model with
     the targets at their offsets, and its parameters."""
     data = _campaign(robot, q, targets)
@@ -163,17 +168,18 @@ def _jacobian(robot: Robot, q: np.ndarray, targets: np.ndarray, effects: list) -
     return np.asarray(J), params
 
 
-def _free_columns(robot: Robot, q: np.ndarray, targets: np.ndarray, effects: list, params: list,
-                  seed: int) -> tuple[np.ndarray, list]:
+def _free_columns(robot: Robot, q: FloatArray, targets: FloatArray, effects: list[_core.Effect],
+                  params: list[_core.Parameter], seed: int) -> tuple[IntArray, list[tuple[str, str]]]:
     """The columns no candidate set can leave undetermined: identify's identifiability analysis on
     (up to 2,000 of) the candidates; the others with identify's reason."""
     rng = np.random.default_rng(seed)
     sub = q[rng.choice(len(q), size=min(len(q), 2000), replace=False)]
     data = _campaign(robot, sub, targets)
-    res = _core.identify(robot, data, ident.options(effects, loss="none", max_iterations=0, covariance=False))
+    res = _core.identify(robot, data, options(effects, loss="none", max_iterations=0, covariance=False))
     fixed = np.asarray(res.fixed)
     compliance = any(e.name == "joint_compliance" for e in effects)
-    free, left = [], []
+    free: list[int] = []
+    left: list[tuple[str, str]] = []
     for p, fx, why in zip(res.layout.parameters, fixed, res.fixed_reason):
         if p.kind == "compliance" and not compliance:
             continue
@@ -184,7 +190,7 @@ def _free_columns(robot: Robot, q: np.ndarray, targets: np.ndarray, effects: lis
     return np.asarray(free, dtype=int), left
 
 
-def greedy_d_optimal(J: np.ndarray, rows_per: int, k: int, ridge: float = 1e-3, epsilon: float = 0.01,
+def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, epsilon: float = 0.01,
                      seed: int = 0, progress: Optional[Callable[[int, int], None]] = None) -> list[int]:
     """Indices of k candidates (J: candidates' rows in blocks of rows_per, columns scaled) chosen one
     at a time for the largest gain log det(I + J_i M^-1 J_i^T), M = ridge I + the chosen J_i^T J_i.
@@ -222,7 +228,7 @@ def greedy_d_optimal(J: np.ndarray, rows_per: int, k: int, ridge: float = 1e-3, 
     return chosen
 
 
-def path_order(q: np.ndarray) -> np.ndarray:
+def path_order(q: FloatArray) -> IntArray:
     """An order of the configurations for a short robot path: nearest neighbour in joint space,
     starting from the one nearest to the middle of the set."""
     left = list(range(len(q)))
@@ -236,15 +242,17 @@ def path_order(q: np.ndarray) -> np.ndarray:
     return np.asarray(order)
 
 
-def plan(robot: Robot, k: int, *, targets: np.ndarray, effects: Sequence = ("joint_compliance",),
-         candidates: Optional[np.ndarray] = None, n_candidates: int = 5000, rules: KeepOut = KeepOut(),
+def plan(robot: Robot, k: int, *, targets: FloatArray,
+         effects: Union[str, Sequence[Union[str, _core.Effect]]] = ("joint_compliance",),
+         candidates: Optional[FloatArray] = None, n_candidates: int = 5000, rules: KeepOut = KeepOut(),
          noise_mm: float = 0.02, seed: int = 0,
          progress: Optional[Callable[[int, int], None]] = None) -> Plan:
     """The K configurations of a campaign (see the module's text). ``targets``: the reflectors'
     offsets on the tool (mm, one row each); ``candidates``: the configurations to choose from (deg),
     or ``n_candidates`` random ones inside the joint limits."""
     targets = np.asarray(targets, dtype=float).reshape(-1, 3)
-    effects = ident.check_effects(effects, robot)
+    # the core's effects (check_effects passes a JointCompliance through, which this plan cannot take)
+    core_effects = [e for e in ident.check_effects(effects, robot) if isinstance(e, _core.Effect)]
     if noise_mm <= 0 or not math.isfinite(noise_mm):
         raise ValueError(f"--noise must be a positive number of mm, not {noise_mm}")
     q = random_candidates(robot, n_candidates, seed) if candidates is None else np.asarray(candidates, dtype=float)
@@ -257,16 +265,16 @@ def plan(robot: Robot, k: int, *, targets: np.ndarray, effects: Sequence = ("joi
     if len(q) < k:
         raise ValueError(f"only {len(q)} candidates satisfy the joint limits and the keep-out rules, fewer than "
                          f"the {k} poses asked for (" + "; ".join(f"{v} {r}" for r, v in rejected.items()) + ")")
-    J, params = _jacobian(robot, q, targets, list(effects))
-    free, left = _free_columns(robot, q, targets, list(effects), params, seed)
+    J, params = _jacobian(robot, q, targets, list(core_effects))
+    free, left = _free_columns(robot, q, targets, list(core_effects), params, seed)
     J = J[:, free]
     # columns scaled to unit RMS per candidate: a candidate's rows are O(1), the ridge a faint prior
     scale = np.linalg.norm(J, axis=0) / math.sqrt(len(q))
     if np.any(scale == 0):
         raise ValueError("a parameter has no effect on any candidate")
     rows_per = 3 * len(targets)
-    chosen = greedy_d_optimal(J / scale, rows_per, k, seed=seed, progress=progress)
-    chosen = np.asarray(chosen)[path_order(q[chosen])]
+    picked = greedy_d_optimal(J / scale, rows_per, k, seed=seed, progress=progress)
+    chosen = np.asarray(picked)[path_order(q[picked])]
     rows = (chosen[:, None] * rows_per + np.arange(rows_per)[None, :]).ravel()
     Jp = J[rows]
     s = np.linalg.svd(Jp / scale, compute_uv=False)
@@ -287,7 +295,8 @@ def plan(robot: Robot, k: int, *, targets: np.ndarray, effects: Sequence = ("joi
                 min_singular_value=float(s[-1]) if m else 0.0, candidates=int(len(q)), rejected=rejected)
 
 
-def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bool = True) -> dict:
+def select_observable(robot: Robot, candidates: dict[str, Any], poses: int,
+                      compliance: bool = True) -> dict[str, Any]:
     """Choose ``poses`` of the candidate campaign's poses that maximise observability: greedy
     D-optimal design on the nominal model's identification Jacobian (unit-scaled columns of the
     parameters a generic campaign identifies), each step adding the pose that most increases
@@ -321,4 +330,4 @@ def select_observable(robot: Robot, candidates: dict, poses: int, compliance: bo
         chosen.append(best)
         left.remove(best)
         info += J[rows_of[best]].T @ J[rows_of[best]]
-    return ident.subset(candidates, np.isin(candidates["pose"], chosen))
+    return subset(candidates, np.isin(candidates["pose"], chosen))

@@ -12,13 +12,16 @@ robust spread and sets the robust loss's scale from it.
 from __future__ import annotations
 
 import math
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core
 from ..stats import grouping
 from .._core import Robot
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray
 
 #: prior standard deviations by kind (file units): a robot maker's tolerances for the joint geometry,
 #: a tool known to a few mm; none for the compliances (their size per kN m differs 100-fold between
@@ -32,13 +35,13 @@ AUTO_SCALES = (0.1, 0.3, 1.0, 3.0, 10.0)
 _GEOMETRIC = ("joint_mm", "joint_deg", "compliance", "tool_mm", "tool_deg", "base_mm", "base_deg", "target_mm")
 
 
-def file_unit(unit: str) -> tuple:
+def file_unit(unit: str) -> tuple[float, str]:
     """(factor, unit) taking a fit parameter from the core's unit to the model file's: radians (and
     rad/h) to degrees, every other unit as it is."""
     return (math.degrees(1.0), unit.replace("rad", "deg")) if unit.startswith("rad") else (1.0, unit)
 
 
-def parse_prior_sd(text: Optional[str]) -> dict:
+def parse_prior_sd(text: Optional[str]) -> dict[str, float]:
     """``--prior-sd``: comma separated KIND=SD (file units) over the defaults; ``none`` removes every
     prior. Errors name the bad item and the kinds known."""
     sd = dict(DEFAULT_PRIOR_SD)
@@ -56,7 +59,7 @@ def parse_prior_sd(text: Optional[str]) -> dict:
     return sd
 
 
-def core_prior_sd(sd: dict) -> list:
+def core_prior_sd(sd: dict[str, float]) -> list[tuple[str, float]]:
     """The kinds in the core's units: degrees to radians, an effect's file units to its core units."""
     out = []
     for kind, v in sd.items():
@@ -70,7 +73,7 @@ def core_prior_sd(sd: dict) -> list:
     return out
 
 
-def parse_prior_scale(text) -> Optional[float]:
+def parse_prior_scale(text: Union[str, float, None]) -> Optional[float]:
     """``--prior-scale``: a positive number, or ``auto`` (None: chosen by cross-validation)."""
     if text is None:
         return 1.0
@@ -79,7 +82,7 @@ def parse_prior_scale(text) -> Optional[float]:
     return _positive(text, f"--prior-scale: '{text}': a positive number or 'auto'")
 
 
-def _positive(text, message: str) -> float:
+def _positive(text: Union[str, float], message: str) -> float:
     """text as a finite positive number; ValueError(message) otherwise."""
     try:
         v = float(text)
@@ -97,24 +100,26 @@ class Fitter:
     so that a fold's choice never sees the rows it is validated on; ``scales`` records each choice."""
 
     def __init__(self, robot: Robot, prior_model: Optional[Robot] = None, auto_scale: bool = False,
-                 folds: int = 5, seed: int = 0):
+                 folds: int = 5, seed: int = 0) -> None:
         if prior_model is not None and prior_model.dof != robot.dof:
             raise ValueError(f"--prior-model: {prior_model.dof} joints but the robot has {robot.dof}")
         self.robot = prior_model if prior_model is not None else robot
         self.from_calibrated = prior_model is not None
         self.auto_scale, self.folds, self.seed = auto_scale, folds, seed
-        self.scales: list = []
+        self.scales: list[float] = []
 
-    def _once(self, data: dict, opts, progress=None) -> "_core.IdentifyResult":
+    def _once(self, data: dict[str, Any], opts: _core.IdentifyOptions,
+              progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         return _core.identify(self.robot, data, opts, progress, self.from_calibrated)
 
-    def __call__(self, data: dict, opts, progress: Optional[Callable[[int, float], None]] = None):
+    def __call__(self, data: dict[str, Any], opts: _core.IdentifyOptions,
+                 progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         if self.auto_scale and opts.prior_scale > 0:
             opts = _copy(opts, prior_scale=self.choose_scale(data, opts))
             self.scales.append(opts.prior_scale)
         return self._once(data, opts, progress)
 
-    def choose_scale(self, data: dict, opts) -> float:
+    def choose_scale(self, data: dict[str, Any], opts: _core.IdentifyOptions) -> float:
         """The overall prior width with the least grouped cross-validated RMS error on data."""
         k = min(self.folds, grouping.configurations(data).count)
         if k < 2:
@@ -137,11 +142,11 @@ class Fitter:
         return best
 
 
-def _subset(data: dict, mask: np.ndarray) -> dict:
+def _subset(data: dict[str, Any], mask: BoolArray) -> dict[str, Any]:
     return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()}
 
 
-def _copy(o, **changes) -> "_core.IdentifyOptions":
+def _copy(o: _core.IdentifyOptions, **changes: Any) -> _core.IdentifyOptions:
     """A copy of IdentifyOptions with some fields changed."""
     c = _core.IdentifyOptions()
     for name in ("compliance", "loss", "loss_scale_mm", "max_iterations", "rank_tolerance", "min_torque_share",
@@ -151,7 +156,7 @@ def _copy(o, **changes) -> "_core.IdentifyOptions":
     return c
 
 
-def down_weighted(fit: "_core.IdentifyResult", data: dict, n: int = 5) -> list:
+def down_weighted(fit: _core.IdentifyResult, data: dict[str, Any], n: int = 5) -> list[tuple[int, int, float, float]]:
     """The rows the robust loss down-weighted most: (pose, target, residual mm, weight), the weight
     the loss gives a row of that residual norm (Huber: scale / residual), smallest first."""
     scale = fit.loss_scale_mm
@@ -163,7 +168,7 @@ def down_weighted(fit: "_core.IdentifyResult", data: dict, n: int = 5) -> list:
     return [(int(data["pose"][i]), int(data["target"][i]), float(e[i]), float(w[i])) for i in order]
 
 
-def report(fit: "_core.IdentifyResult", loss: str, given_scale: Optional[float], scale_choice: str) -> dict:
+def report(fit: _core.IdentifyResult, loss: str, given_scale: Optional[float], scale_choice: str) -> dict[str, Any]:
     """What the model JSON and the summary say of the priors and the loss."""
     names = [p.name for p in fit.layout.parameters]
     at_prior = [n for n, a in zip(names, fit.at_prior) if a]
@@ -174,7 +179,7 @@ def report(fit: "_core.IdentifyResult", loss: str, given_scale: Optional[float],
                      "scale_from": "--loss-scale" if given_scale else "the residuals' robust spread"}}
 
 
-def summary_lines(fit: "_core.IdentifyResult", info: dict, worst: Sequence) -> list:
+def summary_lines(fit: _core.IdentifyResult, info: dict[str, Any], worst: Sequence[tuple[int, int, float, float]]) -> list[str]:
     """The summary's lines on the loss, the priors and what stays at its prior."""
     lines = []
     loss = info["loss"]

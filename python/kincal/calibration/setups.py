@@ -5,7 +5,7 @@ The joint identification of every placement and the validation itself are in ide
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
@@ -14,8 +14,12 @@ from .._core import Robot
 from .fitting import orientation_errors_deg, rms
 from .simulation import simulate
 
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
-def simulate_setups(truth: Robot, placements: dict, poses: int = 150, *, seed: int = 1, **options) -> dict:
+
+def simulate_setups(truth: Robot, placements: Mapping[str, Sequence[float]], poses: int = 150, *, seed: int = 1,
+                    **options: Any) -> dict[str, Any]:
     """A campaign measured from several instrument placements: ``placements`` maps each setup's
     name to the robot base frame seen from the instrument there, (x, y, z mm, a, b, c deg). Each
     setup measures ``poses`` random configurations (its own seed, ``seed`` + its index) with the
@@ -44,7 +48,7 @@ def simulate_setups(truth: Robot, placements: dict, poses: int = 150, *, seed: i
     return out
 
 
-def with_setups(truth: Robot, placements: dict) -> Robot:
+def with_setups(truth: Robot, placements: Mapping[str, Sequence[float]]) -> Robot:
     """The truth seen from the placements of simulate_setups (by name): what its points are
     compared with (point_errors)."""
     return truth.with_placements([(str(n), [float(v) for v in f[:3]], [float(v) for v in f[3:]])
@@ -62,7 +66,7 @@ def robot_for_setup(robot: Robot, name: str, source: str = "the model") -> Robot
     raise ValueError(f"{source}: no setup '{name}' (setups: {have})")
 
 
-def validation_summary(v: dict) -> str:
+def validation_summary(v: dict[str, Any]) -> str:
     """The table of identify's summary for a validation (validate()'s result): RMS, mean (the Samak
     paper's figure) and largest position error before (the nominal model) and after (the calibrated
     one), the placements refitted on both; per setup when there are several, and the orientation
@@ -70,7 +74,7 @@ def validation_summary(v: dict) -> str:
     lines = [f"{'position error (mm)':<28}{'RMS before':>12}{'RMS after':>12}{'mean before':>12}"
              f"{'mean after':>12}{'max before':>12}{'max after':>12}"]
 
-    def row(label: str, f: dict, unit: str = "mm") -> None:
+    def row(label: str, f: dict[str, Any], unit: str = "mm") -> None:
         lines.append(f"{label:<28}" + "".join(f"{f[f'{w}{s}_{unit}']:>12.4f}" for s in ("rms", "mean", "max")
                                               for w in ("before_", "")))
 
@@ -88,14 +92,14 @@ def validation_summary(v: dict) -> str:
 
 
 
-def setup_frames(placements) -> list:
+def setup_frames(placements: Iterable[tuple[str, Iterable[float], Iterable[float]]]) -> list[dict[str, Any]]:
     """Placements as (name, xyz, abc) (an IdentifyResult's or a Robot's) in files: {"name",
     "base_in_instrument": {"xyz_mm", "abc_deg"}} per setup, in the data's order."""
     return [{"name": n, "base_in_instrument": {"xyz_mm": [float(v) for v in xyz], "abc_deg": [float(v) for v in abc]}}
             for n, xyz, abc in placements]
 
 
-def drift_report(fit: "_core.IdentifyResult") -> Optional[dict]:
+def drift_report(fit: _core.IdentifyResult) -> Optional[dict[str, Any]]:
     """The instrument's drift an identification found (a property of the measurement: removed from
     the fit, never compensated), in the model file's units with standard deviations, or None."""
     names = [e.name for e in fit.layout.effect_list]
@@ -113,8 +117,8 @@ def drift_report(fit: "_core.IdentifyResult") -> Optional[dict]:
                            for n, v, d, sc, u in zip(e.parameter_names, vals, sd, e.file_scale, e.file_units)]}
 
 
-def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[np.ndarray],
-                       o_before: Optional[np.ndarray], data: dict) -> dict:
+def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[FloatArray],
+                       o_before: Optional[FloatArray], data: dict[str, Any]) -> dict[str, Any]:
     """The figures of `kincal validate` from the position errors (mm) after (the calibrated model)
     and before (the nominal one) and, with measured orientations, the orientation errors (deg):
     ``points``, ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm`` (``before_mean_mm``,
@@ -126,8 +130,8 @@ def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[
     six_d = (~np.isnan(np.asarray(data["abc"], dtype=float)[:, 0]) if "abc" in data
              else np.ones(len(ea), dtype=bool))
 
-    def figures(mask: np.ndarray) -> dict:
-        out = {"points": int(mask.sum()), "rms_mm": rms(ea[mask]), "mean_mm": float(np.mean(ea[mask])),
+    def figures(mask: BoolArray) -> dict[str, Any]:
+        out: dict[str, Any] = {"points": int(mask.sum()), "rms_mm": rms(ea[mask]), "mean_mm": float(np.mean(ea[mask])),
                "max_mm": float(np.max(ea[mask])), "before_rms_mm": rms(eb[mask]),
                "before_mean_mm": float(np.mean(eb[mask])), "before_max_mm": float(np.max(eb[mask]))}
         if o_after is not None and o_before is not None and np.any(mask[six_d]):
@@ -144,12 +148,13 @@ def validation_figures(after: np.ndarray, before: np.ndarray, o_after: Optional[
     return v
 
 
-def _refit_placements(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1):
+def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1
+                      ) -> tuple[FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
     targets, on the calibrated model (after) and the nominal one (before); orientation errors (or
     None); and the calibrated refit."""
 
-    def frames_only(calibrated: bool) -> "_core.IdentifyResult":
+    def frames_only(calibrated: bool) -> _core.IdentifyResult:
         # the calibrated geometry may load a joint the nominal one does not: each its own names
         layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, calibrated, []).layout
         held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
@@ -166,7 +171,7 @@ def _refit_placements(robot: Robot, data: dict, loss: str = "huber", loss_scale_
     return ea, eb, oa, ob, cal
 
 
-def extrapolated(robot: Robot, q_deg: np.ndarray) -> list:
+def extrapolated(robot: Robot, q_deg: FloatArray) -> list[dict[str, Any]]:
     """Where rows of joint angles take the robot's periodic effects outside the angles they were
     fitted on (_core.extrapolated), as the records of validate()'s ``extrapolated``."""
     n = len(q_deg)
@@ -175,7 +180,8 @@ def extrapolated(robot: Robot, q_deg: np.ndarray) -> list:
             for e in _core.extrapolated(robot, np.asarray(q_deg, dtype=float))]
 
 
-def inside_and_outside(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
+def inside_and_outside(robot: Robot, data: dict[str, Any], loss: str = "huber",
+                       loss_scale_mm: float = 0.1) -> dict[str, dict[str, Any]]:
     """validate()'s RMS (after, before) split between the rows that take none of the robot's periodic
     effects outside their fitted ranges and the rows that take one: ``{"inside": {"rows",
     "rms_mm", "before_rms_mm"}, "outside": {...}}`` (the placements refitted on every row)."""
@@ -185,13 +191,13 @@ def inside_and_outside(robot: Robot, data: dict, loss: str = "huber", loss_scale
     for e in _core.extrapolated(robot, q):
         out |= np.asarray(_core.outside_range(q[:, e.joint - 1], e.fitted_deg))
 
-    def part(m: np.ndarray) -> dict:
+    def part(m: BoolArray) -> dict[str, Any]:
         return {"rows": int(m.sum()), "rms_mm": rms(ea[m]), "before_rms_mm": rms(eb[m])}
 
     return {"inside": part(~out), "outside": part(out)}
 
 
-def validate(robot: Robot, data: dict, loss: str = "huber", loss_scale_mm: float = 0.1) -> dict:
+def validate(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1) -> dict[str, Any]:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
     differently: only the placements and the target offsets are refitted, on the calibrated

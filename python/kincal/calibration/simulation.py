@@ -4,7 +4,7 @@ its measurements by a simulated laser tracker, and the effects hidden in it (`--
 from __future__ import annotations
 
 import math
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
@@ -18,6 +18,9 @@ DEFAULT_INSTRUMENT = (3500.0, -1500.0, -400.0, 35.0, 1.5, -0.8)
 #: harmonic orders of transmission_error unless --harmonics says otherwise
 DEFAULT_HARMONICS = (1, 2)
 
+#: an effect hidden in a simulated truth: (Effect, values), or (name, joint from 1 or 0, values), values in core units
+HiddenEffect = Union[tuple[_core.Effect, Sequence[float]], tuple[str, int, Sequence[float]]]
+
 
 def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
                   compliance: float = 0.003) -> Robot:
@@ -27,9 +30,9 @@ def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg:
 
 
 def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
-             outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence = (),
+             outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence[HiddenEffect] = (),
              t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None,
-             duration_h: Optional[float] = None) -> dict:
+             duration_h: Optional[float] = None) -> dict[str, Any]:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
     model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
     ``effects`` hides more effects in the truth: (Effect, values) or (name, joint from 1 or 0, values),
@@ -57,7 +60,7 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
                           0.0 if duration_h is None else 3600.0 * float(duration_h))
 
 
-def _effect_value(e: Sequence) -> tuple:
+def _effect_value(e: HiddenEffect) -> tuple[_core.Effect, list[float]]:
     """(Effect, values) from (Effect, values) or (name, joint from 1 or 0, values)."""
     if len(e) == 2 and isinstance(e[0], _core.Effect):
         return e[0], [float(v) for v in e[1]]
@@ -68,7 +71,8 @@ def _effect_value(e: Sequence) -> tuple:
     return _core.Effect(str(name), int(joint)), vals
 
 
-def parse_hidden_effect(text: str, dof: int, harmonics: Sequence[int] = DEFAULT_HARMONICS) -> tuple:
+def parse_hidden_effect(text: str, dof: int,
+                        harmonics: Sequence[int] = DEFAULT_HARMONICS) -> tuple[_core.Effect, list[float]]:
     """NAME:JOINT:V1,V2.. of `kincal simulate --hide`: (Effect, values in core units). The values are
     in the model file's units (degrees for angles, 1/C for thermal_expansion: joint 0); their number
     comes from the registry (transmission_error: a sine and a cosine amplitude per harmonic order;

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,8 +14,11 @@ from .. import _core
 from ..io import strict_json
 from .._core import Robot
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def tool_from_targets(robot: Robot, targets: np.ndarray, known: np.ndarray) -> Robot:
+
+def tool_from_targets(robot: Robot, targets: FloatArray, known: FloatArray) -> Robot:
     """Reflectors alone cannot tell where the TCP is: the tool frame is redundant with the target
     offsets and stays nominal in the fit. Given the targets' offsets in the tool frame as designed
     or measured on a CMM (``known``, one row per target, mm), the tool frame of an identified
@@ -39,7 +43,7 @@ def tool_from_targets(robot: Robot, targets: np.ndarray, known: np.ndarray) -> R
     return Robot.from_json(strict_json.dumps(doc), "<identified>")
 
 
-def _abc_of(r: np.ndarray) -> list:
+def _abc_of(r: FloatArray) -> list[float]:
     """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c) (the core's, exact at the pole)."""
     return [float(v) for v in _core.rotation_to_abc(np.asarray(r, dtype=float))]
 
@@ -53,7 +57,7 @@ _TCP_LINES = {
 }
 
 
-def tcp_summary_line(robot: Robot) -> list:
+def tcp_summary_line(robot: Robot) -> list[str]:
     """The identification summary's line on where the TCP comes from (none when not recorded)."""
     line = _TCP_LINES.get(robot.tcp)
     return [line] if line else []

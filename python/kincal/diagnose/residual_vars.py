@@ -20,11 +20,15 @@ offsets as temperature_c, a compliance that is not linear as a gravity torque.
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import TYPE_CHECKING, Any, Sequence, Union
 
 import numpy as np
 
 from .. import _core
+from .._core import Robot
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 #: knots of the piecewise-linear functions of a continuous variable (at its quantiles)
 KNOTS = 8
@@ -35,7 +39,7 @@ RIDGE = 1e-2
 CARRIES = 0.05
 
 
-def variables(robot, data: dict) -> list:
+def variables(robot: Robot, data: dict[str, Any]) -> list[dict[str, Any]]:
     """The candidate variables of a measurement set: dicts with ``variable`` (its name), ``label``
     (in words, with unit), ``values`` (one per row) and ``discrete``."""
     q = np.asarray(data["q_deg"], dtype=float)
@@ -60,12 +64,12 @@ def variables(robot, data: dict) -> list:
     return out
 
 
-def gravity_torques(robot, q_deg: np.ndarray) -> np.ndarray:
+def gravity_torques(robot: Robot, q_deg: FloatArray) -> FloatArray:
     """Gravity torque (N m) on every joint at each row of joint angles (deg)."""
     return np.array([_core.gravity_torque(robot, qq)[0] for qq in np.asarray(q_deg, dtype=float)])
 
 
-def carriers(res, data: dict) -> tuple[np.ndarray, np.ndarray]:
+def carriers(res: _core.IdentifyResult, data: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
     """The residual r (dims per row) of a fit and the carriers C (one column per way the model moves
     a point: the instrument's 6 placement parameters, then each joint's angle, in mm per rad) at
     that fit."""
@@ -84,7 +88,7 @@ def carriers(res, data: dict) -> tuple[np.ndarray, np.ndarray]:
     return r, np.c_[J[:, base], joints]
 
 
-def _basis(values: np.ndarray, discrete: bool) -> np.ndarray:
+def _basis(values: FloatArray, discrete: bool) -> FloatArray:
     """Per-row basis of a variable: indicators of its levels, or piecewise-linear hat functions on
     its quantile knots (empty when it does not vary)."""
     if discrete:
@@ -97,7 +101,8 @@ def _basis(values: np.ndarray, discrete: bool) -> np.ndarray:
     return np.column_stack([np.interp(values, knots, eye[k]) for k in range(len(knots))])
 
 
-def score(r: np.ndarray, C: np.ndarray, variables: Sequence[dict], folds: Sequence[np.ndarray]) -> list:
+def score(r: FloatArray, C: FloatArray, variables: Sequence[dict[str, Any]],
+          folds: Sequence[BoolArray]) -> list[dict[str, Any]]:
     """Each variable's held-out share of the residual (see the module), sorted, largest first: dicts
     with ``variable``, ``label``, ``share`` and ``rms_explained_mm`` (the RMS per point of what the
     fit removes from the held-out residual).
@@ -122,7 +127,7 @@ def score(r: np.ndarray, C: np.ndarray, variables: Sequence[dict], folds: Sequen
         W = (B[:, :, None] * B[:, None, :]).reshape(n, nb * nb)
         Bu = (B[:, :, None] * u[:, None, :]).reshape(n, nb * m)
 
-        def normal(rows):  # the normal equations of the rows, unknowns ordered (basis, carrier)
+        def normal(rows: Union[slice, BoolArray]) -> tuple[FloatArray, FloatArray]:  # the normal equations of the rows, unknowns ordered (basis, carrier)
             G = (W[rows].T @ M[rows]).reshape(nb, nb, m, m).transpose(0, 2, 1, 3).reshape(nb * m, nb * m)
             return G, Bu[rows].sum(axis=0)
 
@@ -143,7 +148,7 @@ def score(r: np.ndarray, C: np.ndarray, variables: Sequence[dict], folds: Sequen
     return out
 
 
-def summary(scores: Sequence[dict]) -> str:
+def summary(scores: Sequence[dict[str, Any]]) -> str:
     """In words: the variable that carries the rest, and how much (or that none does)."""
     if not scores or scores[0]["share"] < CARRIES:
         return (f"no variable carries {CARRIES:.0%} of what remains (held out)" if scores

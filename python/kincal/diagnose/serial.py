@@ -8,7 +8,7 @@ on all the data (the command's files: workflow.py).
 
 from __future__ import annotations
 
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -18,16 +18,20 @@ from ..calibration import identify as ident
 from ..stats import stepwise as engine
 from .._core import Robot
 from ..calibration.effect_choice import (ALPHA, MAX_MAP_ORDER, MIN_GAIN, JointCompliance,  # noqa: F401
-                                         SerialProblem, Spec, candidates, check_data, evaluate)
+                                         Candidate, SerialProblem, Spec, candidates, check_data, evaluate)
 from ..calibration.fitting import FitOptions
 from . import residual_vars
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
+
 __all__ = ["JointCompliance", "SerialProblem", "Spec", "candidates", "diagnose", "final_identification", "step_effect"]
 
-def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
+def diagnose(robot: Robot, data: dict[str, Any], *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
              max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
-             progress: Optional[Callable[[str], None]] = None, effects: Sequence = (),
-             fit: Optional[FitOptions] = None, **fit_options) -> dict:
+             progress: Optional[Callable[[str], None]] = None,
+             effects: Union[str, Sequence[Union[str, Candidate]]] = (),
+             fit: Optional[FitOptions] = None, **fit_options: Any) -> dict[str, Any]:
     """The workflow (stepwise.search, then stepwise.conclude); returns the diagnosis.json of the
     contract (plus details for the report).
 
@@ -66,7 +70,7 @@ def diagnose(robot: Robot, data: dict, *, folds: int = 5, alpha: float = ALPHA, 
             "final_model": final_model, "_final_fit": final, "_spec": spec, "_start": problem.spec(start_effects)}
 
 
-def fitting_report(fit: FitOptions) -> dict:
+def fitting_report(fit: FitOptions) -> dict[str, Any]:
     """The fitting options of every fit, for diagnosis.json."""
     return {"loss": fit.loss, "loss_scale_mm": fit.loss_scale_mm, "gravity": fit.gravity,
             "prior_scale": "auto" if fit.prior_scale is None else fit.prior_scale,
@@ -74,7 +78,7 @@ def fitting_report(fit: FitOptions) -> dict:
             "prior_model": fit.prior_model is not None, "orientation_weight": fit.orientation_weight}
 
 
-def step_effect(step: dict):
+def step_effect(step: dict[str, Any]) -> Candidate:
     """The _core.Effect a step of diagnosis.json names (joint_map with its order)."""
     if step["effect"] == "joint_map":
         return _core.Effect("joint_map", step["joint"], order=step["order"])
@@ -83,8 +87,8 @@ def step_effect(step: dict):
     return _core.Effect(step["effect"], step["joint"] or 0)
 
 
-def final_identification(robot: Robot, data: dict, diag: dict,
-                         tool_targets: Optional[np.ndarray] = None) -> "ident.Identification":
+def final_identification(robot: Robot, data: dict[str, Any], diag: dict[str, Any],
+                         tool_targets: Optional[FloatArray] = None) -> ident.Identification:
     """The diagnosed model (every named effect and those it started from), identified on all the data
     with Ceres as `kincal identify` does (covariance included), ready for model.json; with
     ``tool_targets`` (the targets' offsets in the tool frame) the TCP is placed as identify's

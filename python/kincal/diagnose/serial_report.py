@@ -4,7 +4,8 @@ before and after, residuals against each named effect's variable) and report.htm
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional, Union
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 import numpy as np
 
@@ -15,13 +16,17 @@ from . import residual_vars
 from ..stats.stepwise import noise_phrase
 from .serial import Spec, step_effect
 
+if TYPE_CHECKING:
+    from ..calibration.effect_choice import Candidate
+    from ..typing_ import BoolArray, FloatArray
 
-def _label(step: dict) -> str:
+
+def _label(step: dict[str, Any]) -> str:
     e = step_effect(step)
     return e.label + (f", order {e.order}" if e.name == "joint_map" else "")
 
 
-def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
+def _variable(robot: Robot, data: dict[str, Any], effect: str, joint: Optional[int]) -> tuple[FloatArray, str]:
     """The natural variable of an effect for plots: (values per point, axis label)."""
     j = joint or 1
     if effect in ("transmission_error", "joint_map"):
@@ -45,7 +50,7 @@ def _variable(robot: Robot, data: dict, effect: str, joint: Optional[int]):
 LEVER = 0.25
 
 
-def _joint_error(res, data: dict, joint: int) -> tuple:
+def _joint_error(res: _core.IdentifyResult, data: dict[str, Any], joint: int) -> tuple[FloatArray, BoolArray]:
     """The angle error of ``joint`` (deg) each row's residual implies: the least-squares joint-angle
     change that would close it (-J_j . r / J_j . J_j, J_j the joint's column at the fit); and which
     rows the joint moves enough (|J_j| at least LEVER times the median row's) to read it."""
@@ -58,7 +63,8 @@ def _joint_error(res, data: dict, joint: int) -> tuple:
     return err, lever >= LEVER * np.median(lever)
 
 
-def _effect_curve(res, data: dict, effect, var: np.ndarray):
+def _effect_curve(res: _core.IdentifyResult, data: dict[str, Any], effect: Candidate,
+                  var: FloatArray) -> Optional[tuple[FloatArray, FloatArray]]:
     """The identified effect as a joint-angle change (deg) along its variable, sorted, less its mean
     over the points (a constant change is the joint's offset, which the geometry carries, so the
     residuals never show it), or None (thermal_expansion)."""
@@ -72,16 +78,18 @@ def _effect_curve(res, data: dict, effect, var: np.ndarray):
     if effect.name == "backlash":  # drawn at the two directions only (var: the jittered signs)
         return np.array([-1.0, 1.0]), np.degrees(vals[0]) * (np.array([-1.0, 1.0]) - np.mean(np.sign(var)))
 
-    def dq(deg: np.ndarray) -> np.ndarray:
+    def dq(deg: FloatArray) -> FloatArray:
         t = np.radians(deg)
-        return np.degrees(sum(vals[2 * i] * np.sin(k * t) + vals[2 * i + 1] * np.cos(k * t)
-                              for i, k in enumerate(effect.harmonics)))
+        change: FloatArray = np.degrees(sum(vals[2 * i] * np.sin(k * t) + vals[2 * i + 1] * np.cos(k * t)
+                                            for i, k in enumerate(effect.harmonics)))
+        return change
 
     xs = np.linspace(float(np.min(var)), float(np.max(var)), 400)
     return xs, dq(xs) - float(np.mean(dq(np.asarray(var, dtype=float))))
 
 
-def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, after_fit, path: Path) -> None:
+def _step_figure(plt: ModuleType, robot: Robot, data: dict[str, Any], k: int, st: dict[str, Any],
+                 before_fit: _core.IdentifyResult, after_fit: _core.IdentifyResult, path: Path) -> None:
     """The residual against the variable that carries a step's effect, before and after it was
     added: as the joint's implied angle error for a joint-angle effect (with the identified effect's
     curve), as the point error otherwise."""
@@ -120,7 +128,7 @@ def _step_figure(plt, robot: Robot, data: dict, k: int, st: dict, before_fit, af
 def _compact(model: str) -> str:
     """A model's label with the joints of each effect gathered: "geometry + joint_compliance(2, 3)"
     for "geometry + joint_compliance(joint 2) + joint_compliance(joint 3)"."""
-    joints: dict = {}
+    joints: dict[str, list[str]] = {}
     for part in model.split(" + "):
         name, _, rest = part.partition("(")
         joints.setdefault(name, []).extend([rest.rstrip(")").replace("joint ", "")] if rest else [])
@@ -137,11 +145,11 @@ def _share(share: float) -> str:
     return f"{share:.1%}" if share > 0 else f"none ({share:.1%})"
 
 
-def _point_errors(res, data: dict) -> np.ndarray:
+def _point_errors(res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
     return _core.point_errors(res.robot, res.targets, data)
 
 
-def _variables_figure(plt, scores: list, path: Path) -> None:
+def _variables_figure(plt: ModuleType, scores: list[dict[str, Any]], path: Path) -> None:
     """The held-out share of the residual each candidate variable explains, one bar each, signed (a
     share below zero: fitting the variable only adds noise, the bar goes left of zero)."""
     fig, ax = plt.subplots(figsize=(8, 1.0 + 0.28 * len(scores)), constrained_layout=True)
@@ -164,8 +172,8 @@ def _variables_figure(plt, scores: list, path: Path) -> None:
     plt.close(fig)
 
 
-def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path], title: str = "kincal diagnose",
-                 model_file: Optional[str] = None) -> list:
+def write_report(robot: Robot, data: dict[str, Any], diag: dict[str, Any], out_dir: Union[str, Path],
+                 title: str = "kincal diagnose", model_file: Optional[str] = None) -> list[str]:
     """Figures and report.html of a diagnosis in out_dir; returns the files written. ``model_file``:
     the name of the final model's JSON written beside it (said in the report)."""
     import matplotlib
@@ -173,7 +181,7 @@ def write_report(robot: Robot, data: dict, diag: dict, out_dir: Union[str, Path]
     import matplotlib.pyplot as plt
 
     out = Path(out_dir)
-    files = []
+    files: list[str] = []
     # 1. the gap shrinking step by step
     hist = diag["history"]
     # one horizontal bar per step, labelled by the effect that step added (the model is cumulative):

@@ -5,7 +5,7 @@ diagnosis.json, model.json), whole or not at all; and the command's summary."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, Optional, Union
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 import numpy as np
 
@@ -18,9 +18,13 @@ from ..stats import stepwise as engine
 from .serial import diagnose, final_identification
 from .serial_report import write_report
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_targets: Optional[np.ndarray] = None,
-        progress: Optional[Callable[[str], None]] = None, **options) -> tuple[dict, "ident.Identification"]:
+
+def run(robot: Robot, data: dict[str, Any], out: Union[str, Path], *, title: str,
+        tool_targets: Optional[FloatArray] = None, progress: Optional[Callable[[str], None]] = None,
+        **options: Any) -> tuple[dict[str, Any], ident.Identification]:
     """`kincal diagnose`: the diagnosis (``options``: those of diagnose()), the final model identified
     on all the data, and in the folder ``out`` report.html with its figures, diagnosis.json and
     model.json. Returns the diagnosis and the final identification."""
@@ -41,7 +45,7 @@ def run(robot: Robot, data: dict, out: Union[str, Path], *, title: str, tool_tar
     return diag, model
 
 
-def summary(diag: dict, model: "ident.Identification", out: Union[str, Path], seconds: float) -> str:
+def summary(diag: dict[str, Any], model: ident.Identification, out: Union[str, Path], seconds: float) -> str:
     """`kincal diagnose`'s summary of run()'s results: each named effect, the final verdict and the
     files written in ``out``."""
     folder = Path(out)

@@ -5,7 +5,7 @@ five-bar effects on each link, transmission errors on each actuator) and refit, 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, Optional, Union
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 import numpy as np
 
@@ -13,16 +13,20 @@ from .. import _core
 from .. import report
 from ..io import strict_json
 from ..stats import stepwise as engine
-from .hidden_robot import FiveBar, error_map_figure
+from .._core import FiveBar
+from .hidden_robot import error_map_figure
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 LINKS = ("a", "b", "c", "d")
 
 
-def library() -> list:
+def library() -> list[_core.Effect]:
     """The hidden robot's candidate effects, from the registry: every five-bar effect on each link
     a..d, and every joint-angle effect that needs no extra data (transmission error) on each
     actuator. Each is a _core.Effect (joint: the link or actuator, from 1)."""
-    out = []
+    out: list[_core.Effect] = []
     for kind in _core.effect_kinds():
         if kind.domain == "fivebar" and kind.concerns == "link":
             out += [_core.Effect(kind.name, i + 1) for i in range(len(LINKS))]
@@ -33,14 +37,15 @@ def library() -> list:
     return out
 
 
-def _acts_on(effect) -> str:
+def _acts_on(effect: _core.Effect) -> str:
     return _core.effect_kind(effect.name).acts_on
 
 
-def _basis(effect, t1: np.ndarray, t2: np.ndarray) -> np.ndarray:
+def _basis(effect: _core.Effect, t1: FloatArray, t2: FloatArray) -> FloatArray:
     """Per-point basis functions (n x effect.size) of an effect: a link's length varies with the pose
     as p1 cos t1 + p2 sin t1 + p3 cos t2 + p4 sin t2 (mm); a joint-angle effect of actuator j is the
     sum over its harmonic orders k of s_k sin(k tj) + c_k cos(k tj) (rad)."""
+    b: FloatArray
     if _acts_on(effect) == "link_length":
         b = np.c_[np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)]
     else:
@@ -50,7 +55,7 @@ def _basis(effect, t1: np.ndarray, t2: np.ndarray) -> np.ndarray:
     return b
 
 
-def predict(pts: dict, x: np.ndarray, effects: list) -> np.ndarray:
+def predict(pts: dict[str, Any], x: FloatArray, effects: list[_core.Effect]) -> FloatArray:
     """Model positions (n x 2) for lengths x[:4] and the effects' parameters after them (effects:
     _core.Effect objects, joint = link or actuator from 1)."""
     t1, t2 = np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"])
@@ -74,7 +79,8 @@ def predict(pts: dict, x: np.ndarray, effects: list) -> np.ndarray:
     return out
 
 
-def fit_with_effects(pts: dict, effects: list, start: Optional[np.ndarray] = None) -> np.ndarray:
+def fit_with_effects(pts: dict[str, Any], effects: list[_core.Effect],
+                     start: Optional[FloatArray] = None) -> FloatArray:
     """Least squares of the lengths and the effects' parameters on the measured positions
     (scipy's trust-region reflective; a few parameters, central-difference Jacobian)."""
     from scipy.optimize import least_squares
@@ -84,10 +90,11 @@ def fit_with_effects(pts: dict, effects: list, start: Optional[np.ndarray] = Non
         x0[4:len(start)] = start[4:]
     r = least_squares(lambda x: (predict(pts, x, effects) - pts["measured"]).ravel(), x0, method="trf",
                       x_scale="jac", xtol=1e-12, ftol=1e-12, diff_step=1e-7)
-    return r.x
+    x: FloatArray = r.x  # scipy's result (scipy has no types here)
+    return x
 
 
-def _subset(pts: dict, mask: Union[np.ndarray, slice]) -> dict:
+def _subset(pts: dict[str, Any], mask: Union[BoolArray, slice]) -> dict[str, Any]:
     return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in pts.items()}
 
 
@@ -99,17 +106,18 @@ class Diagnosis:
 
     dims = 2
 
-    def __init__(self, pts: dict, folds: int = 5, seed: int = 0):
+    def __init__(self, pts: dict[str, Any], folds: int = 5, seed: int = 0) -> None:
         n = len(pts["id"])
         order = np.random.default_rng(seed).permutation(n)
         self.pts = pts
         self.folds = [np.isin(np.arange(n), order[i::folds]) for i in range(folds)]
 
-    def held_errors(self, effects: list, held: np.ndarray) -> np.ndarray:
+    def held_errors(self, effects: list[_core.Effect], held: BoolArray) -> FloatArray:
         x = fit_with_effects(_subset(self.pts, ~held), effects)
-        return predict(_subset(self.pts, held), x, effects) - self.pts["measured"][held]
+        err: FloatArray = predict(_subset(self.pts, held), x, effects) - self.pts["measured"][held]
+        return err
 
-    def linearise(self, effects: list) -> engine.Linearisation:
+    def linearise(self, effects: list[_core.Effect]) -> engine.Linearisation[_core.Effect]:
         pts = self.pts
         x = fit_with_effects(pts, effects)
         r = (predict(pts, x, effects) - pts["measured"]).ravel()
@@ -124,7 +132,7 @@ class Diagnosis:
         model = FiveBar(*x[:4])
         return lambda eff: (r, Jc, self._regressors(model, eff))
 
-    def _regressors(self, model: FiveBar, eff) -> np.ndarray:
+    def _regressors(self, model: FiveBar, eff: _core.Effect) -> FloatArray:
         """The candidate's columns (2n x size): the point's derivative in the link length or actuator
         angle the effect changes, times the effect's basis functions."""
         pts = self.pts
@@ -143,21 +151,21 @@ class Diagnosis:
             R[2 * i:2 * i + 2] = np.outer(d, b[i])
         return R
 
-    def describe(self, effect) -> dict:
+    def describe(self, effect: _core.Effect) -> dict[str, Any]:
         if _core.effect_kind(effect.name).concerns == "link":
             return {"effect": effect.name, "joint": None, "link": LINKS[effect.joint - 1]}
         return {"effect": effect.name, "joint": effect.joint}
 
-    def label(self, effect) -> str:
+    def label(self, effect: _core.Effect) -> str:
         d = self.describe(effect)
         return f"{effect.name}(link {d['link']})" if "link" in d else effect.label
 
-    def model_label(self, effects: list) -> str:
+    def model_label(self, effects: list[_core.Effect]) -> str:
         return " + ".join(["four lengths"] + [self.label(e) for e in effects])
 
 
-def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
-             noise_mm: Optional[float] = None, say: Callable[[str], None] = lambda s: None) -> dict:
+def diagnose(pts: dict[str, Any], folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
+             noise_mm: Optional[float] = None, say: Callable[[str], None] = lambda s: None) -> dict[str, Any]:
     """The model-discrepancy workflow on the hidden robot (the engine of kincal.stepwise; contract
     names link_deflection, with "link": "a".."d", and transmission_error with the actuator as
     "joint"), every candidate of library() allowed."""
@@ -174,20 +182,20 @@ def diagnose(pts: dict, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0
             "lengths_mm": x[:4].tolist()}
 
 
-def effects_of(diag: dict) -> list:
+def effects_of(diag: dict[str, Any]) -> list[_core.Effect]:
     """The effects a diagnosis named (_core.Effect, joint: the link or actuator from 1)."""
     return [_core.Effect(s["effect"], LINKS.index(s["link"]) + 1 if s.get("link") else s["joint"])
             for s in diag["steps"]]
 
 
-def write_diagnosis(pts: dict, diag: dict, out: Union[str, Path], title: str) -> None:
+def write_diagnosis(pts: dict[str, Any], diag: dict[str, Any], out: Union[str, Path], title: str) -> None:
     """In the folder ``out``: residual_map.png (the four lengths against the model with the named
     effects), report.html and diagnosis.json."""
     with report.staged_folder(out) as folder:  # the whole folder or nothing
         _write_diagnosis(pts, diag, folder, title)
 
 
-def _write_diagnosis(pts: dict, diag: dict, folder: Path, title: str) -> None:
+def _write_diagnosis(pts: dict[str, Any], diag: dict[str, Any], folder: Path, title: str) -> None:
     named = effects_of(diag)
     before = dict(pts, desired=predict(pts, fit_with_effects(pts, []), []))
     after = dict(pts, desired=predict(pts, fit_with_effects(pts, named), named))
@@ -206,7 +214,7 @@ def _write_diagnosis(pts: dict, diag: dict, folder: Path, title: str) -> None:
     _core.write_file_atomic(str(folder / "diagnosis.json"), strict_json.dumps(engine.contract_json(diag), indent=1) + "\n")
 
 
-def diagnosis_summary(diag: dict) -> str:
+def diagnosis_summary(diag: dict[str, Any]) -> str:
     """`kincal diagnose --robot fivebar`'s summary: each named effect and the final verdict."""
     lines = [f"{st['effect']} {st.get('link') or st['joint']}: cross-validated RMS "
              f"{st['rms_before_mm'] * 1000:.1f} -> {st['rms_after_mm'] * 1000:.1f} um" for st in diag["steps"]]

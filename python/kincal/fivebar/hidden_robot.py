@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -20,25 +20,28 @@ from ..io import strict_json
 from .._core import ErrorMatrix, FiveBar
 from ..io.csv_text import format_rows
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
+
 METHODS = ("polynomial", "lsq", "minimax", "nonlinear")
 
 #: the paper's workspace (Table I): 100 mm x 150 mm
 WORKSPACE = ((162.132, 262.132), (-75.0, 75.0))
 
 
-def read_table(path: str) -> dict:
+def read_table(path: str) -> dict[str, Any]:
     """A table with the columns of data/fivebar-table1.csv (errors name file:line and cause)."""
     return _core.read_fivebar_table(str(path))
 
 
-def largest_error(model: FiveBar, pts: dict, desired: bool) -> float:
+def largest_error(model: FiveBar, pts: dict[str, Any], desired: bool) -> float:
     """The largest distance (mm) between the model's position at the commanded angles and the
     desired (``desired``) or the measured position of every point: a fit's score."""
     return float(_core.fivebar_max_error(model, pts, desired))
 
 
 
-def minimax_fit(pts: dict, start: FiveBar, desired: bool = False, sides: int = 64, max_iter: int = 200) -> FiveBar:
+def minimax_fit(pts: dict[str, Any], start: FiveBar, desired: bool = False, sides: int = 64, max_iter: int = 200) -> FiveBar:
     """The four lengths that minimise the largest distance between model and target (Chebyshev fit):
     linear programs on the linearised errors (each distance bounded by a regular polygon of
     ``sides`` sides) inside a trust region that shrinks when a step does not lower the true largest
@@ -81,7 +84,7 @@ def minimax_fit(pts: dict, start: FiveBar, desired: bool = False, sides: int = 6
     return model
 
 
-def fit(pts: dict, method: str = "lsq", score: str = "measured") -> dict:
+def fit(pts: dict[str, Any], method: str = "lsq", score: str = "measured") -> dict[str, Any]:
     """Hidden-robot synthesis (FIT.json of the contract). ``score``: rank models by the largest
     distance at the commanded angles to the measured (default) or, as the paper does, the desired
     positions. polynomial: every pair of points (eqs. 1-3); lsq: every subset of 3..N (eqs. 4-6);
@@ -93,7 +96,7 @@ def fit(pts: dict, method: str = "lsq", score: str = "measured") -> dict:
     desired = score == "desired"
     n = len(pts["id"])
     ids = [int(i) for i in pts["id"]]
-    out: dict = {"method": method, "score": score}
+    out: dict[str, Any] = {"method": method, "score": score}
     if method in ("polynomial", "lsq"):
         if n < (2 if method == "polynomial" else 3):
             raise ValueError(f"{method} needs at least {2 if method == 'polynomial' else 3} points, the table has {n}")
@@ -113,7 +116,7 @@ def fit(pts: dict, method: str = "lsq", score: str = "measured") -> dict:
     return out
 
 
-def model_of(fit_json: dict) -> FiveBar:
+def model_of(fit_json: dict[str, Any]) -> FiveBar:
     return _core.fivebar_from_json(strict_json.dumps(fit_json))
 
 
@@ -135,14 +138,15 @@ def load_matrix(path: str) -> ErrorMatrix:
     return ErrorMatrix.from_json(_read(path), str(path))
 
 
-def grid_targets(spacing: float = 5.0, workspace=WORKSPACE) -> np.ndarray:
+def grid_targets(spacing: float = 5.0,
+                 workspace: tuple[tuple[float, float], tuple[float, float]] = WORKSPACE) -> FloatArray:
     (x0, x1), (y0, y1) = workspace
     xs = np.arange(x0, x1 + 1e-9, spacing)
     ys = np.arange(y0, y1 + 1e-9, spacing)
     return np.array([(x, y) for y in ys for x in xs])
 
 
-def command(model: FiveBar, xy: np.ndarray, matrix: Optional[ErrorMatrix] = None) -> np.ndarray:
+def command(model: FiveBar, xy: FloatArray, matrix: Optional[ErrorMatrix] = None) -> FloatArray:
     """Joint commands (deg, n x 2) for desired points (n x 2)."""
     return _core.fivebar_command(model, matrix, np.asarray(xy, dtype=float).reshape(-1, 2))
 
@@ -152,7 +156,7 @@ def command(model: FiveBar, xy: np.ndarray, matrix: Optional[ErrorMatrix] = None
 COMMAND_TOLERANCE_DEG = 0.005
 
 
-def check_commanded_by(model: FiveBar, pts: dict, fit_file: str, grid_file: str) -> dict:
+def check_commanded_by(model: FiveBar, pts: dict[str, Any], fit_file: str, grid_file: str) -> dict[str, Any]:
     """``pts`` when its angles are the commands ``model`` gives for its desired points: an error
     matrix corrects the model that commanded the grid, and only that one. Otherwise a ValueError
     naming the grid's line, the angles and the model's."""
@@ -176,12 +180,14 @@ def check_commanded_by(model: FiveBar, pts: dict, fit_file: str, grid_file: str)
     return pts
 
 
-def position_errors(points: dict) -> np.ndarray:
+def position_errors(points: dict[str, Any]) -> FloatArray:
     """Distance (mm) between desired and measured position of every point."""
-    return np.linalg.norm(points["measured"] - points["desired"], axis=1)
+    err: FloatArray = np.linalg.norm(points["measured"] - points["desired"], axis=1)
+    return err
 
 
-def error_map_figure(maps: list, path: str, title: str = "five-bar positioning error") -> None:
+def error_map_figure(maps: list[tuple[str, dict[str, Any]]], path: str,
+                     title: str = "five-bar positioning error") -> None:
     """One panel per (label, points) pair: the error (um) at each desired position, one colour scale
     (logarithmic: report.error_norm)."""
     import matplotlib
@@ -204,7 +210,7 @@ def error_map_figure(maps: list, path: str, title: str = "five-bar positioning e
     plt.close(fig)
 
 
-def points_csv(pts: dict) -> str:
+def points_csv(pts: dict[str, Any]) -> str:
     """A point set as the CSV of data/fivebar-table1.csv."""
     rows = [[int(i), t1, t2, d[0], d[1], m[0], m[1]] for i, t1, t2, d, m in
             zip(pts["id"], pts["theta1_deg"], pts["theta2_deg"], pts["desired"], pts["measured"])]

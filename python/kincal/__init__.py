@@ -58,6 +58,8 @@ __all__ = ["Robot", "load_robot", "fk", "ik", "compensate", "run_program", "jaco
 __version__ = "0.1.0"
 
 ArrayLike = Union[np.ndarray, Sequence[Sequence[float]]]
+#: one value, or one per pose (temperatures; initial directions: one per joint)
+Floats = Union[None, float, Sequence[float], np.ndarray]
 
 
 def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: Optional[str] = None,
@@ -71,7 +73,7 @@ def load_robot(name_or_path: Union[str, Path], base: Optional[str] = None, tip: 
 
 
 def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "base",
-       dir: Optional[ArrayLike] = None, temperature_c: Union[None, float, Sequence[float]] = None) -> FloatArray:
+       dir: Optional[ArrayLike] = None, temperature_c: Floats = None) -> FloatArray:
     """Tool poses (N x 6: x,y,z mm, a,b,c deg) for joint angles in degrees (N x dof), every effect
     of the model acting: ``dir`` (N x dof signs +-1, the direction of each joint's last motion into
     the pose) when it has backlash, ``temperature_c`` (one value or N) when it has thermal expansion."""
@@ -83,8 +85,8 @@ def fk(robot: Robot, q_deg: ArrayLike, calibrated: bool = True, frame: str = "ba
     return _core.fk(robot, q, calibrated, frame == "instrument", d, t)
 
 
-def run_program(robot: Robot, q_deg: ArrayLike, *, initial_direction: Union[None, float, Sequence[float]] = None,
-                temperature_c: Union[None, float, Sequence[float]] = None, frame: str = "base") -> FloatArray:
+def run_program(robot: Robot, q_deg: ArrayLike, *, initial_direction: Floats = None,
+                temperature_c: Floats = None, frame: str = "base") -> FloatArray:
     """The tool poses a robot reaches when it runs a joint program (N x 6 joint angles in degrees,
     in order): each joint's direction into each pose is the sign of its commanded change, held while
     it stands still (the first pose's from ``initial_direction``, default the direction of the first
@@ -111,8 +113,8 @@ def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] =
 def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finite_difference: bool = False,
                delta: float = 1e-8, epsilon: float = 1e-15, max_iterations: int = 20,
                corrected_start: bool = True, frame: str = "base", residual: str = "rotation_vector",
-               temperature_c: Union[None, float, Sequence[float]] = None,
-               initial_direction: Union[None, float, Sequence[float]] = None, keep_branch: bool = False) -> dict[str, Any]:
+               temperature_c: Floats = None,
+               initial_direction: Floats = None, keep_branch: bool = False) -> dict[str, Any]:
     """Machine coordinates for desired tool poses (N x 6, in program order) on the robot's calibrated
     model, every effect it carries acting: backlash with the directions of the program's own
     commanded motion (the first pose's from ``initial_direction``, default the direction of the

@@ -25,11 +25,15 @@ import json
 import math
 import textwrap
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import numpy as np
 
 from ..io import strict_json
+
+if TYPE_CHECKING:
+    from .._core import Robot
+    from ..typing_ import BoolArray, FloatArray
 
 METHODS = ("spline", "linear")
 DEFAULT_SAMPLES = 2900
@@ -37,13 +41,13 @@ DEFAULT_SAMPLES = 2900
 DEFAULT_FEED = 0.25
 
 
-def path_parameter(q_rad: np.ndarray) -> np.ndarray:
+def path_parameter(q_rad: FloatArray) -> FloatArray:
     """Total vector displacement s at every program point (rad)."""
     d = np.linalg.norm(np.diff(q_rad, axis=0), axis=1)
     return np.concatenate([[0.0], np.cumsum(d)])
 
 
-def _nodes(q_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _nodes(q_rad: FloatArray) -> tuple[FloatArray, FloatArray]:
     """s and q at the program's points, repeated points dropped (they carry no path)."""
     q_rad = np.asarray(q_rad, dtype=float)
     if q_rad.ndim != 2 or len(q_rad) < 2:
@@ -60,7 +64,8 @@ def _degree(points: int) -> int:
     return 5 if points >= 6 else (3 if points >= 4 else 1)
 
 
-def resample(q_rad: np.ndarray, samples: int = DEFAULT_SAMPLES, method: str = "spline"):
+def resample(q_rad: FloatArray, samples: int = DEFAULT_SAMPLES, method: str = "spline"
+             ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """s (samples,) and q, q', q'', q''' at those s (samples x dof), derivatives in s."""
     if method not in METHODS:
         raise ValueError(f"unknown method '{method}' ({', '.join(METHODS)})")
@@ -80,7 +85,7 @@ def resample(q_rad: np.ndarray, samples: int = DEFAULT_SAMPLES, method: str = "s
     return s, spl(s), spl(s, 1), spl(s, 2), spl(s, 3)
 
 
-def _runs(mask: np.ndarray):
+def _runs(mask: BoolArray) -> list[tuple[np.intp, np.intp]]:
     """(start, end) index pairs of the True runs of a boolean array."""
     if not mask.any():
         return []
@@ -88,8 +93,8 @@ def _runs(mask: np.ndarray):
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1))
 
 
-def time_optimal(s: np.ndarray, d1: np.ndarray, d2: np.ndarray, v: np.ndarray, a: np.ndarray,
-                 cap: Optional[np.ndarray] = None) -> tuple[np.ndarray, float]:
+def time_optimal(s: FloatArray, d1: FloatArray, d2: FloatArray, v: FloatArray, a: FloatArray,
+                 cap: Optional[FloatArray] = None) -> tuple[FloatArray, float]:
     """Time-optimal rate of s along the path (from rest to rest) under |q' s-dot| <= v and
     |q' s-ddot + q'' s-dot^2| <= a per axis, and s-dot <= cap (e.g. the jerk cap of eq. 28): the
     forward-backward integration of x = s-dot^2 on the grid (C++ core). Returns s-dot(s) and the
@@ -102,9 +107,9 @@ def time_optimal(s: np.ndarray, d1: np.ndarray, d2: np.ndarray, v: np.ndarray, a
     return np.asarray(sd), float(t)
 
 
-def analyse(q_deg: np.ndarray, v_max: Sequence[float], a_max: Sequence[float], j_max: Sequence[float], *,
+def analyse(q_deg: FloatArray, v_max: Sequence[float], a_max: Sequence[float], j_max: Sequence[float], *,
             feed: float = DEFAULT_FEED, samples: int = DEFAULT_SAMPLES, method: str = "spline",
-            optimal: bool = True) -> dict:
+            optimal: bool = True) -> dict[str, Any]:
     """The derivative analysis of one joint program (degrees, n x dof); limits per axis in deg/s,
     deg/s^2, deg/s^3. Returns the feed.json entry of the program plus the arrays (key ``arrays``)."""
     q = np.radians(np.asarray(q_deg, dtype=float))
@@ -127,7 +132,7 @@ def analyse(q_deg: np.ndarray, v_max: Sequence[float], a_max: Sequence[float], j
         sj = np.cbrt(1.0 / nj3.max(axis=1))                    # eq. 28
         s22 = 1.0 / (a1 / a).max(axis=1)                       # eq. 22 as printed
         s23 = 1.0 / (a1 / j).max(axis=1)                       # eq. 23 as printed
-    violations = []
+    violations: list[dict[str, Any]] = []
     for limit, curve, norm in (("velocity", sv, nv), ("acceleration", sa, na2), ("jerk", sj, nj3)):
         for i0, i1 in _runs(feed > curve):
             k = i0 + int(np.argmin(curve[i0:i1 + 1]))
@@ -137,7 +142,7 @@ def analyse(q_deg: np.ndarray, v_max: Sequence[float], a_max: Sequence[float], j
     # chain rule at the constant feed: axis velocity, acceleration and jerk against the limits
     const = {"velocity_ratio": (p1 * feed / v).tolist(), "acceleration_ratio": (p2 * feed ** 2 / a).tolist(),
              "jerk_ratio": (p3 * feed ** 3 / j).tolist()}
-    out = {
+    out: dict[str, Any] = {
         "method": method, "samples": int(samples), "feed_rad_s": feed,
         "s_total_rad": float(s[-1]), "s": s,
         "axes": [{"axis": i + 1, "peak_q_s_v": float(p1[i] / v[i]), "peak_q_s_a": float(p1[i] / a[i]),
@@ -159,9 +164,9 @@ def analyse(q_deg: np.ndarray, v_max: Sequence[float], a_max: Sequence[float], j
     return out
 
 
-def json_ready(result: dict) -> dict:
+def json_ready(result: dict[str, Any]) -> dict[str, Any]:
     """A result of analyse() for feed.json: arrays as lists, the raw arrays left out."""
-    def conv(x):
+    def conv(x: Any) -> Any:
         if isinstance(x, np.ndarray):
             return x.tolist()
         if isinstance(x, dict):
@@ -169,10 +174,11 @@ def json_ready(result: dict) -> dict:
         if isinstance(x, list):
             return [conv(v) for v in x]
         return x
-    return conv(result)
+    ready: dict[str, Any] = conv(result)
+    return ready
 
 
-def robot_limits(robot) -> tuple[list, list, list]:
+def robot_limits(robot: Robot) -> tuple[list[float], list[float], list[float]]:
     """Velocity, acceleration and jerk limits (deg/s, /s^2, /s^3) of a robot's model."""
     joints = json.loads(robot.to_json())["nominal"]["joints"]
     v = [jt["max_velocity_deg_s"] for jt in joints]
@@ -181,7 +187,8 @@ def robot_limits(robot) -> tuple[list, list, list]:
     return v, a, j
 
 
-def read_limits(path: str, dof: int, base: tuple[list, list, list]) -> tuple[list, list, list]:
+def read_limits(path: str, dof: int, base: tuple[list[float], list[float], list[float]]
+                ) -> tuple[list[float], list[float], list[float]]:
     """A limits CSV (axis, v_max, a_max, j_max; axis from 1) overriding the given limits."""
     from .. import _core
 
@@ -202,7 +209,7 @@ def read_limits(path: str, dof: int, base: tuple[list, list, list]) -> tuple[lis
 SCATTER_ORDER = 6
 
 
-def point_scatter(q_rad: np.ndarray, order: int = SCATTER_ORDER) -> np.ndarray:
+def point_scatter(q_rad: FloatArray, order: int = SCATTER_ORDER) -> FloatArray:
     """Per axis, the scatter (standard deviation, rad) of a program's points about a smooth path, such
     as the rounding of coordinates written before the inverse kinematics, as it shows in q(s): across
     the path (a component along it moves a point along the path and the chord-length s follows it).
@@ -219,7 +226,8 @@ def point_scatter(q_rad: np.ndarray, order: int = SCATTER_ORDER) -> np.ndarray:
     norm = np.linalg.norm(chord, axis=1, keepdims=True)
     t = np.divide(chord, norm, out=np.zeros_like(chord), where=norm > 0)
     across = d - t * np.sum(d * t, axis=1, keepdims=True)
-    return np.median(np.abs(across), axis=0) / 0.6744897501960817 / math.sqrt(math.comb(2 * order, order))
+    sigma: FloatArray = np.median(np.abs(across), axis=0) / 0.6744897501960817 / math.sqrt(math.comb(2 * order, order))
+    return sigma
 
 
 @functools.lru_cache(maxsize=8)
@@ -238,7 +246,8 @@ def _unit_scatter_gain(k: int, derivative: int) -> tuple[float, float]:
     return float(np.sqrt(np.mean(g[mid] ** 2))), float(g.max())
 
 
-def scatter_derivative(sigma, spacing: float, derivative: int, k: int = 5) -> tuple:
+def scatter_derivative(sigma: Union[float, FloatArray], spacing: float, derivative: int,
+                       k: int = 5) -> tuple[FloatArray, FloatArray]:
     """What a scatter ``sigma`` (rad) of points ``spacing`` apart in s (rad) alone gives the
     ``derivative``-th derivative of the interpolating spline of degree k (rad/rad^derivative): its
     standard deviation in the middle of the path and the largest one (at the ends), for independent
@@ -250,8 +259,8 @@ def scatter_derivative(sigma, spacing: float, derivative: int, k: int = 5) -> tu
     return scale * rms, scale * top
 
 
-def panel_range(data: Sequence[np.ndarray], lines: Sequence[float], margin: float = 0.08,
-                reach: float = 3.0) -> tuple[tuple[float, float], list, list]:
+def panel_range(data: Sequence[FloatArray], lines: Sequence[float], margin: float = 0.08,
+                reach: float = 3.0) -> tuple[tuple[float, float], list[float], list[float]]:
     """The y range of one figure panel and which of the (signed) limit lines it shows. The range comes
     from the data: their [min, max] widened by ``margin`` of their height on each side (flat data get
     a height of 10% of their value, or 1 at zero). A limit line is drawn if the range widened to take
@@ -272,7 +281,8 @@ def panel_range(data: Sequence[np.ndarray], lines: Sequence[float], margin: floa
     pad = margin * height
     lo, hi = lo - pad, hi + pad
     most = reach * (hi - lo)
-    drawn, off = [], []
+    drawn: list[float] = []
+    off: list[float] = []
     for val in sorted(lines, key=lambda x: max(lo - x, x - hi, 0.0)):
         nlo, nhi = min(lo, val - pad), max(hi, val + pad)
         if nhi - nlo <= most:
@@ -288,14 +298,15 @@ def _fmt(x: float) -> str:
     return f"{x:.0f}" if abs(x) >= 1000 else f"{x:.3g}"
 
 
-def off_scale_note(bounds: Sequence[tuple], off: Sequence[float], data: Sequence[np.ndarray] = ()) -> str:
+def off_scale_note(bounds: Sequence[tuple[float, str, str]], off: Sequence[float],
+                   data: Sequence[FloatArray] = ()) -> str:
     """'off scale: jerk (eq. 23) ±104, ...' for the limit lines ``off`` of a panel whose lines are
     ``bounds`` ((value, kind, label), drawn at +-value), '(exceeded)' after a line the panel's ``data``
     pass; empty if none."""
     parts_d = [np.ravel(np.asarray(x, dtype=float)) for x in data]
     d = np.concatenate(parts_d) if parts_d else np.zeros(0)
     top, bottom = (float(d.max()), float(d.min())) if d.size else (-math.inf, math.inf)
-    parts = []
+    parts: list[str] = []
     for val, _, lab in bounds:
         plus, minus = val in off, -val in off
         passed = (plus and top > val) or (minus and bottom < -val)
@@ -306,13 +317,14 @@ def off_scale_note(bounds: Sequence[tuple], off: Sequence[float], data: Sequence
     return "off scale: " + ", ".join(parts) if parts else ""
 
 
-def _scatter_note(results: dict, axis: int) -> str:
+def _scatter_note(results: dict[str, dict[str, Any]], axis: int) -> str:
     """The figure's note on what the program points' scatter alone gives the derivatives."""
     if any(r.get("method") == "linear" for r in results.values()):
         return ("linear interpolation (the paper's): the second and third derivatives are spikes at the program's "
                 "points and their differences, not the motion's derivatives")
     i = axis - 1
-    sig, parts, spacing, k = -1.0, [], 1.0, 5
+    parts: list[str] = []
+    sig, spacing, k = -1.0, 1.0, 5
     for key, r in results.items():
         arr = r["arrays"]
         if "scatter" not in arr or not np.isfinite(arr["scatter"][i]):
@@ -335,8 +347,9 @@ _STYLE: dict[str, dict[str, Any]] = {"compare": {"color": "tab:blue", "lw": 3.0,
           "program": {"color": "tab:red", "lw": 1.1, "zorder": 3}}
 
 
-def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str,
-           window: Optional[tuple] = None, zoom: Optional[tuple] = None) -> dict:
+def figure(results: dict[str, dict[str, Any]], v_max: Sequence[float], a_max: Sequence[float],
+           j_max: Sequence[float], feed: float, axis: int, path: str, window: Optional[tuple[float, float]] = None,
+           zoom: Optional[tuple[float, float]] = None) -> dict[tuple[int, int], dict[str, Any]]:
     """Fig. 1 of the paper for one axis: the coordinate and its three derivatives in s, the programs
     compared, with the constraint lines +- limit / feed^k (velocity green, acceleration magenta, jerk
     cyan), over a window and a zoomed one. Every panel scales to its own data (panel_range); limit
@@ -374,11 +387,12 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
                  (j / feed, "jerk", "jerk (eq. 23)")],
             [(a / feed ** 2, "acceleration", "acceleration"), (j / feed ** 2, "jerk", "jerk (eq. 25)")],
             [(j / feed ** 3, "jerk", "jerk")]]
-    kinds_drawn, panels = set(), {}
+    kinds_drawn: set[str] = set()
+    panels: dict[tuple[int, int], dict[str, Any]] = {}
     for col, (lo, hi) in enumerate((window, zoom)):
         for row, key in enumerate(("q", "d1", "d2", "d3")):
             ax = axes[row, col]
-            data = []
+            data: list[FloatArray] = []
             for name in order:
                 arr = results[name]["arrays"]
                 m = (arr["s"] >= lo) & (arr["s"] <= hi)
@@ -414,9 +428,10 @@ def figure(results: dict, v_max, a_max, j_max, feed: float, axis: int, path: str
     return panels
 
 
-def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_path: Optional[str] = None,
-                  feed: float = DEFAULT_FEED, samples: int = DEFAULT_SAMPLES, method: str = "spline",
-                  window: Optional[tuple] = None, zoom: Optional[tuple] = None) -> dict:
+def analyse_files(robot: Robot, robot_arg: str, programs: dict[str, str], out: str, *,
+                  limits_path: Optional[str] = None, feed: float = DEFAULT_FEED, samples: int = DEFAULT_SAMPLES,
+                  method: str = "spline", window: Optional[tuple[float, float]] = None,
+                  zoom: Optional[tuple[float, float]] = None) -> dict[str, dict[str, Any]]:
     """`kincal feed`: the joint programs ``programs`` (key -> file: "program" and optionally
     "compare") analysed against the robot's limits (overridden by the CSV ``limits_path``); writes
     out/feed.json and one figure per axis. Returns the results by key (with ``file`` and ``label``)."""
@@ -428,7 +443,7 @@ def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_pat
     for name, lim in zip(("velocity", "acceleration", "jerk"), limits):
         if not all(x > 0 for x in lim):
             raise ValueError(f"{robot_arg}: the model has no {name} limit for some axis; give --limits L.csv")
-    results = {}
+    results: dict[str, dict[str, Any]] = {}
     for key, path in programs.items():
         q, _ = _core.read_joint_program(path, robot.dof)
         res = analyse(np.asarray(q), *limits, feed=feed, samples=samples, method=method)
@@ -437,7 +452,7 @@ def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_pat
         results[key] = res
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    figures = []
+    figures: list[str] = []
     for axis in range(1, robot.dof + 1):
         name = f"axis{axis}.png"
         figure(results, *limits, feed, axis, str(folder / name), window=window, zoom=zoom)
@@ -450,10 +465,10 @@ def analyse_files(robot, robot_arg: str, programs: dict, out: str, *, limits_pat
     return results
 
 
-def summary(results: dict, feed: float) -> str:
+def summary(results: dict[str, dict[str, Any]], feed: float) -> str:
     """`kincal feed`'s summary of analyse_files()'s results: per program its length in s, its
     violations at the rate ``feed`` (the first ten) and its time-optimal traversal."""
-    lines = []
+    lines: list[str] = []
     for k, r in results.items():
         t = r.get("time_optimal", {})
         lines.append(f"{k} ({r['file']}): s = {r['s_total_rad']:.4f} rad, {len(r['violations'])} violation(s) at "

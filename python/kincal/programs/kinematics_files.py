@@ -6,19 +6,22 @@ from __future__ import annotations
 
 import json
 import sys
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
 from .. import _core, fk, ik
 from ..io.csv_text import format_rows, header, text_columns
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional[float]) -> dict:
+
+def effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional[float]) -> dict[str, FloatArray]:
     """What the model's effects read from a joint file of ``n`` rows: ``dir`` from dir1..dirN
     (backlash) and ``temperature_c`` (thermal expansion, unless ``temperature`` is given); a missing
     column is an error naming it."""
-    out: dict = {}
+    out: dict[str, FloatArray] = {}
     if robot.needs_temperature and temperature is not None:
         out["temperature_c"] = np.full(n, float(temperature))
     if not (robot.needs_dir or (robot.needs_temperature and temperature is None)):
@@ -44,7 +47,7 @@ def effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional[
     return out
 
 
-def identified_targets(robot_arg: str) -> np.ndarray:
+def identified_targets(robot_arg: str) -> FloatArray:
     """Target offsets (tool frame, mm) an identified model JSON carries; only the tool point otherwise."""
     if str(robot_arg).lower().endswith(".json"):
         with open(robot_arg) as f:
@@ -87,7 +90,7 @@ def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: st
     _core.write_file_atomic(out, format_rows(head, rows))
 
 
-def _controller(robot: _core.Robot, q) -> list:
+def _controller(robot: _core.Robot, q: Sequence[float]) -> list[float]:
     """One configuration as the controller numbers its joints (the robot's joint convention)."""
     return list(_core.joints_to_controller(robot, np.asarray(q, dtype=float).reshape(1, -1))[0])
 
@@ -100,7 +103,7 @@ def ik_file(robot: _core.Robot, robot_arg: str, poses_path: str, out: str, every
         raise ValueError(f"{robot_arg}: no closed-form IK for this robot ({robot.ik_reason})")
     poses, lines = _core.read_pose_program(poses_path)
     ref = list(robot.home_deg) or [0.0] * robot.dof
-    rows = []
+    rows: list[list[Any]] = []
     for i, (pose, line) in enumerate(zip(poses, lines)):
         sols = ik(robot, pose, ref)
         if not sols:

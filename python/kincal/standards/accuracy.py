@@ -43,11 +43,17 @@ import itertools
 import json
 import math
 import re
-from typing import Optional, Sequence
+from typing import TYPE_CHECKING, Any, Optional, Sequence, TypeVar
 
 import numpy as np
 
 from .. import _core
+
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray, IntArray
+
+#: what rows are grouped by (a point's name, a direction, a target position)
+K = TypeVar("K")
 
 POSITION = ["x", "y", "z"]
 ANGLES = ["a", "b", "c"]
@@ -55,14 +61,14 @@ ANGLES = ["a", "b", "c"]
 
 # --- reading ------------------------------------------------------------------------------------
 
-def read_table(path: str, required: Sequence[str], optional: Sequence[str] = ()) -> dict:
+def read_table(path: str, required: Sequence[str], optional: Sequence[str] = ()) -> dict[str, Any]:
     """The columns ``required`` (a missing one is an error naming it) and those of ``optional`` the
     CSV has, as texts, with ``line`` (the file's line of each row; blank lines skipped)."""
     with open(path, newline="", encoding="utf-8-sig") as f:  # a leading BOM (Excel) is no part of a name
         reader = csv.reader(f)
-        head: Optional[list] = None
-        cols: dict = {}
-        lines: list = []
+        head: Optional[list[str]] = None
+        cols: dict[str, list[str]] = {}
+        lines: list[int] = []
         for row in reader:
             if not any(c.strip() for c in row):
                 continue
@@ -87,7 +93,7 @@ def read_table(path: str, required: Sequence[str], optional: Sequence[str] = ())
     return dict(cols, line=lines, source=path)
 
 
-def numbers(t: dict, name: str) -> np.ndarray:
+def numbers(t: dict[str, Any], name: str) -> FloatArray:
     """Column ``name`` of a table as finite floats (an error names the file, line and column)."""
     out = np.empty(len(t["line"]))
     for i, (text, line) in enumerate(zip(t[name], t["line"])):
@@ -101,7 +107,7 @@ def numbers(t: dict, name: str) -> np.ndarray:
     return out
 
 
-def integers(t: dict, name: str) -> np.ndarray:
+def integers(t: dict[str, Any], name: str) -> IntArray:
     out = numbers(t, name)
     bad = np.flatnonzero(out != np.round(out))
     if len(bad):
@@ -109,7 +115,7 @@ def integers(t: dict, name: str) -> np.ndarray:
     return out.astype(np.int64)
 
 
-def natural_key(name: str) -> tuple:
+def natural_key(name: str) -> tuple[tuple[int, int, str], ...]:
     """P2 before P10: digit runs compare as numbers."""
     return tuple((0, int(p), "") if p.isdigit() else (1, 0, p) for p in re.split(r"(\d+)", name) if p)
 
@@ -123,7 +129,7 @@ def _triple_set(t_head: Sequence[str], names: Sequence[str], path: str) -> bool:
     return bool(have)
 
 
-def read_runs(path: str) -> dict:
+def read_runs(path: str) -> dict[str, Any]:
     """RUNS.csv of `kincal accuracy iso9283`: point, cycle, commanded xc,yc,zc[,ac,bc,cc], attained
     x,y,z[,a,b,c][,direction]. Returns the rows sorted (point, direction, cycle) with ``cmd`` and
     ``att`` (N x 3, or N x 6 with orientation), ``point``, ``cycle``, ``direction`` (None without the
@@ -142,7 +148,7 @@ def read_runs(path: str) -> dict:
     direction = t.get("direction")
     dkey = direction if direction is not None else [""] * len(cycle)
     order = sorted(range(len(cycle)), key=lambda i: (natural_key(t["point"][i]), t["point"][i], dkey[i], cycle[i]))
-    seen: dict = {}
+    seen: dict[tuple[str, str, int], int] = {}
     for i in order:
         key = (t["point"][i], dkey[i], cycle[i])
         if key in seen:
@@ -154,7 +160,7 @@ def read_runs(path: str) -> dict:
                 line=[t["line"][i] for i in order], source=path, orientation=orient)
 
 
-def placement(model_path: str) -> tuple:
+def placement(model_path: str) -> tuple[FloatArray, FloatArray]:
     """The instrument placement of an identified model JSON: (R, t) with p_instrument = R p_base + t."""
     robot = _core.Robot.load(model_path)
     if not robot.identified:
@@ -164,7 +170,7 @@ def placement(model_path: str) -> tuple:
     return _core.abc_to_rotation(np.asarray(b["abc_deg"], dtype=float)), np.asarray(b["xyz_mm"], dtype=float)
 
 
-def to_base(runs: dict, model_path: str) -> dict:
+def to_base(runs: dict[str, Any], model_path: str) -> dict[str, Any]:
     """The attained poses (measured in the instrument frame) mapped into the robot base frame with the
     identified model's instrument placement; the commanded poses are in the base frame already."""
     R, t = placement(model_path)
@@ -178,17 +184,17 @@ def to_base(runs: dict, model_path: str) -> dict:
 
 # --- ISO 9283 -----------------------------------------------------------------------------------
 
-def wrap(deg: np.ndarray) -> np.ndarray:
+def wrap(deg: FloatArray) -> FloatArray:
     """Angles (deg) wrapped to (-180, 180]."""
     return 180.0 - np.mod(180.0 - np.asarray(deg, dtype=float), 360.0)
 
 
-def _groups(keys: Sequence) -> list:
+def _groups(keys: Sequence[K]) -> list[tuple[K, IntArray]]:
     """Consecutive runs of equal keys (the rows are sorted): a list of (key, index array)."""
     return [(k, np.fromiter(g, dtype=np.int64)) for k, g in itertools.groupby(range(len(keys)), key=lambda i: keys[i])]
 
 
-def pose_statistics(cmd: np.ndarray, att: np.ndarray) -> dict:
+def pose_statistics(cmd: FloatArray, att: FloatArray) -> dict[str, Any]:
     """ISO 9283 7.2 for one commanded pose ``cmd`` (3 or 6) and its attained poses ``att`` (n x 3 or
     n x 6, n >= 2): AP and RP, and the barycentre."""
     bary = att[:, :3].mean(axis=0)
@@ -209,12 +215,12 @@ def pose_statistics(cmd: np.ndarray, att: np.ndarray) -> dict:
     return out
 
 
-def iso9283(runs: dict, distance: Optional[Sequence[str]] = None) -> dict:
+def iso9283(runs: dict[str, Any], distance: Optional[Sequence[str]] = None) -> dict[str, Any]:
     """The ISO 9283 report of ``runs`` (read_runs): per point AP, RP (and vAP with directions); with
     ``distance`` (two point names) AD and RD over the cycles both points share."""
     src, cmd, att = runs["source"], runs["cmd"], runs["att"]
     dirs = runs["direction"]
-    points = []
+    points: list[dict[str, Any]] = []
     by_point = _groups(runs["point"])
     for name, idx in by_point:
         c0 = cmd[idx[0]]
@@ -251,7 +257,7 @@ def iso9283(runs: dict, distance: Optional[Sequence[str]] = None) -> dict:
     return out
 
 
-def parse_distance(text: str) -> list:
+def parse_distance(text: str) -> list[str]:
     """--distance P2,P4: two distinct point names."""
     names = [x.strip() for x in text.split(",")]
     if len(names) != 2 or not all(names) or names[0] == names[1]:
@@ -259,7 +265,7 @@ def parse_distance(text: str) -> list:
     return names
 
 
-def distance_statistics(runs: dict, names: Sequence[str]) -> dict:
+def distance_statistics(runs: dict[str, Any], names: Sequence[str]) -> dict[str, Any]:
     """ISO 9283 7.4: AD and RD between two points, cycle by cycle (and direction by direction)."""
     src = runs["source"]
     known = sorted(set(runs["point"]), key=natural_key)
@@ -289,7 +295,7 @@ def distance_statistics(runs: dict, names: Sequence[str]) -> dict:
 
 # --- ISO 230-2 and VDI/DGQ 3441 -----------------------------------------------------------------
 
-def read_axis(path: str) -> dict:
+def read_axis(path: str) -> dict[str, Any]:
     """AXIS.csv of `kincal accuracy axis`: target, direction (+1/-1), run, measured; sorted by target,
     direction, run (duplicates are an error)."""
     t = read_table(path, ["target", "direction", "run", "measured"])
@@ -308,14 +314,14 @@ def read_axis(path: str) -> dict:
                 measured=measured[order], line=[t["line"][i] for i in order], source=path)
 
 
-def axis_statistics(data: dict, unit: str = "mm") -> dict:
+def axis_statistics(data: dict[str, Any], unit: str = "mm") -> dict[str, Any]:
     """ISO 230-2 and VDI/DGQ 3441 figures of one axis (see the module's docstring); every value in
     ``unit`` (mm or deg), as the file."""
     src = data["source"]
     dev = data["measured"] - data["target"]
-    per = []
+    per: list[dict[str, Any]] = []
     for tgt, idx in _groups(list(data["target"])):
-        side = {}
+        side: dict[int, tuple[float, float, int]] = {}
         for d in (1, -1):
             j = idx[data["direction"][idx] == d]
             what = f"{src}: target {tgt:g}"
@@ -350,7 +356,7 @@ def axis_statistics(data: dict, unit: str = "mm") -> dict:
     half = (u_j + ps_j) / 2.0
     travel = float(data["target"].max() - data["target"].min())
     p_unc = float((mean_i + half).max() - (mean_i - half).min())
-    vdi: dict = {"P": p_unc, "Pa": float(mean_i.max() - mean_i.min()),
+    vdi: dict[str, Any] = {"P": p_unc, "Pa": float(mean_i.max() - mean_i.min()),
            "Ps": float(ps_j.max()), "U": float(u_j.max()), "Ps_mean": float(ps_j.mean()), "U_mean": float(u_j.mean()),
            "travel": travel,
            "targets": [{"target": p["target"], "mean": float(mean_i[k]), "U_j": float(u_j[k]), "Ps_j": float(ps_j[k]),

@@ -19,12 +19,15 @@ position."""
 from __future__ import annotations
 
 import itertools
-from typing import Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core, fk
 from ..io.csv_text import format_rows
+
+if TYPE_CHECKING:
+    from ..typing_ import BoolArray, FloatArray
 
 VOXELS = 48          # voxels along the largest extent of the robot's reach
 SEARCH_LATTICE = 7   # lattice points per edge while searching
@@ -36,26 +39,27 @@ CORNERS = {"P2": (1, 1, 1), "P3": (-1, 1, 1), "P4": (-1, -1, -1), "P5": (1, -1, 
 class Reach:
     """Reachability of tool positions at one orientation within the joint limits (closed-form IK)."""
 
-    def __init__(self, robot: _core.Robot, abc: Union[np.ndarray, Sequence[float]], z_min: Optional[float] = None):
+    def __init__(self, robot: _core.Robot, abc: Union[FloatArray, Sequence[float]],
+                 z_min: Optional[float] = None) -> None:
         if not robot.closed_form_ik:
             raise ValueError(f"{robot.name}: plan-iso9283 needs the closed-form IK, which this robot has not "
                              f"({robot.ik_reason})")
         self.robot, self.abc, self.z_min = robot, np.asarray(abc, dtype=float), z_min
         self.ref = np.asarray(robot.home_deg or [0.0] * robot.dof, dtype=float)
 
-    def one(self, p: np.ndarray) -> bool:
+    def one(self, p: FloatArray) -> bool:
         if self.z_min is not None and p[2] < self.z_min:
             return False
         return _core.ik_nearest(self.robot, np.concatenate((p, self.abc)), self.ref) is not None
 
-    def many(self, pts: np.ndarray) -> np.ndarray:
+    def many(self, pts: FloatArray) -> BoolArray:
         return np.fromiter((self.one(p) for p in pts), dtype=bool, count=len(pts))
 
-    def all(self, pts: np.ndarray) -> bool:
+    def all(self, pts: FloatArray) -> bool:
         return all(self.one(p) for p in pts)
 
 
-def lattice(centre: np.ndarray, edge: float, k: int) -> np.ndarray:
+def lattice(centre: FloatArray, edge: float, k: int) -> FloatArray:
     """k^3 points over the cube, its corners first (a cube that does not fit fails there most often)."""
     u = np.linspace(-0.5, 0.5, k)
     g = np.array(list(itertools.product(u, u, u)))
@@ -64,16 +68,16 @@ def lattice(centre: np.ndarray, edge: float, k: int) -> np.ndarray:
     return np.asarray(centre, dtype=float) + edge * g
 
 
-def fits(reach: Reach, centre: np.ndarray, edge: float, k: int = FINAL_LATTICE) -> bool:
+def fits(reach: Reach, centre: FloatArray, edge: float, k: int = FINAL_LATTICE) -> bool:
     return reach.all(lattice(centre, edge, k))
 
 
-def working_orientation(robot: _core.Robot) -> np.ndarray:
+def working_orientation(robot: _core.Robot) -> FloatArray:
     """The tool's orientation (ABC, deg) at the robot's home pose."""
     return np.round(fk(robot, [robot.home_deg or [0.0] * robot.dof])[0, 3:], 9) + 0.0
 
 
-def _voxel_cube(reach: Reach, seed: int) -> tuple:
+def _voxel_cube(reach: Reach, seed: int) -> tuple[FloatArray, float, float]:
     """The reachable set on a voxel grid over the tool's reach, and the largest cubes of reachable
     voxels: (candidate centres, their edge in mm, the voxel size)."""
     rng = np.random.default_rng(seed)
@@ -89,8 +93,8 @@ def _voxel_cube(reach: Reach, seed: int) -> tuple:
         raise ValueError(f"{reach.robot.name}: no position is reachable within the joint limits at orientation "
                          f"a,b,c = {', '.join(f'{v:g}' for v in reach.abc)}")
 
-    def corners(s: int) -> np.ndarray:  # low corners of fully reachable s x s x s blocks
-        m: np.ndarray = occ
+    def corners(s: int) -> BoolArray:  # low corners of fully reachable s x s x s blocks
+        m: BoolArray = occ
         for ax in range(3):
             m = np.asarray(np.lib.stride_tricks.sliding_window_view(m, s, axis=ax).all(axis=-1))
         return m
@@ -113,7 +117,7 @@ def _voxel_cube(reach: Reach, seed: int) -> tuple:
     return centres[pick], (best - 1) * h, h
 
 
-def _largest_edge(reach: Reach, c: np.ndarray, start: float, k: int, rel: float = 1e-3) -> float:
+def _largest_edge(reach: Reach, c: FloatArray, start: float, k: int, rel: float = 1e-3) -> float:
     """The largest edge of a cube centred at ``c`` that fits (on a k-lattice), by bisection."""
     lo, hi = 0.0, max(start, 1.0)
     if fits(reach, c, hi, k):
@@ -129,7 +133,7 @@ def _largest_edge(reach: Reach, c: np.ndarray, start: float, k: int, rel: float 
     return lo
 
 
-def _refine(reach: Reach, c: np.ndarray, edge: float, step: float, k: int) -> tuple:
+def _refine(reach: Reach, c: FloatArray, edge: float, step: float, k: int) -> tuple[FloatArray, float]:
     """Pattern search over the centre (26 directions, halving steps): the largest cube near ``c``."""
     edge = _largest_edge(reach, c, edge, k)
     dirs = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)], dtype=float)
@@ -148,7 +152,7 @@ def _refine(reach: Reach, c: np.ndarray, edge: float, step: float, k: int) -> tu
     return c, edge
 
 
-def largest_cube(reach: Reach, seed: int = 0) -> tuple:
+def largest_cube(reach: Reach, seed: int = 0) -> tuple[FloatArray, float]:
     """(centre, edge): the largest cube that fits (on the final lattice)."""
     cands, edge0, h = _voxel_cube(reach, seed)
     found = [_refine(reach, c, edge0, h / 2, SEARCH_LATTICE) for c in cands]
@@ -160,7 +164,7 @@ def largest_cube(reach: Reach, seed: int = 0) -> tuple:
     return c, _largest_edge(reach, c, e, FINAL_LATTICE)
 
 
-def iso_poses(centre: np.ndarray, edge: float, abc: np.ndarray) -> dict:
+def iso_poses(centre: FloatArray, edge: float, abc: FloatArray) -> dict[str, FloatArray]:
     """P1..P5 (x,y,z,a,b,c) of the cube of ``edge`` centred at ``centre``."""
     out = {"P1": np.r_[centre, abc]}
     for name, s in CORNERS.items():
@@ -168,15 +172,15 @@ def iso_poses(centre: np.ndarray, edge: float, abc: np.ndarray) -> dict:
     return {k: out[k] for k in ("P1", "P2", "P3", "P4", "P5")}
 
 
-def program_rows(poses: dict, cycles: int) -> list:
+def program_rows(poses: dict[str, FloatArray], cycles: int) -> list[list[Any]]:
     """The pose program: P1 (cycle 0: the start), then per cycle P5, P4, P3, P2, P1."""
-    rows = [list(poses["P1"]) + ["P1", 0]]
+    rows: list[list[Any]] = [list(poses["P1"]) + ["P1", 0]]
     for j in range(1, cycles + 1):
         rows += [list(poses[p]) + [p, j] for p in ORDER[1:] + ["P1"]]
     return rows
 
 
-def parse_triple(text: Optional[str], option: str) -> Optional[np.ndarray]:
+def parse_triple(text: Optional[str], option: str) -> Optional[FloatArray]:
     if text is None:
         return None
     try:
@@ -189,7 +193,7 @@ def parse_triple(text: Optional[str], option: str) -> Optional[np.ndarray]:
 
 
 def plan(robot: _core.Robot, cube: Optional[float] = None, orientation: Optional[str] = None,
-         z_min: Optional[float] = None, cycles: int = 30, seed: int = 0) -> dict:
+         z_min: Optional[float] = None, cycles: int = 30, seed: int = 0) -> dict[str, Any]:
     """The cube (largest, or of edge ``cube`` placed where the largest is), P1..P5 and the program
     rows; a cube that does not fit is an error naming --cube."""
     if cycles < 1:
@@ -213,7 +217,7 @@ def plan(robot: _core.Robot, cube: Optional[float] = None, orientation: Optional
             "rows": program_rows(poses, cycles)}
 
 
-def write_plan(robot: _core.Robot, out: str, **options) -> str:
+def write_plan(robot: _core.Robot, out: str, **options: Any) -> str:
     """`kincal accuracy plan-iso9283`: the program written to ``out`` (x,y,z,a,b,c, point, cycle);
     returns the summary (the cube and P1..P5)."""
     res = plan(robot, **options)

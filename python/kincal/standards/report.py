@@ -7,7 +7,8 @@ from __future__ import annotations
 import io
 import math
 from pathlib import Path
-from typing import Optional, Union
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 import numpy as np
 
@@ -15,24 +16,27 @@ from .. import report
 from ..io import strict_json
 from . import accuracy as acc
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
 
 
-def _plt():
+def _plt() -> ModuleType:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
 
 
-def _png(fig) -> bytes:
+def _png(fig: Figure) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
     _plt().close(fig)
     return buf.getvalue()
 
 
-def write_folder(out: Union[str, Path], files: dict) -> None:
+def write_folder(out: Union[str, Path], files: dict[str, Union[str, bytes]]) -> None:
     """``files`` (name -> text or bytes) written into the folder ``out`` (created), whole or not at
     all (report.staged_folder)."""
     with report.staged_folder(out) as stage:
@@ -70,7 +74,7 @@ def rounded(value: float, digits: int, factor: float = 1.0) -> str:
     return _f(round(value * factor / step) * step, shown)
 
 
-def _length_unit(extent_mm: float) -> tuple:
+def _length_unit(extent_mm: float) -> tuple[str, float]:
     """(unit, factor from mm) for lengths of about ``extent_mm``: um below 1 mm."""
     return ("um", 1000.0) if extent_mm < 1.0 else ("mm", 1.0)
 
@@ -85,7 +89,7 @@ PANEL_MARGIN = 1.35
 COMMANDED_REACH = 2.5
 
 
-def iso9283_decimals(res: dict) -> tuple:
+def iso9283_decimals(res: dict[str, Any]) -> tuple[int, int]:
     """(position decimals in mm, angle decimals in deg) of the precision rule for an ISO 9283 report."""
     pts = res["points"]
     pos = decimals(min(p["RP_l_mm"] for p in pts))
@@ -93,7 +97,7 @@ def iso9283_decimals(res: dict) -> tuple:
     return pos, ang
 
 
-def deviation_layout(runs: dict, res: dict) -> dict:
+def deviation_layout(runs: dict[str, Any], res: dict[str, Any]) -> dict[str, Any]:
     """What the attained-positions figure draws, in mm from each point's barycentre: per point and
     plane (x-y, x-z) a panel with its attained points (``xy``, and ``idx`` their rows), the RP_l
     circle's radius, the commanded position (``commanded``) and whether it is inside the panel
@@ -102,7 +106,7 @@ def deviation_layout(runs: dict, res: dict) -> dict:
     distance of an attained point or of an RP_l circle from its barycentre, enlarged to take the
     commanded positions in when they lie within COMMANDED_REACH times that distance (a compensated
     robot: AP and RP comparable). ``unit``/``scale``: the axes' unit (um below 1 mm) and factor from mm."""
-    panels = []
+    panels: list[dict[str, Any]] = []
     reach = 0.0
     for p in res["points"]:
         idx = np.array([i for i, n in enumerate(runs["point"]) if n == p["point"]])
@@ -128,7 +132,7 @@ def deviation_layout(runs: dict, res: dict) -> dict:
     return {"lim_mm": lim, "reach_mm": reach, "unit": unit, "scale": scale, "panels": panels}
 
 
-def _deviation_figure(runs: dict, res: dict, layout: dict) -> bytes:
+def _deviation_figure(runs: dict[str, Any], res: dict[str, Any], layout: dict[str, Any]) -> bytes:
     """Attained positions around each point's barycentre (deviation_layout): per point, the x-y and
     x-z planes, the RP_l circle, and the commanded position or an arrow toward it."""
     plt = _plt()
@@ -191,7 +195,7 @@ def _deviation_figure(runs: dict, res: dict, layout: dict) -> bytes:
     return _png(fig)
 
 
-def _summary_figure(res: dict) -> bytes:
+def _summary_figure(res: dict[str, Any]) -> bytes:
     """AP_P and RP_l per point, each on its own axes and in its own unit (um below 1 mm), each bar
     labelled with its value (precision rule)."""
     plt = _plt()
@@ -212,7 +216,8 @@ def _summary_figure(res: dict) -> bytes:
     return _png(fig)
 
 
-def iso9283_html(runs: dict, res: dict, title: str, layout: Optional[dict] = None, data_name: str = "") -> str:
+def iso9283_html(runs: dict[str, Any], res: dict[str, Any], title: str, layout: Optional[dict[str, Any]] = None,
+                 data_name: str = "") -> str:
     esc = report.esc
     pts = res["points"]
     dp, da = iso9283_decimals(res)
@@ -266,7 +271,7 @@ def _default_label(data: str, out: str) -> str:
 
 
 def run_iso9283(data: str, out: str, distance: Optional[str] = None, model: Optional[str] = None,
-                frame: str = "base", frame_label: Optional[str] = None, label: Optional[str] = None) -> dict:
+                frame: str = "base", frame_label: Optional[str] = None, label: Optional[str] = None) -> dict[str, Any]:
     """`kincal accuracy iso9283`: DIR/iso9283.json, DIR/report.html and the figures; returns the report.
     ``frame_label``: the frame the data are in, as the report says it (default "base (as given)");
     ``label``: which run this is, in the report's title (default: the output folder's name and the
@@ -288,14 +293,15 @@ def run_iso9283(data: str, out: str, distance: Optional[str] = None, model: Opti
     res = acc.iso9283(runs, names)
     layout = deviation_layout(runs, res)
     title = f"ISO 9283 pose accuracy and repeatability: {label or _default_label(data, out)}"
-    files = {"deviations.png": _deviation_figure(runs, res, layout), "summary.png": _summary_figure(res),
-             "iso9283.json": strict_json.dumps(res, indent=1) + "\n",
-             "report.html": iso9283_html(runs, res, title, layout, Path(data).name)}
+    files: dict[str, Union[str, bytes]] = {
+        "deviations.png": _deviation_figure(runs, res, layout), "summary.png": _summary_figure(res),
+        "iso9283.json": strict_json.dumps(res, indent=1) + "\n",
+        "report.html": iso9283_html(runs, res, title, layout, Path(data).name)}
     write_folder(out, files)
     return res
 
 
-def iso9283_summary(res: dict, out: str) -> str:
+def iso9283_summary(res: dict[str, Any], out: str) -> str:
     dp = iso9283_decimals(res)[0]
     w = dp + 7
     has_v = any("vAP_P_mm" in p for p in res["points"])
@@ -312,7 +318,7 @@ def iso9283_summary(res: dict, out: str) -> str:
 
 # --- ISO 230-2 / VDI/DGQ 3441 -------------------------------------------------------------------
 
-def axis_decimals(res: dict) -> tuple:
+def axis_decimals(res: dict[str, Any]) -> tuple[int, int]:
     """(decimals in the axis's unit, decimals of the per-metre figures in um/m) of the precision rule
     (the mean Ps_j of VDI/DGQ 3441, 6 s, as the repeatability figure; per metre of travel for the
     per-metre figures)."""
@@ -321,7 +327,7 @@ def axis_decimals(res: dict) -> tuple:
     return decimals(vdi["Ps_mean"]), per_m
 
 
-def axis_figures_text(res: dict) -> dict:
+def axis_figures_text(res: dict[str, Any]) -> dict[str, str]:
     """The one-line statements of the figures, each value with its unit and to the precision rule's
     digits: ``iso`` (ISO 230-2: A, E, M, R, B), ``vdi`` (VDI/DGQ 3441: P, its value per metre, Pa, Ps,
     U) and ``per_m`` (P and Ps per metre of travel; empty without). The figure's titles, the page and
@@ -336,7 +342,7 @@ def axis_figures_text(res: dict) -> dict:
             "per_m": per_m}
 
 
-def _axis_figure(data: dict, res: dict) -> bytes:
+def _axis_figure(data: dict[str, Any], res: dict[str, Any]) -> bytes:
     """Per-axis deviation bands: above, ISO 230-2 (each run's deviation, the mean per direction and
     the band mean +- 2 s); below, VDI/DGQ 3441 (the mean position deviation and the band of
     (U_j + Ps_j) / 2 around it, whose extent is P)."""
@@ -378,7 +384,7 @@ def _axis_figure(data: dict, res: dict) -> bytes:
     return _png(fig)
 
 
-def axis_html(data: dict, res: dict, title: str, data_name: str = "") -> str:
+def axis_html(data: dict[str, Any], res: dict[str, Any], title: str, data_name: str = "") -> str:
     u = res["unit"]
     iso, vdi = res["iso230_2"], res["vdi3441"]
     d = axis_decimals(res)[0]
@@ -414,7 +420,7 @@ targets.</li></ul>"""
     return report.page(title, body)
 
 
-def run_axis(data_path: str, out: str, unit: str = "mm", label: Optional[str] = None) -> dict:
+def run_axis(data_path: str, out: str, unit: str = "mm", label: Optional[str] = None) -> dict[str, Any]:
     """`kincal accuracy axis`: DIR/axis.json, DIR/report.html and DIR/axis.png; returns the report.
     ``label``: which axis and run this is, in the report's title (default: the output folder's name
     and the data file's)."""
@@ -423,12 +429,13 @@ def run_axis(data_path: str, out: str, unit: str = "mm", label: Optional[str] = 
     data = acc.read_axis(data_path)
     res = acc.axis_statistics(data, unit)
     title = f"Positioning accuracy of one axis: {label or _default_label(data_path, out)}"
-    files = {"axis.png": _axis_figure(data, res), "axis.json": strict_json.dumps(res, indent=1) + "\n",
-             "report.html": axis_html(data, res, title, Path(data_path).name)}
+    files: dict[str, Union[str, bytes]] = {
+        "axis.png": _axis_figure(data, res), "axis.json": strict_json.dumps(res, indent=1) + "\n",
+        "report.html": axis_html(data, res, title, Path(data_path).name)}
     write_folder(out, files)
     return res
 
 
-def axis_summary(res: dict, out: str) -> str:
+def axis_summary(res: dict[str, Any], out: str) -> str:
     text = axis_figures_text(res)
     return f"ISO 230-2: {text['iso']}\nVDI/DGQ 3441: {text['vdi']}\nreport: {Path(out) / 'report.html'}"

@@ -25,12 +25,12 @@ from .tool_frame import tcp_summary_line, tool_from_targets as place
 from .effect_choice import Candidate, applicable_joints, check_data as check_data_for
 from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, orientation_errors_deg, point_errors, rms, subset
 from .setups import _refit_placements, drift_report, setup_frames
-from .simulation import DEFAULT_HARMONICS
 # the names kincal.identify had before the calibration package, re-exported (`X as X`: explicitly, for mypy)
 from .fitting import options as options
 from .setups import (validate as validate, validation_figures as validation_figures,
                      validation_summary as validation_summary)
-from .simulation import (DEFAULT_INSTRUMENT as DEFAULT_INSTRUMENT, DEFAULT_TARGETS as DEFAULT_TARGETS,
+from .simulation import (DEFAULT_HARMONICS as DEFAULT_HARMONICS, DEFAULT_INSTRUMENT as DEFAULT_INSTRUMENT,
+                         DEFAULT_TARGETS as DEFAULT_TARGETS,
                          default_truth as default_truth, parse_hidden_effect as parse_hidden_effect,
                          simulate as simulate)
 

@@ -4,6 +4,7 @@ kincal.diagnose). Parsing and calling only."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 import time
@@ -18,7 +19,7 @@ from .options import (effect_opts, effects_arg, fit_options, fit_opts, harmonics
                       robot_of, robot_opts, say, step_progress, tool_targets)
 
 
-def cmd_simulate(args) -> None:
+def cmd_simulate(args: argparse.Namespace) -> None:
     robot = robot_of(args)
     if args.truth:
         truth = load_robot(args.truth)
@@ -43,7 +44,7 @@ def cmd_simulate(args) -> None:
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
 
-def cmd_identify(args) -> None:
+def cmd_identify(args: argparse.Namespace) -> None:
     robot = robot_of(args)
     data = ident.read_measurements(args.data, robot)
     effects = effects_arg(args, robot, data)
@@ -72,7 +73,7 @@ def cmd_identify(args) -> None:
     print(res.summary())
 
 
-def cmd_validate(args) -> None:
+def cmd_validate(args: argparse.Namespace) -> None:
     robot = load_robot(args.model)
     data = ident.read_measurements(args.data, robot)
     v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
@@ -81,7 +82,7 @@ def cmd_validate(args) -> None:
     print(ident.validation_summary(v))
 
 
-def _diagnose_fivebar(args) -> None:
+def _diagnose_fivebar(args: argparse.Namespace) -> None:
     pts = fivebar.read_table(args.data)
     report.check_folder(args.out)
     diag = fivebar.diagnose(pts, folds=args.folds, seed=args.seed, noise_mm=args.noise, say=say)
@@ -89,7 +90,7 @@ def _diagnose_fivebar(args) -> None:
     print(fivebar.diagnosis_summary(diag))
 
 
-def cmd_diagnose(args) -> None:
+def cmd_diagnose(args: argparse.Namespace) -> None:
     if args.robot == "fivebar":
         _diagnose_fivebar(args)
         return
@@ -108,7 +109,7 @@ def cmd_diagnose(args) -> None:
     print(diagnosis.summary(diag, model, args.out, time.perf_counter() - t0))
 
 
-def add_commands(sub) -> None:
+def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """simulate, identify and validate on the command line's subparsers ``sub``."""
     sp = sub.add_parser("simulate", help="a simulated measurement campaign on a true model")
     robot_opts(sp)
@@ -167,7 +168,7 @@ def add_commands(sub) -> None:
     sp.set_defaults(func=cmd_validate)
 
 
-def add_diagnose(sub) -> None:
+def add_diagnose(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """diagnose on the command line's subparsers ``sub``."""
     sp = sub.add_parser("diagnose", help="find the effect a model misses, add it, show the gap shrink")
     robot_opts(sp)

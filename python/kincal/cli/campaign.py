@@ -4,6 +4,7 @@ calling only."""
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 
@@ -13,7 +14,7 @@ from ..io.csv_text import format_rows
 from .options import effect_opts, robot_of, robot_opts, step_progress
 
 
-def _numbers(text: str, n: int, option: str) -> list:
+def _numbers(text: str, n: int, option: str) -> list[float]:
     """n comma-separated numbers of an option (a clear error otherwise)."""
     try:
         v = [float(x) for x in text.split(",")]
@@ -24,7 +25,7 @@ def _numbers(text: str, n: int, option: str) -> list:
     return v
 
 
-def cmd_plan(args) -> None:
+def cmd_plan(args: argparse.Namespace) -> None:
     from ..calibration import plan
 
     robot = robot_of(args)
@@ -54,7 +55,7 @@ def cmd_plan(args) -> None:
     print(f"wrote {len(res.q_deg)} configurations, in a short path order, to {args.out}")
 
 
-def cmd_accuracy_iso9283(args) -> None:
+def cmd_accuracy_iso9283(args: argparse.Namespace) -> None:
     from ..standards import report as rep
 
     res = rep.run_iso9283(args.data, args.out, distance=args.distance, model=args.model, frame=args.frame,
@@ -62,21 +63,21 @@ def cmd_accuracy_iso9283(args) -> None:
     print(rep.iso9283_summary(res, args.out))
 
 
-def cmd_accuracy_plan(args) -> None:
+def cmd_accuracy_plan(args: argparse.Namespace) -> None:
     from ..standards import iso9283_plan as iso
 
     print(iso.write_plan(robot_of(args), args.out, cube=args.cube, orientation=args.orientation, z_min=args.z_min,
                          cycles=args.cycles))
 
 
-def cmd_accuracy_axis(args) -> None:
+def cmd_accuracy_axis(args: argparse.Namespace) -> None:
     from ..standards import report as rep
 
     print(rep.axis_summary(rep.run_axis(args.data, args.out, args.unit, label=args.label), args.out))
 
 
 
-def add_commands(sub) -> None:
+def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """The plan and accuracy subcommands on the command line's subparsers ``sub``."""
     sp = sub.add_parser("plan", help="the configurations to measure that determine the model best (D-optimal)")
     robot_opts(sp)

@@ -3,6 +3,7 @@ commands, the simulated over-constrained 6-bar), for kincal.cli."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 
 from .. import _core
@@ -11,7 +12,7 @@ from ..io import strict_json
 from ..io.csv_text import format_rows
 
 
-def cmd_hr_fit(args) -> None:
+def cmd_hr_fit(args: argparse.Namespace) -> None:
     pts = fivebar.read_table(args.data)
     res = fivebar.fit(pts, args.method, args.score)
     _core.write_file_atomic(args.out, strict_json.dumps(res, indent=1) + "\n")
@@ -19,7 +20,7 @@ def cmd_hr_fit(args) -> None:
           f"points {res['points']}, largest error {res['max_error_mm'] * 1000:.1f} um")
 
 
-def cmd_hr_matrix(args) -> None:
+def cmd_hr_matrix(args: argparse.Namespace) -> None:
     model, pts = fivebar.load_fit(args.fit), fivebar.read_table(args.data)
     m = _core.ErrorMatrix.from_points(pts, args.data)  # a regular grid first, then commanded by the fit
     fivebar.check_commanded_by(model, pts, args.fit, args.data)
@@ -29,14 +30,14 @@ def cmd_hr_matrix(args) -> None:
           f"measured errors up to {e.max() * 1000:.1f} um")
 
 
-def cmd_hr_command(args) -> None:
+def cmd_hr_command(args: argparse.Namespace) -> None:
     model = fivebar.load_fit(args.fit)
     matrix = fivebar.load_matrix(args.matrix) if args.matrix else None
     q = _core.fivebar_command_file(model, matrix, args.targets)  # a point out of reach: file:line
     _core.write_file_atomic(args.out, format_rows(["theta1_deg", "theta2_deg"], q))
 
 
-def cmd_hr_simulate(args) -> None:
+def cmd_hr_simulate(args: argparse.Namespace) -> None:
     truth = _core.paper_sixbar(args.seed)
     model = fivebar.load_fit(args.fit) if args.fit else fivebar.FiveBar()
     matrix = fivebar.load_matrix(args.matrix) if args.matrix else None
@@ -47,7 +48,7 @@ def cmd_hr_simulate(args) -> None:
           f"largest error {fivebar.position_errors(pts).max() * 1000:.1f} um", file=sys.stderr)
 
 
-def add_commands(sub) -> None:
+def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """The `hidden-robot` command and its subcommands on the CLI's subparsers ``sub``."""
     hr = sub.add_parser("hidden-robot", help="five-bar hidden-robot calibration (the Kiper paper)")
     hsub = hr.add_subparsers(dest="hr_command", required=True)

@@ -3,12 +3,14 @@ files (kincal.programs.kinematics_files). Parsing and calling only."""
 
 from __future__ import annotations
 
+import argparse
+
 from ..calibration.setups import robot_for_setup
 from ..programs.kinematics_files import fk_file, ik_file
 from .options import robot_of, robot_opts
 
 
-def cmd_fk(args) -> None:
+def cmd_fk(args: argparse.Namespace) -> None:
     robot = robot_of(args)
     if args.setup is not None:
         if args.frame != "instrument":
@@ -17,11 +19,11 @@ def cmd_fk(args) -> None:
     fk_file(robot, args.robot, args.joints, args.out, args.frame, args.temperature)
 
 
-def cmd_ik(args) -> None:
+def cmd_ik(args: argparse.Namespace) -> None:
     ik_file(robot_of(args), args.robot, args.poses, args.out, args.all)
 
 
-def add_commands(sub) -> None:
+def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """fk and ik on the command line's subparsers ``sub``."""
     sp = sub.add_parser("fk", help="forward kinematics of a joint program")
     robot_opts(sp)

@@ -5,37 +5,41 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 import numpy as np
 
 from .. import _core, load_robot
 from ..calibration import identify as ident
 from ..calibration import priors
+from ..calibration.effect_choice import check_data
 from ..calibration.fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, masses
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
-def joint_convention_option(sp) -> None:
+
+def joint_convention_option(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--joint-convention", choices=["fanuc"],
                     help="how the controller numbers the joints of a URDF or built-in robot (a model JSON carries "
                          "its own): fanuc, J3 is the forearm's angle to the horizontal; every joint angle in the "
                          "files is then the controller's")
 
 
-def robot_opts(sp) -> None:
+def robot_opts(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--robot", required=True, help="built-in name (kr500), URDF file or model JSON")
     sp.add_argument("--base", help="URDF: base link of the chain (default: the root link)")
     sp.add_argument("--tip", help="URDF: tip link of the chain (default: the only leaf)")
     joint_convention_option(sp)
 
 
-def robot_of(args) -> _core.Robot:
+def robot_of(args: argparse.Namespace) -> _core.Robot:
     """The robot of --robot (with --base, --tip, --joint-convention where the command has them)."""
     return load_robot(args.robot, getattr(args, "base", None), getattr(args, "tip", None),
                       getattr(args, "joint_convention", None))
 
 
-def harmonics(text: str) -> list:
+def harmonics(text: str) -> list[int]:
     """--harmonics 1,2,3: transmission_error's harmonic orders."""
     try:
         h = [int(x) for x in text.split(",") if x.strip()]
@@ -46,12 +50,12 @@ def harmonics(text: str) -> list:
     return h
 
 
-def harmonics_option(sp, what: str) -> None:
+def harmonics_option(sp: argparse.ArgumentParser, what: str) -> None:
     sp.add_argument("--harmonics", type=harmonics, default=list(ident.DEFAULT_HARMONICS), metavar="K1,K2",
                     help=f"harmonic orders of {what} (default 1,2)")
 
 
-def effect_opts(sp, default: str, what: str) -> None:
+def effect_opts(sp: argparse.ArgumentParser, default: str, what: str) -> None:
     names = ", ".join(k.name for k in _core.effect_kinds() if k.domain == "serial")
     sp.add_argument("--effects", default=default,
                     help=f"{what}, comma separated: NAME (every joint where it applies) or NAME:J (joint J); "
@@ -60,13 +64,13 @@ def effect_opts(sp, default: str, what: str) -> None:
     harmonics_option(sp, "transmission_error")
 
 
-def loss_opts(sp, scale: Optional[float] = 0.1) -> None:
+def loss_opts(sp: argparse.ArgumentParser, scale: Optional[float] = 0.1) -> None:
     sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
     sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
                     + (f"{scale})" if scale else "from the residuals' robust spread)"))
 
 
-def fit_opts(sp) -> None:
+def fit_opts(sp: argparse.ArgumentParser) -> None:
     """The fitting options of identify and diagnose: one group, one default each (kincal.calibration.fitting)."""
     loss_opts(sp, DEFAULT_LOSS_SCALE_MM)
     sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated "
@@ -89,7 +93,7 @@ def fit_opts(sp) -> None:
                          "100: 0.02 mm against 0.011 deg of noise)")
 
 
-def fit_options(args, robot: _core.Robot) -> FitOptions:
+def fit_options(args: argparse.Namespace, robot: _core.Robot) -> FitOptions:
     """The fitting options of identify and diagnose (one group of options, one default each)."""
     prior_model = load_robot(args.prior_model) if args.prior_model else None
     if prior_model is not None and prior_model.dof != robot.dof:
@@ -103,16 +107,16 @@ def fit_options(args, robot: _core.Robot) -> FitOptions:
                       orientation_weight=args.orientation_weight, max_iterations=args.max_iterations)
 
 
-def effects_arg(args, robot: _core.Robot, data: dict):
+def effects_arg(args: argparse.Namespace, robot: _core.Robot, data: dict[str, Any]) -> Union[str, list[_core.Effect]]:
     """--effects: "auto" (identify's default) or a list (checked against the data's columns)."""
     if args.effects.strip() == "auto":
         return "auto"
     effects = ident.parse_effects(args.effects, robot, args.harmonics)
-    ident.check_data_for(effects, dict(data, source=args.data), robot)
+    check_data(effects, dict(data, source=args.data), robot)
     return effects
 
 
-def tool_targets(path: Optional[str], data: dict, data_path: str) -> Optional[np.ndarray]:
+def tool_targets(path: Optional[str], data: dict[str, Any], data_path: str) -> Optional[FloatArray]:
     """--tool-targets: x,y,z of each target of the measurements in the tool frame, one row each
     (checked before any fit: an error names the file and both counts)."""
     if not path:
@@ -125,7 +129,7 @@ def tool_targets(path: Optional[str], data: dict, data_path: str) -> Optional[np
     return known
 
 
-def progress(label: str):
+def progress(label: str) -> Optional[Callable[[int, float], None]]:
     """A one-line progress report of a solver's iterations on stderr (quiet when not a terminal)."""
     if not sys.stderr.isatty():
         return None
@@ -135,7 +139,7 @@ def progress(label: str):
     return report
 
 
-def step_progress(label: str):
+def step_progress(label: str) -> Optional[Callable[[int, int], None]]:
     """A one-line report of a loop's steps on stderr (quiet when not a terminal)."""
     if not sys.stderr.isatty():
         return None

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from ..calibration.tool_frame import warn_nominal_tcp
 FORMATS = ["krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"]
 
 
-def add_options(sp) -> None:
+def add_options(sp: argparse.ArgumentParser) -> None:
     joint_convention_option(sp)
     sp.add_argument("--format", choices=FORMATS,
                     help="the output's language (default: by --out's extension: .src KRL (+ .dat), .mod RAPID, "
@@ -67,7 +68,7 @@ def add_options(sp) -> None:
                          "than MM; the summary gives the largest deviation before and after")
 
 
-def _frame(text, option: str) -> list:
+def _frame(text: Optional[str], option: str) -> list[float]:
     if text is None:
         return []
     try:
@@ -79,7 +80,8 @@ def _frame(text, option: str) -> list:
     return v
 
 
-def compensate(robot, args, comp_kwargs: dict, progress=None) -> dict:
+def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[str, Any],
+               progress: Optional[Callable[[int, int], None]] = None) -> dict[str, Any]:
     """Compensates args.program (a file, or several files and folders: a controller backup) into args.out
     in the chosen language; returns the result dict (with `files`, the files written; a backup: `programs`,
     `copied`, `failed`). A model whose TCP is nominal (not measured) gets one warning line."""
@@ -97,7 +99,7 @@ def compensate(robot, args, comp_kwargs: dict, progress=None) -> dict:
                                           threads=args.jobs, progress=progress)
 
 
-def summary(res: dict) -> list[str]:
+def summary(res: dict[str, Any]) -> list[str]:
     """The summary's lines on a native program's targets (joints or filtered) and on --tolerance."""
     lines = [res["targets_note"]] if res.get("targets_note") else []
     if res.get("inserted") is None or res["path_before_mm"] != res["path_before_mm"]:  # NaN: no --tolerance
@@ -106,7 +108,7 @@ def summary(res: dict) -> list[str]:
                     f"before, {res['path_after_mm']:.4f} mm after {res['inserted']} inserted target(s)"]
 
 
-def compensate_backup(robot, args, comp_kwargs: dict) -> None:
+def compensate_backup(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[str, Any]) -> None:
     """A controller backup (folders, several files): every program filtered into the same tree under --out;
     a program that fails is listed (file:line: cause) and the exit status is 1, the others are written."""
     step = step_progress("kincal compensate: programs")  # (done counts from 1)
@@ -130,7 +132,7 @@ def compensate_backup(robot, args, comp_kwargs: dict) -> None:
         raise ValueError(f"{res['failed']} program(s) not written (the others are):\n  " + "\n  ".join(lines))
 
 
-def _comp_kwargs(args) -> dict:
+def _comp_kwargs(args: argparse.Namespace) -> dict[str, Any]:
     return dict(compensate=not args.nominal, instrument=args.frame == "instrument",
                 finite_difference=args.finite_difference, delta=args.delta, epsilon=args.epsilon,
                 max_iterations=args.max_iterations, corrected_start=not args.paper_start, residual=args.residual,
@@ -139,7 +141,7 @@ def _comp_kwargs(args) -> dict:
                 keep_branch=args.keep_branch)
 
 
-def cmd_compensate(args) -> None:
+def cmd_compensate(args: argparse.Namespace) -> None:
     robot = load_robot(args.model, joint_convention=args.joint_convention)
     if args.frame == "instrument" and not robot.identified:
         raise ValueError(f"{args.model}: --frame instrument needs an identified model (kincal identify)")
@@ -157,7 +159,7 @@ def cmd_compensate(args) -> None:
         print(f"{written}: {line}", file=sys.stderr)
 
 
-def _pair(text: str) -> tuple:
+def _pair(text: str) -> tuple[float, float]:
     try:
         a, b = (float(x) for x in text.split(","))
     except ValueError:
@@ -167,7 +169,7 @@ def _pair(text: str) -> tuple:
     return a, b
 
 
-def cmd_feed(args) -> None:
+def cmd_feed(args: argparse.Namespace) -> None:
     programs = {"program": args.program}
     if args.compare:
         programs["compare"] = args.compare
@@ -177,7 +179,7 @@ def cmd_feed(args) -> None:
     print(feed.summary(results, args.feed))
 
 
-def add_compensate(sub) -> None:
+def add_compensate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """compensate on the command line's subparsers ``sub``."""
     sp = sub.add_parser("compensate", help="Newton compensation of a pose program into a joint program")
     sp.add_argument("--model", required=True, help="built-in name, URDF file or model JSON")
@@ -207,7 +209,7 @@ def add_compensate(sub) -> None:
     sp.set_defaults(func=cmd_compensate)
 
 
-def add_feed(sub) -> None:
+def add_feed(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """feed on the command line's subparsers ``sub``."""
     sp = sub.add_parser("feed", help="derivative analysis of joint programs (Samak section III)")
     robot_opts(sp)

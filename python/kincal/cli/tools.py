@@ -3,6 +3,7 @@ pipeline on the built-in examples. Parsing and calling only."""
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import sys
 from pathlib import Path
@@ -10,14 +11,14 @@ from pathlib import Path
 from ..io import strict_json
 
 
-def cmd_bench(args) -> None:
+def cmd_bench(args: argparse.Namespace) -> None:
     # shipped in the wheel as the private kincal._benchmarks (benchmarks/_benchmarks in the source)
     benchmarks = importlib.import_module("kincal._benchmarks")
     r = benchmarks.run(args.poses, args.seed, args.threads, args.identify_poses, identify=not args.no_identify)
     print(strict_json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()}))
 
 
-def cmd_demo(args) -> None:
+def cmd_demo(args: argparse.Namespace) -> None:
     from ..demo import pipeline as demo
 
     def say(i: int, n: int, what: str) -> None:
@@ -28,7 +29,7 @@ def cmd_demo(args) -> None:
     print(f"report: {out / 'report.html'}", file=sys.stderr)
 
 
-def add_commands(sub) -> None:
+def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """bench and demo on the command line's subparsers ``sub``."""
     sp = sub.add_parser("bench", help="benchmarks: our code and KDL's solvers in one run, JSON on stdout")
     sp.add_argument("--poses", type=int, default=2000)

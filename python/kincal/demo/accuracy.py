@@ -15,7 +15,7 @@ accuracy_report.py) from runs the demo simulates and writes as the files those c
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -25,6 +25,9 @@ from .. import fivebar as fb
 from ..standards import iso9283_plan
 from .. import report
 from ..io.csv_text import format_rows
+
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
 
 #: ISO 9283 runs: the truth is deterministic, its repeatability is simulated as an isotropic
 #: Gaussian scatter of the attained position (mm, per axis) and of each attained angle (deg)
@@ -42,7 +45,7 @@ AXIS_TARGETS = 11
 RUNS_HEAD = ["point", "cycle", "xc", "yc", "zc", "ac", "bc", "cc", "x", "y", "z", "a", "b", "c"]
 
 
-def orientation_errors_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def orientation_errors_deg(a: FloatArray, b: FloatArray) -> FloatArray:
     """Angle (deg) of the rotation between the orientations (KUKA ABC, deg) of the rows of a and b."""
     out = np.empty(len(a))
     for i, (u, v) in enumerate(zip(a, b)):
@@ -51,7 +54,8 @@ def orientation_errors_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def iso9283_runs(robot, nominal_fitted, models: dict, truth, out: Path, seed: int) -> dict:
+def iso9283_runs(robot: _core.Robot, nominal_fitted: _core.Robot, models: dict[str, tuple[str, _core.Robot]],
+                 truth: _core.Robot, out: Path, seed: int) -> dict[str, Any]:
     """The ISO 9283 test on the truth: the test poses of ``robot`` (plan-iso9283, in its base frame)
     taught in the tracker frame where ``nominal_fitted`` (the nominal geometry with the measured
     tracker frame) puts them; per program (nominal IK, then Newton on each of ``models``: label ->
@@ -62,13 +66,14 @@ def iso9283_runs(robot, nominal_fitted, models: dict, truth, out: Path, seed: in
     base_poses = np.array([r[:6] for r in rows], dtype=float)
     names, cycles = [r[6] for r in rows], [int(r[7]) for r in rows]
     taught = fk(nominal_fitted, compensate(nominal_fitted, base_poses, compensate=False)["q_deg"], frame="instrument")
-    programs = {"uncompensated": ("uncompensated (nominal IK)", compensate(nominal_fitted, taught, compensate=False,
-                                                                          frame="instrument")["q_deg"])}
+    programs: dict[str, tuple[str, FloatArray]] = {
+        "uncompensated": ("uncompensated (nominal IK)",
+                          compensate(nominal_fitted, taught, compensate=False, frame="instrument")["q_deg"])}
     for key, (label, model) in models.items():
         programs[key] = (label, compensate(model, taught, frame="instrument")["q_deg"])
     rng = np.random.default_rng(seed)
     measured = [i for i, c in enumerate(cycles) if c >= 1]  # cycle 0 is the start at P1
-    reports = {}
+    reports: dict[str, dict[str, Any]] = {}
     for key, (label, q) in programs.items():
         att = run_program(truth, q, frame="instrument")
         att[:, :3] += rng.normal(0.0, REPEATABILITY_MM, (len(att), 3))
@@ -83,10 +88,11 @@ def iso9283_runs(robot, nominal_fitted, models: dict, truth, out: Path, seed: in
     return {"plan": plan, "programs": reports}
 
 
-def _axis_csv(path: Path, sixbar, model, matrix, line: np.ndarray, coord: int, seed: int) -> None:
+def _axis_csv(path: Path, sixbar: _core.SixBar, model: _core.FiveBar, matrix: Optional[_core.ErrorMatrix],
+              line: FloatArray, coord: int, seed: int) -> None:
     """AXIS.csv of `kincal accuracy axis` for one coordinate of the five-bar: the targets of ``line``
     (n x 2, in order of increasing ``coord``) visited up then down, AXIS_RUNS times."""
-    rows = []
+    rows: list[list[Any]] = []
     for run in range(1, AXIS_RUNS + 1):
         for d in (1, -1):
             order = line if d == 1 else line[::-1]
@@ -98,7 +104,8 @@ def _axis_csv(path: Path, sixbar, model, matrix, line: np.ndarray, coord: int, s
     _core.write_file_atomic(str(path), format_rows(["target", "direction", "run", "measured"], rows))
 
 
-def fivebar_axes(sixbar, model, matrix, out: Path, seed: int) -> dict:
+def fivebar_axes(sixbar: _core.SixBar, model: _core.FiveBar, matrix: Optional[_core.ErrorMatrix], out: Path,
+                 seed: int) -> dict[tuple[str, str], dict[str, Any]]:
     """VDI/DGQ 3441 and ISO 230-2 of the five-bar along x (at y = 0) and along y (at the workspace's
     middle x), corrected (``model`` + ``matrix``) and nominal: OUT/fivebar/axis_<mech>_<x|y>/ with
     axis.csv and the report of `kincal accuracy axis`."""
@@ -106,7 +113,7 @@ def fivebar_axes(sixbar, model, matrix, out: Path, seed: int) -> dict:
     xm = (x0 + x1) / 2.0
     lines = {"x": (np.c_[np.linspace(x0 + 1, x1 - 1, AXIS_TARGETS), np.zeros(AXIS_TARGETS)], 0),
              "y": (np.c_[np.full(AXIS_TARGETS, xm), np.linspace(y0 + 1, y1 - 1, AXIS_TARGETS)], 1)}
-    res: dict = {}
+    res: dict[tuple[str, str], dict[str, Any]] = {}
     for mech, (m, mx) in (("corrected", (model, matrix)), ("nominal", (fb.FiveBar(), None))):
         for name, (line, coord) in lines.items():
             folder = out / "fivebar" / f"axis_{mech}_{name}"
@@ -123,7 +130,7 @@ def _f(v: Optional[float], digits: int = 3) -> str:
     return accrep._f(v, digits)
 
 
-def iso9283_section(iso: dict, sigma_note: str) -> str:
+def iso9283_section(iso: dict[str, Any], sigma_note: str) -> str:
     plan = iso["plan"]
     c = plan["centre_mm"]
     # the precision rule of accuracy_report.py (the finest any program's repeatability asks for)
@@ -159,7 +166,7 @@ P5 in this cycle) and hits the others, as along the line, where its error jumps 
 diagnosed model, which carries the backlash, brings every AP_P below the repeatability.</p>"""
 
 
-def axis_section(axes: dict) -> str:
+def axis_section(axes: dict[tuple[str, str], dict[str, Any]]) -> str:
     rows = []
     for (mech, name), r in axes.items():
         v, i = r["vdi3441"], r["iso230_2"]

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
 
@@ -34,12 +34,15 @@ from .. import report
 from ..io import strict_json
 from ..io.csv_text import format_rows
 
+if TYPE_CHECKING:
+    from ..typing_ import FloatArray
+
 SEED = 7
 #: the effect the starting model does not know: joint 2 lags 0.01 deg behind its command (a gear's play)
 HIDDEN = [("backlash", 2, [math.radians(-0.01)])]
 
 
-def _gcode(poses: np.ndarray) -> str:
+def _gcode(poses: FloatArray) -> str:
     g = ["; kincal demo: 1480 mm straight tool path, 297 poses, tool pointing down (tracker frame)", "G90"]
     g += [f"N{10 * (i + 1)} G1 X{p[0]:.4f} Y{p[1]:.4f} Z{p[2]:.4f} A{p[3]:.5f} B{p[4]:.5f} C{p[5]:.5f}"
           for i, p in enumerate(poses)]
@@ -57,7 +60,7 @@ def _table1() -> Optional[Path]:
     return None
 
 
-def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
+def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     n_steps = 8
@@ -104,7 +107,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     q_unc, q_com, q_dia = np.asarray(unc["q_deg"]), np.asarray(com["q_deg"]), np.asarray(com_d["q_deg"])
     # what the true robot does with each program: geometry, compliance and the backlash of joint 2,
     # which acts with the direction each axis arrives from (the sign of its commanded motion)
-    def on_truth(q):
+    def on_truth(q: FloatArray) -> tuple[FloatArray, FloatArray]:
         att = run_program(truth, q, frame="instrument")
         return (np.linalg.norm(att[:, :3] - poses[:, :3], axis=1),
                 accuracy_demo.orientation_errors_deg(poses[:, 3:], att[:, 3:]))
@@ -129,7 +132,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     say(7, n_steps, "five-bar: the Kiper paper's Table I, fit and error matrix on the simulated 6-bar, VDI/DGQ 3441")
     hdir = out / "fivebar"
     hdir.mkdir(exist_ok=True)
-    table_fits = {}
+    table_fits: dict[str, dict[str, Any]] = {}
     table = _table1()
     if table is not None:
         t1_pts = fb.read_table(str(table))
@@ -200,7 +203,9 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict:
     return summary
 
 
-def _report(out: Path, res, diag, summary, err_unc, err_com, err_dia, fres, table_fits, sections) -> None:
+def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary: dict[str, Any], err_unc: FloatArray,
+            err_com: FloatArray, err_dia: FloatArray, fres: dict[str, dict[str, Any]],
+            table_fits: dict[str, dict[str, Any]], sections: dict[str, str]) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -308,7 +313,7 @@ hidden robot by {hb['fit'] * 1000:.0f} um, fit plus the 5 mm error matrix by {hb
     report.write(out / "report.html", "kincal demo", body)
 
 
-def summary_text(summary: dict) -> str:
+def summary_text(summary: dict[str, Any]) -> str:
     """One line on what run() found (its summary)."""
     return (f"identification: held-out RMS {summary['identification']['held_out_rms_before_mm']:.3f} -> "
             f"{summary['identification']['held_out_rms_after_mm']:.3f} mm; diagnosis named "

@@ -42,7 +42,8 @@ def choice_report(top: effect_choice.Choice, fold_choices: list[Optional[effect_
     for ch in fold_choices:
         for x in (ch.effects if ch is not None else []):
             counts[x.label] = counts.get(x.label, 0) + 1
-    out: dict[str, Any] = {"mode": "auto", "rule": f"F-test p < {effect_choice.ALPHA:g} and linear cross-validated gain > "
+    out: dict[str, Any] = {
+           "mode": "auto", "rule": f"F-test p < {effect_choice.ALPHA:g} and linear cross-validated gain > "
                                    f"{effect_choice.MIN_GAIN:.0%} (the diagnosis's), on {k_folds} folds of "
                                    "whole configurations",
            "kept": kept, "tried": sorted(tried.values(), key=lambda t: (not t["kept"], t.get("step", 0), -t["cv_gain"])),

@@ -163,7 +163,8 @@ class Spec:
                  fit: Optional[FitOptions] = None) -> None:
         self.robot = robot
         self.effects: list[Candidate] = list(effects)
-        self.penalties: list[tuple[str, float]] = list(penalties)  # (parameter name, weight): ridge penalties of the fit
+        #: (parameter name, weight): ridge penalties of the fit
+        self.penalties: list[tuple[str, float]] = list(penalties)
         self.fit_options = fit or FitOptions()
 
     def with_(self, cand: Candidate, penalties: Sequence[tuple[str, float]] = ()) -> Spec:
@@ -267,7 +268,8 @@ class _Linearised:
         have = {(e.name, e.joint) for e in res.layout.effect_list}
         self.extra = [c for c in candidates if isinstance(c, _core.Effect) and c.name != "joint_compliance"
                       and (c.name, c.joint) not in have]
-        self.cols: Optional[dict[tuple[str, int, tuple[int, ...], str], tuple[FloatArray, FloatArray, FloatArray]]] = None
+        self.cols: Optional[dict[tuple[str, int, tuple[int, ...], str],
+                                 tuple[FloatArray, FloatArray, FloatArray]]] = None
         self.added: list[FloatArray] = []  # the columns of the steps taken since the fit (unweighted)
         self.r_now: Optional[FloatArray] = None  # the residual after them (unweighted; None: the fit's)
         self.scale: Optional[float] = None  # where the candidates' scores bend (from the residual's spread)
@@ -285,7 +287,8 @@ class _Linearised:
                 spec = self.spec or Spec(self.robot, list(self.res.layout.effect_list), fit=self.fit)
                 self.cols[key] = (self.r, self.cur, fitted_compliance_columns(self.res, self.data, spec))
                 return self.cols[key]
-            if isinstance(cand, _core.Effect) and cand.name != "joint_compliance" and not any(cand == e for e in self.extra):
+            if (isinstance(cand, _core.Effect) and cand.name != "joint_compliance"
+                    and not any(cand == e for e in self.extra)):
                 r, cur, J, new, fit_of = evaluate(self.res, self.data, [cand])  # not among the round's candidates
             else:
                 r, cur, J, new, fit_of = self.r, self.cur, self.J, self.new, self.fit_of
@@ -345,7 +348,8 @@ class SerialProblem:
                  candidates: Sequence[Candidate] = ()) -> None:
         self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit
         self.candidates = list(candidates)
-        self.penalty: dict[tuple[str, int, int], list[tuple[str, float]]] = {}  # (name, joint, order) -> the penalties of the variant chosen
+        #: (name, joint, order) -> the penalties of the variant chosen
+        self.penalty: dict[tuple[str, int, int], list[tuple[str, float]]] = {}
         self.fits: list[tuple[list[Candidate], _core.IdentifyResult]] = []
         self.dims = 6 if "abc" in data else 3
         self.point_dims = 3
@@ -464,8 +468,9 @@ class Choice:
     problem: Optional[SerialProblem] = field(repr=False, default=None)
 
 
-def choose(robot: Robot, data: dict[str, Any], fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5, seed: int = 0,
-           max_steps: int = 6, say: Callable[[str], None] = lambda s: None, fit_chosen: bool = True) -> Choice:
+def choose(robot: Robot, data: dict[str, Any], fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5,
+           seed: int = 0, max_steps: int = 6, say: Callable[[str], None] = lambda s: None,
+           fit_chosen: bool = True) -> Choice:
     """`--effects auto` on one data set: the stepwise search over the candidates from the
     ``start`` effects (the significance rule of the diagnosis: ALPHA, MIN_GAIN, on ``k_folds`` folds
     of whole configurations), the starting model fitted once and each step's effect added to its

@@ -179,7 +179,8 @@ def report(fit: _core.IdentifyResult, loss: str, given_scale: Optional[float], s
                      "scale_from": "--loss-scale" if given_scale else "the residuals' robust spread"}}
 
 
-def summary_lines(fit: _core.IdentifyResult, info: dict[str, Any], worst: Sequence[tuple[int, int, float, float]]) -> list[str]:
+def summary_lines(fit: _core.IdentifyResult, info: dict[str, Any],
+                  worst: Sequence[tuple[int, int, float, float]]) -> list[str]:
     """The summary's lines on the loss, the priors and what stays at its prior."""
     lines = []
     loss = info["loss"]

@@ -148,8 +148,8 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
     return v
 
 
-def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1
-                      ) -> tuple[FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
+def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1) -> tuple[
+        FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
     targets, on the calibrated model (after) and the nominal one (before); orientation errors (or
     None); and the calibrated refit."""

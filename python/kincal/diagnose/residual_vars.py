@@ -127,7 +127,8 @@ def score(r: FloatArray, C: FloatArray, variables: Sequence[dict[str, Any]],
         W = (B[:, :, None] * B[:, None, :]).reshape(n, nb * nb)
         Bu = (B[:, :, None] * u[:, None, :]).reshape(n, nb * m)
 
-        def normal(rows: Union[slice, BoolArray]) -> tuple[FloatArray, FloatArray]:  # the normal equations of the rows, unknowns ordered (basis, carrier)
+        # the normal equations of the rows, unknowns ordered (basis, carrier)
+        def normal(rows: Union[slice, BoolArray]) -> tuple[FloatArray, FloatArray]:
             G = (W[rows].T @ M[rows]).reshape(nb, nb, m, m).transpose(0, 2, 1, 3).reshape(nb * m, nb * m)
             return G, Bu[rows].sum(axis=0)
 

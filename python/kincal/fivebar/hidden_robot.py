@@ -41,7 +41,8 @@ def largest_error(model: FiveBar, pts: dict[str, Any], desired: bool) -> float:
 
 
 
-def minimax_fit(pts: dict[str, Any], start: FiveBar, desired: bool = False, sides: int = 64, max_iter: int = 200) -> FiveBar:
+def minimax_fit(pts: dict[str, Any], start: FiveBar, desired: bool = False, sides: int = 64,
+                max_iter: int = 200) -> FiveBar:
     """The four lengths that minimise the largest distance between model and target (Chebyshev fit):
     linear programs on the linearised errors (each distance bounded by a regular polygon of
     ``sides`` sides) inside a trust region that shrinks when a step does not lower the true largest

@@ -228,9 +228,10 @@ class Search(Generic[E]):
     linearised: Optional[Linearisation[E]] = None
 
 
-def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, alpha: float = 1e-6, min_gain: float = 0.03,
-           max_steps: int = 6, say: Callable[[str], None] = lambda s: None, confirm: bool = True,
-           cur: Optional[float] = None, listed: int = LISTED, refit: bool = True) -> Search[E]:
+def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, alpha: float = 1e-6,
+           min_gain: float = 0.03, max_steps: int = 6, say: Callable[[str], None] = lambda s: None,
+           confirm: bool = True, cur: Optional[float] = None, listed: int = LISTED,
+           refit: bool = True) -> Search[E]:
     """The greedy search from the model with the ``start`` effects: at most ``max_steps`` effects of
     ``candidates`` added, each significant (F-test p below ``alpha``), gaining more than ``min_gain``
     in the linear cross-validation, and (with ``confirm``) lowering the refitted model's

@@ -7,8 +7,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
-import numpy as np
-
 from .. import _core
 from .._core import Robot
 from ..calibration import identify as ident

@@ -15,7 +15,7 @@ accuracy_report.py) from runs the demo simulates and writes as the files those c
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 import numpy as np
 
@@ -92,7 +92,7 @@ def _axis_csv(path: Path, sixbar: _core.SixBar, model: _core.FiveBar, matrix: Op
               line: FloatArray, coord: int, seed: int) -> None:
     """AXIS.csv of `kincal accuracy axis` for one coordinate of the five-bar: the targets of ``line``
     (n x 2, in order of increasing ``coord``) visited up then down, AXIS_RUNS times."""
-    rows: list[list[Any]] = []
+    rows: list[list[Union[str, int]]] = []
     for run in range(1, AXIS_RUNS + 1):
         for d in (1, -1):
             order = line if d == 1 else line[::-1]

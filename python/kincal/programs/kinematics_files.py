@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import sys
-from typing import TYPE_CHECKING, Any, Optional, Sequence
+from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
@@ -103,7 +103,7 @@ def ik_file(robot: _core.Robot, robot_arg: str, poses_path: str, out: str, every
         raise ValueError(f"{robot_arg}: no closed-form IK for this robot ({robot.ik_reason})")
     poses, lines = _core.read_pose_program(poses_path)
     ref = list(robot.home_deg) or [0.0] * robot.dof
-    rows: list[list[Any]] = []
+    rows: list[list[float]] = []  # integers (row, solution, within_limits) and angles
     for i, (pose, line) in enumerate(zip(poses, lines)):
         sols = ik(robot, pose, ref)
         if not sols:

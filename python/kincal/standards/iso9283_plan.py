@@ -172,9 +172,9 @@ def iso_poses(centre: FloatArray, edge: float, abc: FloatArray) -> dict[str, Flo
     return {k: out[k] for k in ("P1", "P2", "P3", "P4", "P5")}
 
 
-def program_rows(poses: dict[str, FloatArray], cycles: int) -> list[list[Any]]:
+def program_rows(poses: dict[str, FloatArray], cycles: int) -> list[list[Union[float, str]]]:
     """The pose program: P1 (cycle 0: the start), then per cycle P5, P4, P3, P2, P1."""
-    rows: list[list[Any]] = [list(poses["P1"]) + ["P1", 0]]
+    rows: list[list[Union[float, str]]] = [list(poses["P1"]) + ["P1", 0]]
     for j in range(1, cycles + 1):
         rows += [list(poses[p]) + [p, j] for p in ORDER[1:] + ["P1"]]
     return rows

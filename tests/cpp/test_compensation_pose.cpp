@@ -12,7 +12,8 @@
 using namespace kincal;
 
 TEST(Compensation, FiniteDifferenceAndAnalyticAgree) {
-  const Model cal(perturbed_spec(kr500_spec(), 6, 1.0, 0.05, 0.003));
+  KINCAL_SEED_TRACE(6);
+  const Model cal(perturbed_spec(kr500_spec(), test::test_seed(6), 1.0, 0.05, 0.003));
   const Model nom(kr500_spec());
   Vec6 q;
   q << -30, -50, 70, 100, -60, 45;
@@ -30,10 +31,11 @@ TEST(Compensation, FiniteDifferenceAndAnalyticAgree) {
 // The default compensation's analytic Jacobian of F (eq. 6) against central differences of F, on
 // random configurations of a kr500 with geometric errors, without and with joint compliance.
 TEST(Compensation, AnalyticJacobianMatchesFiniteDifferences) {
-  std::mt19937_64 rng(32);
+  KINCAL_SEED_TRACE(32, 7);
+  std::mt19937_64 rng(test::test_seed(32));
   double worst = 0;
   for (double compliance : {0.0, 0.003}) {
-    const Model cal(perturbed_spec(kr500_spec(), 7, 1.0, 0.05, compliance));
+    const Model cal(perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, compliance));
     for (int i = 0; i < 200; ++i) {
       const Vec6 q = test::random_q(cal, rng, 1.0);
       Vec6 qt = q;
@@ -59,7 +61,8 @@ TEST(Compensation, AnalyticJacobianMatchesFiniteDifferences) {
 // mm-sized units, wrist rows in unit-sized ones): well-conditioned blocks, an arm block that is
 // singular while the system is not (the pivoted fallback), and a singular system.
 TEST(Compensation, BlockSolveMatchesPivotedLu) {
-  std::mt19937_64 rng(33);
+  KINCAL_SEED_TRACE(33);
+  std::mt19937_64 rng(test::test_seed(33));
   std::normal_distribution<double> nd;
   double worst = 0;
   int fallbacks = 0;

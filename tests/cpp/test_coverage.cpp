@@ -6,6 +6,8 @@
 #include "kincal/model/coverage.hpp"
 #include "kincal/model/robots.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -63,7 +65,8 @@ TEST(Coverage, OutsideCountsTurnsAndTheMargin) {
 }
 
 TEST(Coverage, ModelJsonCarriesTheRangesAndRejectsBadOnes) {
-  ModelSpec s = perturbed_spec(kr500_spec(), 3, 1.0, 0.05, 0.003);
+  KINCAL_SEED_TRACE(3);
+  ModelSpec s = perturbed_spec(kr500_spec(), test::test_seed(3), 1.0, 0.05, 0.003);
   s.fitted_deg = {{-170.0, 160.0}, {-120.0, -60.0}, {-80.0, 130.0}, {25.0, 370.0}, {-100.0, 100.0}, {-180.0, 180.0}};
   const Robot r{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(s)};
   const std::string text = robot_to_json(r);
@@ -90,8 +93,9 @@ TEST(Coverage, ModelJsonCarriesTheRangesAndRejectsBadOnes) {
 }
 
 TEST(Coverage, ExtrapolatedNamesTheJointsOfPeriodicEffectsOnly) {
+  KINCAL_SEED_TRACE(3);
   const double d = kDeg;
-  ModelSpec s = with_effects(perturbed_spec(kr500_spec(), 3, 1.0, 0.05, 0.003),
+  ModelSpec s = with_effects(perturbed_spec(kr500_spec(), test::test_seed(3), 1.0, 0.05, 0.003),
                              {{Effect{"transmission_error", 1, {1, 2}}, {0.02 * d, 0, 0, 0.01 * d}},
                               {Effect{"backlash", 2, {}}, {0.01 * d}}},
                              20.0);

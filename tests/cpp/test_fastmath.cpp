@@ -24,7 +24,8 @@ double ulps(double got, long double truth) {
 }  // namespace
 
 TEST(FastMath, SinCosWithinFourUlp) {
-  std::mt19937_64 rng(11);
+  KINCAL_SEED_TRACE(11);
+  std::mt19937_64 rng(kincal::test::test_seed(11));
   double worst_s = 0, worst_c = 0;
   const int n = std::max(400000, kincal::test::count(0));
   for (double range : {1.0, 7.0, 40.0, 1e3, 1e5}) {
@@ -54,7 +55,8 @@ TEST(FastMath, SinCosWithinFourUlp) {
 }
 
 TEST(FastMath, Atan2AndAcosWithinFourUlp) {
-  std::mt19937_64 rng(12);
+  KINCAL_SEED_TRACE(12);
+  std::mt19937_64 rng(kincal::test::test_seed(12));
   std::uniform_real_distribution<double> sign(-1, 1), expo(-9, 9), rel(-1e-3, 1e-3);
   double worst = 0, worst_acos = 0;
   const int n = std::max(1000000, kincal::test::count(0));
@@ -99,7 +101,8 @@ TEST(FastMath, SpecialValuesAsLibm) {
 
 // The pair version gives what two single calls give, bit for bit (and libm's beyond the fast range).
 TEST(FastMath, PairsEqualSingles) {
-  std::mt19937_64 rng(12);
+  KINCAL_SEED_TRACE(12);
+  std::mt19937_64 rng(kincal::test::test_seed(12));
   std::uniform_real_distribution<double> u(-40, 40);
   int differ = 0;
   for (int i = 0; i < 200000; ++i) {

@@ -70,9 +70,10 @@ ModelSpec random_robot(std::mt19937_64& rng, bool orthogonal_wrist = false, bool
 }  // namespace
 
 TEST(Ik, Kr500AllSolutionsRoundTrip) {
+  KINCAL_SEED_TRACE(21);
   const Model m(kr500_spec());
   const IkSolver ik(m);
-  std::mt19937_64 rng(21);
+  std::mt19937_64 rng(test::test_seed(21));
   double wp = 0, wr = 0;
   for (int i = 0, n = test::count(5000); i < n; ++i) check_round_trip(m, ik, test::random_q(m, rng), wp, wr);
   EXPECT_LT(wp, 1e-9);  // mm
@@ -80,7 +81,8 @@ TEST(Ik, Kr500AllSolutionsRoundTrip) {
 }
 
 TEST(Ik, AnyOffsetsRoundTrip) {
-  std::mt19937_64 rng(22);
+  KINCAL_SEED_TRACE(22);
+  std::mt19937_64 rng(test::test_seed(22));
   double wp = 0, wr = 0;
   int robots = 0, inexact23 = 0;
   for (int r = 0; r < 200; ++r) {

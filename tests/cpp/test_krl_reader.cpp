@@ -326,6 +326,7 @@ TEST(KrlReader, KrlNameDeclaredNowhereIsUnresolved) {
 }
 
 TEST(KrlReader, KrlBackupProgramsReadAsOneReachTheirTaughtBranch) {
+  KINCAL_SEED_TRACE(9);
   // the three programs read as one: motions in their files, each declared target once per frame, and every
   // target reached by the nominal kr500 on its taught branch through its own tool and base
   const NativeProgram p = read_native_programs({program("pick.src"), program("weld.src"), program("service.src")},

@@ -55,6 +55,7 @@ const char* kGcode =
 }  // namespace
 
 TEST(Io, GcodeWordsAreReplacedAndEverythingElsePassesThrough) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   const std::string in = tmp("p.gcode", kGcode), out = ::testing::TempDir() + "q.gcode";
   const ProgramResult res = compensate_program_file(r, in, out, ProgramOptions{});
@@ -82,6 +83,7 @@ TEST(Io, GcodeWordsAreReplacedAndEverythingElsePassesThrough) {
 }
 
 TEST(Io, BadInputNamesFileLineAndCauseAndWritesNothing) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   const std::string out = ::testing::TempDir() + "never.csv";
   std::remove(out.c_str());
@@ -115,6 +117,7 @@ TEST(Io, BadInputNamesFileLineAndCauseAndWritesNothing) {
 // word is an error naming the file, the line and the word; the motion is never dropped and no output is
 // written. (Before: "G1 Xnan" passed through as an unknown word, "X1,5" and "X1e400" read as X1.)
 TEST(Io, NonFiniteOrNonDecimalGcodeNumbersAreErrors) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   const std::string out = ::testing::TempDir() + "never.gcode";
   std::remove(out.c_str());
@@ -174,6 +177,7 @@ TEST(Io, ADwellIsNoMotion) {
 // A CRLF program comes back with CRLF, line by line (the LF program's output with each "\n" a "\r\n");
 // mixed line ends and a last line without a newline are kept as they were.
 TEST(Io, GcodeLinesKeepTheirOwnLineEnds) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   const std::string lf_in = tmp("lf.gcode", kGcode), crlf_in = tmp("crlf.gcode", replaced(kGcode, "\n", "\r\n"));
   const std::string lf_out = ::testing::TempDir() + "lf_o.gcode", crlf_out = ::testing::TempDir() + "crlf_o.gcode";
@@ -199,6 +203,7 @@ TEST(Io, GcodeLinesKeepTheirOwnLineEnds) {
 // byte order mark (as Excel writes it) skipped. (Before: the quoted comma split the field, "8 fields, the
 // header has 7"; the mark made the first column "\xEF\xBB\xBFx", "missing column 'x'".)
 TEST(Io, CsvQuotedFieldsAndByteOrderMark) {
+  KINCAL_SEED_TRACE(9);
   const CsvTable t = parse_csv("\xEF\xBB\xBF" "x,\"note, with comma\",y\n"
                                "1,\"hello, world\",2\n"
                                "  3 , \"say \"\"hi\"\"\" ,4\r\n"

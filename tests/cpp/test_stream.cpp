@@ -28,6 +28,7 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 TEST(Io, StreamEqualsFileAndAllocatesNothingPerLine) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   // a 200-pose G-code program with pass-through words
   std::ostringstream prog;
@@ -77,7 +78,8 @@ TEST(Io, StreamEqualsFileAndAllocatesNothingPerLine) {
 // commanded motion, thermal expansion at --temperature) on a back-and-forth G-code program: equal to
 // the file given the same first directions, and still no allocation per line.
 TEST(Io, StreamWithEveryEffectAllocatesNothingPerLine) {
-  ModelSpec s = perturbed_spec(kr500_spec(), 8, 1.0, 0.05, 0.003);
+  KINCAL_SEED_TRACE(8);
+  ModelSpec s = perturbed_spec(kr500_spec(), test::test_seed(8), 1.0, 0.05, 0.003);
   s.effects.push_back({Effect{"transmission_error", 1, {1, 2}}, {3e-4, -2e-4, 1e-4, 0.0}});
   s.effects.push_back({Effect{"backlash", 0, {}}, {-2e-4}});
   s.effects.push_back({Effect{"backlash", 2, {}}, {-3e-4}});
@@ -123,6 +125,7 @@ TEST(Io, StreamWithEveryEffectAllocatesNothingPerLine) {
 // solve_pose, the per-pose path of programs and of the stream, allocates nothing when the branch
 // nearest the reference gives the answer.
 TEST(Io, SolvePoseAllocatesNothingOnTheNearestBranch) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   Vec6 q;
   q << 10, -70, 95, 20, 40, -10;
@@ -144,6 +147,7 @@ TEST(Io, SolvePoseAllocatesNothingOnTheNearestBranch) {
 // The stream stops at the first bad line (README): a NaN, infinite or non-decimal pose word is an error
 // naming stdin:line and the word (before: "G1 Xnan" came out unchanged and the motion was dropped).
 TEST(Io, StreamStopsAtANonFiniteWord) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   for (const char* w : {"Xnan", "Xinf", "X1,5", "X1e400"}) {
     StreamCompensator sc(r, ProgramOptions{});
@@ -164,6 +168,7 @@ TEST(Io, StreamStopsAtANonFiniteWord) {
 // A CRLF G-code line comes out with its '\r' (the caller adds the '\n'), an LF line without; a CSV stream
 // may start with Excel's byte order mark and carry quoted extra columns.
 TEST(Io, StreamKeepsCrlfAndReadsExcelCsv) {
+  KINCAL_SEED_TRACE(9);
   const Robot r = kr500_calibrated();
   StreamCompensator sc(r, ProgramOptions{});
   char buf[8192];

@@ -1,4 +1,5 @@
-// Shared helpers of the C++ tests: seeded random configurations, the test count CI can raise.
+// Shared helpers of the C++ tests: seeded random configurations, the test count CI can raise and the
+// seed it can change.
 #pragma once
 
 #include "kincal/ik/ik.hpp"
@@ -6,8 +7,15 @@
 #include "kincal/model/model.hpp"
 #include "kincal/model/robots.hpp"
 
+#include <gtest/gtest.h>
+
+#include <cerrno>
+#include <cstdint>
 #include <cstdlib>
+#include <initializer_list>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 namespace kincal::test {
 
@@ -15,6 +23,47 @@ namespace kincal::test {
 inline int count(int dflt) {
   const char* e = std::getenv("KINCAL_TEST_COUNT");
   return e ? std::max(1, std::atoi(e)) : dflt;
+}
+
+/// KINCAL_TEST_SEED as an unsigned integer, or false when it is not set; a value that is not one (empty,
+/// a sign, letters, beyond 2^64 - 1) throws std::invalid_argument naming the variable.
+inline bool seed_override(std::uint64_t& value) {
+  const char* e = std::getenv("KINCAL_TEST_SEED");
+  if (!e) return false;
+  const std::string s(e);
+  const bool digits = !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+  errno = 0;
+  value = digits ? std::strtoull(s.c_str(), nullptr, 10) : 0;
+  if (!digits || errno == ERANGE)
+    throw std::invalid_argument("KINCAL_TEST_SEED='" + s + "' is not an unsigned integer (0 .. 2^64 - 1)");
+  return true;
+}
+
+/// The seed of a randomized test whose default seed is dflt: dflt itself, or with KINCAL_TEST_SEED=S set,
+/// a seed drawn from S and dflt (splitmix64 of both), so that one variable changes every test's seed while
+/// the different streams of one test (a fit and a held-out campaign, the truth and its poses) stay
+/// different. Deterministic: the same S gives the same seeds.
+inline unsigned test_seed(unsigned dflt) {
+  std::uint64_t s;
+  if (!seed_override(s)) return dflt;
+  std::uint64_t z = s * 0x9E3779B97F4A7C15ull + dflt + 0x632BE59BD9B4E019ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return static_cast<unsigned>((z ^ (z >> 31)) & 0xFFFFFFFFu);
+}
+
+/// What a failure prints of a test's seeds (SCOPED_TRACE): the seeds used, their defaults and the
+/// KINCAL_TEST_SEED that reproduces them.
+inline std::string seed_note(std::initializer_list<unsigned> defaults) {
+  std::uint64_t s;
+  const bool set = seed_override(s);
+  std::string used, dflt;
+  for (unsigned d : defaults) {
+    used += (used.empty() ? "" : ", ") + std::to_string(test_seed(d));
+    dflt += (dflt.empty() ? "" : ", ") + std::to_string(d);
+  }
+  return "seed(s) " + used + (set ? " from the default(s) " + dflt + " with KINCAL_TEST_SEED=" + std::to_string(s)
+                                  : " (the defaults: KINCAL_TEST_SEED unset)");
 }
 
 inline Vec6 random_q(const Model& m, std::mt19937_64& rng, double margin_deg = 0) {
@@ -43,3 +92,6 @@ inline double singularity_distance_deg(const Model& m, const Vec6& q) {
 }
 
 }  // namespace kincal::test
+
+/// Prints the test's seeds with a failure: KINCAL_SEED_TRACE(31) or KINCAL_SEED_TRACE(21, 3, 4).
+#define KINCAL_SEED_TRACE(...) SCOPED_TRACE(::kincal::test::seed_note({__VA_ARGS__}))

@@ -138,7 +138,7 @@ IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
   bool any = false;
   std::vector<int> joints;
   for (const Effect& e : o.effects) {
-    if (e.name != "joint_compliance") {
+    if (!e.kind().gravity_loaded_only) {
       rest.push_back(e);
       continue;
     }

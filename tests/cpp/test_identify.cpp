@@ -143,7 +143,7 @@ TEST(Identify, HiddenTransmissionErrorIsRecovered) {
   so.poses = 150;
   so.targets = kTargets;
   EffectValue te;
-  te.effect.name = "transmission_error";
+  te.effect = Effect("transmission_error");
   te.effect.joint = 1;
   te.p = {0.01 * d2r, 0.0, 0.0, 0.005 * d2r};
   so.effects.push_back(te);

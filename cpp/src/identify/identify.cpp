@@ -197,7 +197,7 @@ bool same_effect(const Effect& a, const Effect& b) { return a.name == b.name && 
 std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt) {
   std::vector<Effect> effects = opt.effects;
   for (const EffectValue& ev : nominal.spec().effects) {
-    if (ev.effect.name == "drift") continue;
+    if (ev.effect.kind().of_instrument()) continue;
     bool asked = false;
     for (const Effect& e : effects) asked = asked || same_effect(e, ev.effect);
     if (!asked) effects.push_back(ev.effect);
@@ -206,27 +206,25 @@ std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOpti
 }
 
 bool has_thermal(const std::vector<Effect>& effects) {
-  return std::any_of(effects.begin(), effects.end(), [](const Effect& e) { return e.name == "thermal_expansion"; });
+  return std::any_of(effects.begin(), effects.end(), [](const Effect& e) { return e.kind().scales_lengths(); });
 }
 
 /// InputError unless the effects are valid for the robot and the data carry the columns they read
-/// (temperature_c for thermal_expansion, dir1..dirN for backlash).
+/// (the registry's needs: temperature_c, time_s, dir1..dirN).
 void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
   for (const Effect& e : effects) check_effect(e, nominal.dof(), "");
-  if (has_thermal(effects))
-    for (const auto& r : data.rows)
-      if (std::isnan(r.temperature_c))
-        throw InputError(where(data, r) + ": thermal_expansion needs the temperature_c column");
-  for (const Effect& e : effects)
-    if (e.name == "drift")
-      for (const auto& r : data.rows)
-        if (std::isnan(r.time_s)) throw InputError(where(data, r) + ": drift needs the time_s column");
-  for (const Effect& e : effects)
-    if (e.name == "backlash")
-      for (const auto& r : data.rows)
-        if (r.dir.size() != nominal.dof())
-          throw InputError(where(data, r) + ": backlash needs the dir1..dir" + std::to_string(nominal.dof()) +
-                           " columns");
+  for (const Effect& e : effects) {  // the column each effect reads (the registry's "needs")
+    const std::string& column = e.kind().needs;
+    for (const auto& r : data.rows) {
+      if (column == "temperature_c" && std::isnan(r.temperature_c))
+        throw InputError(where(data, r) + ": " + e.name + " needs the temperature_c column");
+      if (column == "time_s" && std::isnan(r.time_s))
+        throw InputError(where(data, r) + ": " + e.name + " needs the time_s column");
+      if (column == "dir" && r.dir.size() != nominal.dof())
+        throw InputError(where(data, r) + ": " + e.name + " needs the dir1..dir" + std::to_string(nominal.dof()) +
+                         " columns");
+    }
+  }
 }
 
 /// The reference temperature of thermal_expansion: the starting model's, or the mean of the data's
@@ -240,7 +238,7 @@ double reference_temperature(const Model& nominal, const MeasurementSet& data, c
 
 /// The drift's reference time: the data's mean time (the placements are those of that moment).
 double reference_time(const MeasurementSet& data, const std::vector<Effect>& effects) {
-  if (std::none_of(effects.begin(), effects.end(), [](const Effect& e) { return e.name == "drift"; })) return 0;
+  if (std::none_of(effects.begin(), effects.end(), [](const Effect& e) { return e.kind().of_instrument(); })) return 0;
   double sum = 0;
   for (const auto& r : data.rows) sum += r.time_s;
   return sum / data.rows.size();
@@ -252,7 +250,7 @@ void start_carried_effects(const Model& nominal, const IdentifyOptions& opt, Ide
   for (size_t e = 0; e < L.effect_list.size(); ++e)
     for (const EffectValue& ev : nominal.spec().effects)
       if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size() &&
-          ev.effect.name != "drift") {
+          !ev.effect.kind().of_instrument()) {
         const bool asked = e < opt.effects.size();
         for (size_t k = 0; k < ev.p.size(); ++k) {
           const int i = L.effect_offset[e] + static_cast<int>(k);
@@ -296,7 +294,8 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   res.nominal_fitted = pm.spec();
   res.nominal_fitted.name = nominal.spec().name;
   if (L.drift >= 0) {  // the "before" model sees the points from the same drifting instrument
-    res.nominal_fitted.effects.push_back({Effect{"drift", -1, {}}, std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)});
+    res.nominal_fitted.effects.push_back({Effect{effect_kind(EffectId::drift).name, -1, {}},
+                                          std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)});
     res.nominal_fitted.t_mean_s = L.t_mean;
   }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));

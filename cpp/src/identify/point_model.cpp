@@ -27,12 +27,13 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
   scale = 1.0;
   double b[128];
   for (const Effect& e : eff) {
-    if (e.name == "thermal_expansion") {
-      if (std::isnan(m.temperature_c)) throw InputError("thermal_expansion needs the temperature_c column");
+    const EffectKind& kind = e.kind();
+    if (kind.scales_lengths()) {
+      if (std::isnan(m.temperature_c)) throw InputError(e.name + " needs the temperature_c column");
       scale *= 1.0 + p[0] * (m.temperature_c - t_ref);
-    } else if (e.name != "drift") {  // the drift moves the instrument, not the robot
-      if (e.name == "backlash" && m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
-      joint_basis(e, m.q_deg[e.joint] * kDeg, e.name == "backlash" ? m.dir[e.joint] : 0.0, b);
+    } else if (!kind.of_instrument()) {  // the drift moves the instrument, not the robot
+      if (kind.reads_dir() && m.dir.size() != m.q_deg.size()) throw InputError(e.name + " needs the dir1..dirN columns");
+      joint_basis(e, m.q_deg[e.joint] * kDeg, kind.reads_dir() ? m.dir[e.joint] : 0.0, b);
       for (int k = 0; k < e.size(); ++k) dq[e.joint] += p[k] * b[k];
     }
     p += e.size();
@@ -60,10 +61,10 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
   size = effects;
   for (const Effect& e : effect_list) {
     check_effect(e, dof, "");
-    if (e.name == "joint_compliance")
+    if (e.kind().gravity_loaded_only)
       throw InputError("joint_compliance is identified through IdentifyOptions::compliance, not as an extra effect");
-    if (e.name == "drift") {
-      if (drift >= 0) throw InputError("drift is given twice");
+    if (e.kind().of_instrument()) {
+      if (drift >= 0) throw InputError(e.name + " is given twice");
       drift = size;
     }
     effect_offset.push_back(size);
@@ -372,10 +373,11 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
-    if (ef.name == "drift") continue;  // the instrument's, above
-    if (ef.name != "thermal_expansion") {  // joint-angle effects: dq_j = p . basis
+    const EffectKind& kind = ef.kind();
+    if (kind.of_instrument()) continue;  // the instrument's, above
+    if (!kind.scales_lengths()) {  // joint-angle effects: dq_j = p . basis
       double b[128];
-      joint_basis(ef, q[ef.joint], ef.name == "backlash" ? m.dir[ef.joint] : 0.0, b);
+      joint_basis(ef, q[ef.joint], kind.reads_dir() ? m.dir[ef.joint] : 0.0, b);
       for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb * jp[ef.joint] * b[k];
       if (ang)
         for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb * jw[ef.joint] * b[k];
@@ -388,7 +390,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
     // the drift's)
     J.leftCols(layout_.base) *= scale;
     for (size_t e = 0; e < layout_.effect_list.size(); ++e)
-      if (layout_.effect_list[e].name != "thermal_expansion" && layout_.effect_list[e].name != "drift")
+      if (!layout_.effect_list[e].kind().scales_lengths() && !layout_.effect_list[e].kind().of_instrument())
         J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
   }
   return y;

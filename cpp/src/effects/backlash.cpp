@@ -9,7 +9,7 @@ namespace kincal {
 const EffectKind& backlash_kind() {
   static const EffectKind k{
       EffectId::backlash, "backlash", "serial", "joint", "dir", "joint_angle",
-      "an offset of the joint angle that depends on the approach direction: b dir (deg)", false, false,
+      "an offset of the joint angle that depends on the approach direction: b dir (deg)", false, false, 1,
       [](const Effect&) { return std::vector<std::string>{"backlash"}; },
       [](const Effect&) { return std::vector<std::string>{"rad"}; }, nullptr,
       [](const Effect&, double, double dir, double* b, double* db) {

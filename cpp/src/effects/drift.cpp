@@ -12,7 +12,7 @@ const EffectKind& drift_kind() {
       EffectId::drift, "drift", "serial", "robot", "time_s", "instrument",
       "the instrument's placement moving linearly with time (a property of the measurement: removed from "
       "the fit, never compensated): translation mm/h and rotation deg/h about the campaign's mean time",
-      false, false,
+      false, false, 6,
       [](const Effect&) {
         return std::vector<std::string>{"drift_x", "drift_y", "drift_z", "drift_rx", "drift_ry", "drift_rz"};
       },

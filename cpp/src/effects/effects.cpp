@@ -47,7 +47,7 @@ Effect::Effect(std::string name_, int joint_, std::vector<int> harmonics_)
 
 int Effect::size() const {
   if (harmonic()) return 2 * static_cast<int>(harmonics.size());
-  return static_cast<int>(kind().parameter_names(*this).size());
+  return kind().parameters;
 }
 
 int Effect::order() const { return id() == EffectId::joint_map && !harmonics.empty() ? harmonics.back() : 0; }

@@ -7,7 +7,7 @@ namespace kincal {
 
 const EffectKind& joint_compliance_kind() {
   static const EffectKind k{EffectId::joint_compliance, "joint_compliance", "serial", "joint", "", "joint_angle",
-                            "joint deflection proportional to the gravity torque (deg per kN m)", true, false,
+                            "joint deflection proportional to the gravity torque (deg per kN m)", true, false, 1,
                             [](const Effect&) { return std::vector<std::string>{"compliance"}; },
                             [](const Effect&) { return std::vector<std::string>{"deg/kNm"}; }, nullptr, nullptr};
   return k;

@@ -7,7 +7,7 @@ namespace kincal {
 const EffectKind& thermal_expansion_kind() {
   static const EffectKind k{EffectId::thermal_expansion, "thermal_expansion", "serial", "robot", "temperature_c",
                             "length_scale", "the robot's lengths scale by 1 + alpha (T - t_ref) (alpha per deg C)",
-                            false, false, [](const Effect&) { return std::vector<std::string>{"thermal_expansion"}; },
+                            false, false, 1, [](const Effect&) { return std::vector<std::string>{"thermal_expansion"}; },
                             [](const Effect&) { return std::vector<std::string>{"1/degC"}; }, nullptr, nullptr};
   return k;
 }

@@ -26,7 +26,7 @@ void check(const Effect& e, const std::string& who) {
 const EffectKind& transmission_error_kind() {
   static const EffectKind k{
       EffectId::transmission_error, "transmission_error", "serial", "joint", "", "joint_angle",
-      "errors periodic in the joint angle: sine and cosine amplitudes of each harmonic order (deg)", false, true,
+      "errors periodic in the joint angle: sine and cosine amplitudes of each harmonic order (deg)", false, true, 0,
       [](const Effect& e) { return harmonic::names("te_", e.harmonics); }, harmonic::units, check,
       [](const Effect& e, double q, double, double* b, double* db) { harmonic::basis(e.harmonics, q, b, db); }};
   return k;

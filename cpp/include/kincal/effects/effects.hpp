@@ -34,6 +34,7 @@ struct EffectKind {
   std::string description;
   bool gravity_loaded_only;  ///< per joint only where gravity loads the joint (joint_compliance)
   bool harmonic;             ///< its parameters: a sine and a cosine amplitude per harmonic order of the Effect
+  int parameters;            ///< how many parameters it has (a harmonic one: 0, two per order)
   /// parameter names without the joint prefix (e.g. te_sin1, te_cos1) and their core units ("rad",
   /// "1/degC", "deg/kNm", "mm", "mm/h", "rad/h"), one per parameter
   std::vector<std::string> (*parameter_names)(const Effect&);

@@ -47,7 +47,7 @@ TEST(Identify, NoiseFreeGeometricErrorsFittedExactly) {
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
   opt.compliance = false;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(nominal, fit, opt);
   const Model cal(r.calibrated);
   const double before = rms(point_errors(nominal, {Vec3::Zero()}, held));
@@ -122,7 +122,7 @@ TEST(Identify, RobustLossIgnoresGrossOutliers) {
   const double e_dirty = held_rms(dirty, opt);
   EXPECT_LT(std::abs(e_dirty - e_clean), 0.1 * e_clean) << e_clean << " " << e_dirty;
   IdentifyOptions plain = opt;
-  plain.loss = "none";
+  plain.loss = Loss::none;
   EXPECT_GT(held_rms(dirty, plain), 1.1 * e_clean);
 }
 
@@ -219,7 +219,7 @@ TEST(Identify, NoiseFreeSixDimensionalPosesIdentifyTheToolFrame) {
   ASSERT_TRUE(fit.orientation);
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(nominal, fit, opt);
   const ParamLayout& L = r.layout;
   for (int i = L.tool; i < L.tool + 6; ++i) EXPECT_FALSE(r.fixed[i]) << L.names[i] << ": " << r.fixed_reason[i];
@@ -257,7 +257,7 @@ TEST(Identify, SixDimensionalRowsWithReflectorsKeepTheReflectorsOffsetsInTheTool
   }
   ASSERT_EQ(six_d, 200);
   IdentifyOptions opt;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(Model(kr500_spec()), fit, opt);
   EXPECT_EQ(r.calibrated.tcp, "measured");
   ASSERT_EQ(r.targets.size(), 3u);
@@ -290,7 +290,7 @@ TEST(Identify, ReflectorsAloneLeaveTheTcpNominal) {
   so.seed = 35;
   IdentifyOptions opt;
   opt.compliance = false;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(Model(kr500_spec()), simulate(truth, so), opt);
   EXPECT_EQ(r.calibrated.tcp, "nominal");
   for (int i = r.layout.tool; i < r.layout.tool + 6; ++i) EXPECT_TRUE(r.fixed[i]) << r.layout.names[i];
@@ -340,6 +340,6 @@ TEST(Identify, GravityWithoutAMassTablePredictsAsTheTrueMasses) {
   EXPECT_TRUE(rf.fixed[rf.layout.compliance + 4]);
   // --gravity masses on the massless model is an input error
   opt.compliance = true;
-  opt.gravity = "masses";
+  opt.gravity = GravityTorques::masses;
   EXPECT_THROW(identify(Model(massless), fit, opt), InputError);
 }

@@ -140,11 +140,12 @@ class Progress : public ceres::IterationCallback {
 
 /// The robust loss of the options at a scale (mm); none when the scale is not positive.
 std::unique_ptr<ceres::LossFunction> make_loss(const IdentifyOptions& opt, double scale_mm) {
-  if (opt.loss != "none" && opt.loss != "huber" && opt.loss != "cauchy" && !opt.loss.empty())
-    throw InputError("identify: unknown loss '" + opt.loss + "' (none, huber, cauchy)");
   if (!(scale_mm > 0)) return nullptr;
-  if (opt.loss == "huber") return std::make_unique<ceres::HuberLoss>(scale_mm);
-  if (opt.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale_mm);
+  switch (opt.loss) {
+    case Loss::huber: return std::make_unique<ceres::HuberLoss>(scale_mm);
+    case Loss::cauchy: return std::make_unique<ceres::CauchyLoss>(scale_mm);
+    case Loss::none: break;
+  }
   return nullptr;
 }
 
@@ -493,7 +494,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // stage 2: everything identifiable, its first evaluation the linearization at the start
   Stage2 s2(pm, data, x, opt, res);
   const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double v) { return std::isfinite(v); });
-  if (!priors && (opt.loss_scale_mm > 0 || opt.loss == "none")) {
+  if (!priors && (opt.loss_scale_mm > 0 || opt.loss == Loss::none)) {
     s2.solve(free_idx, &at_start, opt.loss_scale_mm, {});
   } else {
     // the noise from a least-squares start on what the data determine (one Gauss-Newton step from the
@@ -505,7 +506,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     res.noise_mm = least_squares_noise(at_start, determined, s2.row_size());
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
-      s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == "none" ? 0.0 : scale,
+      s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == Loss::none ? 0.0 : scale,
                prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
       if (pass == 1) break;
       // res.noise_mm stays the one the final solve weighed the priors and set the loss with

@@ -24,12 +24,11 @@ void define_effects(py::module_& m) {
       .def_readonly("gravity_loaded_only", &EffectKind::gravity_loaded_only)
       .def("__repr__", [](const EffectKind& k) { return "<EffectKind " + k.name + ">"; });
   m.def("effect_kinds", &effect_kinds, py::return_value_policy::copy, "Every effect kind, in the diagnosis's order");
-  m.def("effect_kind", &effect_kind, py::arg("name"), py::return_value_policy::copy);
+  m.def("effect_kind", py::overload_cast<const std::string&>(&effect_kind), py::arg("name"), py::return_value_policy::copy);
   m.def(
       "joint_basis",
       [](const Effect& e, const Eigen::VectorXd& q_rad, std::optional<Eigen::VectorXd> dir) {
-        if (e.name != "transmission_error" && e.name != "joint_map" && e.name != "backlash")
-          throw InputError(e.name + " is no joint-angle effect (transmission_error, joint_map, backlash)");
+        if (!e.kind().basis) throw InputError(e.name + " is no joint-angle effect (it has no basis)");
         if (dir && dir->size() != q_rad.size()) throw InputError("joint_basis: one dir per angle");
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> b(q_rad.size(), e.size());
         for (Eigen::Index i = 0; i < q_rad.size(); ++i)
@@ -41,10 +40,10 @@ void define_effects(py::module_& m) {
 
   py::class_<Effect>(m, "Effect", "An effect on one joint (or link), or on the whole robot")
       .def(py::init([](const std::string& name, int joint, std::vector<int> harmonics, int order) {
-             effect_kind(name);
-             if (order != 0 && name != "joint_map")
+             const bool is_map = effect_kind(name).id == EffectId::joint_map;
+             if (order != 0 && !is_map)
                throw InputError(name + " has no order (only joint_map has: its highest harmonic)");
-             if (name == "joint_map") {
+             if (is_map) {
                if (order < 0 || order > 64) throw InputError("joint_map: the order must be 1..64, not " + std::to_string(order));
                if (order == 0) order = harmonics.empty() ? 0 : harmonics.back();
                Effect e = joint_map(joint - 1, order);
@@ -53,7 +52,7 @@ void define_effects(py::module_& m) {
                return e;
              }
              Effect e{name, joint - 1, std::move(harmonics)};
-             if (name != "transmission_error") e.harmonics.clear();
+             if (!e.harmonic()) e.harmonics.clear();
              return e;
            }),
            py::arg("name"), py::arg("joint") = 0, py::arg("harmonics") = std::vector<int>{1, 2}, py::arg("order") = 0,

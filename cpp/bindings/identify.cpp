@@ -138,7 +138,7 @@ IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
   bool any = false;
   std::vector<int> joints;
   for (const Effect& e : o.effects) {
-    if (e.name != "joint_compliance") {
+    if (!e.kind().gravity_loaded_only) {
       rest.push_back(e);
       continue;
     }
@@ -270,9 +270,9 @@ void define_identify(py::module_& m) {
                        const std::optional<std::vector<std::pair<std::string, double>>>& prior_sd,
                        const std::string& gravity) {
              IdentifyOptions o;
-             o.gravity = gravity;
+             o.gravity = parse_gravity(gravity);
              o.compliance = compliance, o.compliance_joints = joints_from_one(compliance_joints), o.effects = effects;
-             o.loss = loss, o.loss_scale_mm = loss_scale_mm, o.max_iterations = max_iterations;
+             o.loss = parse_loss(loss), o.loss_scale_mm = loss_scale_mm, o.max_iterations = max_iterations;
              o.fix = fix, o.covariance = covariance, o.orientation_weight = orientation_weight;
              o.rank_tolerance = rank_tolerance, o.weak_tolerance = weak_tolerance;
              o.min_torque_share = min_torque_share, o.correlation_threshold = correlation_threshold;
@@ -280,18 +280,22 @@ void define_identify(py::module_& m) {
              if (prior_sd) o.prior_sd = *prior_sd;
              return o;
            }),
-           py::arg("compliance") = def.compliance, py::arg("loss") = def.loss,
+           py::arg("compliance") = def.compliance, py::arg("loss") = loss_word(def.loss),
            py::arg("loss_scale_mm") = def.loss_scale_mm, py::arg("max_iterations") = def.max_iterations,
            py::arg("fix") = std::vector<std::string>{}, py::arg("compliance_joints") = std::vector<int>{},
            py::arg("effects") = std::vector<Effect>{}, py::arg("covariance") = def.covariance,
            py::arg("orientation_weight") = def.orientation_weight, py::arg("rank_tolerance") = def.rank_tolerance,
            py::arg("weak_tolerance") = def.weak_tolerance, py::arg("min_torque_share") = def.min_torque_share,
            py::arg("correlation_threshold") = def.correlation_threshold, py::arg("prior_scale") = def.prior_scale,
-           py::arg("prior_sd") = py::none(), py::arg("gravity") = def.gravity)
+           py::arg("prior_sd") = py::none(), py::arg("gravity") = gravity_word(def.gravity))
       .def_readwrite("compliance", &IdentifyOptions::compliance, "identify the joint compliances")
-      .def_readwrite("loss", &IdentifyOptions::loss, "'none', 'huber' or 'cauchy'")
-      .def_readwrite("gravity", &IdentifyOptions::gravity,
-                     "the compliances' gravity torques: 'masses', 'fit' (mass moments identified) or 'auto'")
+      .def_property(
+          "loss", [](const IdentifyOptions& o) { return loss_word(o.loss); },
+          [](IdentifyOptions& o, const std::string& w) { o.loss = parse_loss(w); }, "'none', 'huber' or 'cauchy'")
+      .def_property(
+          "gravity", [](const IdentifyOptions& o) { return gravity_word(o.gravity); },
+          [](IdentifyOptions& o, const std::string& w) { o.gravity = parse_gravity(w); },
+          "the compliances' gravity torques: 'masses', 'fit' (mass moments identified) or 'auto'")
       .def_readwrite("loss_scale_mm", &IdentifyOptions::loss_scale_mm,
                      "where the robust loss bends on a row's residual norm (mm); 0: from the data")
       .def_readwrite("prior_sd", &IdentifyOptions::prior_sd,

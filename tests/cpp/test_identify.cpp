@@ -48,7 +48,7 @@ TEST(Identify, NoiseFreeGeometricErrorsFittedExactly) {
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
   opt.compliance = false;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(nominal, fit, opt);
   const Model cal(r.calibrated);
   const double before = rms(point_errors(nominal, {Vec3::Zero()}, held));
@@ -125,7 +125,7 @@ TEST(Identify, RobustLossIgnoresGrossOutliers) {
   const double e_dirty = held_rms(dirty, opt);
   EXPECT_LT(std::abs(e_dirty - e_clean), 0.1 * e_clean) << e_clean << " " << e_dirty;
   IdentifyOptions plain = opt;
-  plain.loss = "none";
+  plain.loss = Loss::none;
   EXPECT_GT(held_rms(dirty, plain), 1.1 * e_clean);
 }
 
@@ -149,7 +149,7 @@ TEST(Identify, HiddenTransmissionErrorIsRecovered) {
   so.poses = 150;
   so.targets = kTargets;
   EffectValue te;
-  te.effect.name = "transmission_error";
+  te.effect = Effect("transmission_error");
   te.effect.joint = 1;
   te.p = {0.01 * d2r, 0.0, 0.0, 0.005 * d2r};
   so.effects.push_back(te);
@@ -227,7 +227,7 @@ TEST(Identify, NoiseFreeSixDimensionalPosesIdentifyTheToolFrame) {
   ASSERT_TRUE(fit.orientation);
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(nominal, fit, opt);
   const ParamLayout& L = r.layout;
   for (int i = L.tool; i < L.tool + 6; ++i) EXPECT_FALSE(r.fixed[i]) << L.names[i] << ": " << r.fixed_reason[i];
@@ -266,7 +266,7 @@ TEST(Identify, SixDimensionalRowsWithReflectorsKeepTheReflectorsOffsetsInTheTool
   }
   ASSERT_EQ(six_d, 200);
   IdentifyOptions opt;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(Model(kr500_spec()), fit, opt);
   EXPECT_EQ(r.calibrated.tcp, "measured");
   ASSERT_EQ(r.targets.size(), 3u);
@@ -300,7 +300,7 @@ TEST(Identify, ReflectorsAloneLeaveTheTcpNominal) {
   so.seed = test::test_seed(35);
   IdentifyOptions opt;
   opt.compliance = false;
-  opt.loss = "none";
+  opt.loss = Loss::none;
   const IdentifyResult r = identify(Model(kr500_spec()), simulate(truth, so), opt);
   EXPECT_EQ(r.calibrated.tcp, "nominal");
   for (int i = r.layout.tool; i < r.layout.tool + 6; ++i) EXPECT_TRUE(r.fixed[i]) << r.layout.names[i];
@@ -351,6 +351,6 @@ TEST(Identify, GravityWithoutAMassTablePredictsAsTheTrueMasses) {
   EXPECT_TRUE(rf.fixed[rf.layout.compliance + 4]);
   // --gravity masses on the massless model is an input error
   opt.compliance = true;
-  opt.gravity = "masses";
+  opt.gravity = GravityTorques::masses;
   EXPECT_THROW(identify(Model(massless), fit, opt), InputError);
 }

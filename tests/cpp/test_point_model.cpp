@@ -192,12 +192,15 @@ std::vector<double> fitted_gravity_point(const PointModel& pm, const Measurement
 
 TEST(PointModel, GravityModeFromTheMassTable) {
   const Model with(kr500_spec()), without(massless_kr500());
-  EXPECT_FALSE(gravity_fitted(with, "auto"));
-  EXPECT_TRUE(gravity_fitted(without, "auto"));
-  EXPECT_TRUE(gravity_fitted(with, "fit"));
-  EXPECT_FALSE(gravity_fitted(with, "masses"));
-  EXPECT_THROW(gravity_fitted(without, "masses"), InputError);
-  EXPECT_THROW(gravity_fitted(with, "guess"), InputError);
+  EXPECT_FALSE(gravity_fitted(with, GravityTorques::automatic));
+  EXPECT_TRUE(gravity_fitted(without, GravityTorques::automatic));
+  EXPECT_TRUE(gravity_fitted(with, GravityTorques::fit));
+  EXPECT_FALSE(gravity_fitted(with, GravityTorques::masses));
+  EXPECT_THROW(gravity_fitted(without, GravityTorques::masses), InputError);
+  EXPECT_THROW(parse_gravity("guess"), InputError);
+  EXPECT_EQ(gravity_word(parse_gravity("fit")), "fit");
+  EXPECT_THROW(parse_loss("l1"), InputError);
+  EXPECT_EQ(loss_word(parse_loss("cauchy")), "cauchy");
   // the fitted layout: 2 moments per link from the first loaded joint's (A2) on, after the compliances
   const ParamLayout L(without, 3, {}, 20.0, {}, 0, true);
   ASSERT_EQ(L.moment_links, (std::vector<int>{1, 2, 3, 4, 5}));

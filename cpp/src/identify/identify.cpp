@@ -2,6 +2,8 @@
 // of the two translation units that include Ceres (builds stay quick).
 #include "kincal/identify/identify.hpp"
 
+#include "fit_setup.hpp"
+
 #include "kincal/identify/identifiability.hpp"
 #include "kincal/identify/priors.hpp"
 #include "kincal/identify/simulate.hpp"
@@ -14,6 +16,8 @@
 #include <memory>
 
 namespace kincal {
+
+using namespace fit_setup;  // the checks and starts before Ceres runs
 
 namespace {
 
@@ -140,11 +144,12 @@ class Progress : public ceres::IterationCallback {
 
 /// The robust loss of the options at a scale (mm); none when the scale is not positive.
 std::unique_ptr<ceres::LossFunction> make_loss(const IdentifyOptions& opt, double scale_mm) {
-  if (opt.loss != "none" && opt.loss != "huber" && opt.loss != "cauchy" && !opt.loss.empty())
-    throw InputError("identify: unknown loss '" + opt.loss + "' (none, huber, cauchy)");
   if (!(scale_mm > 0)) return nullptr;
-  if (opt.loss == "huber") return std::make_unique<ceres::HuberLoss>(scale_mm);
-  if (opt.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale_mm);
+  switch (opt.loss) {
+    case Loss::huber: return std::make_unique<ceres::HuberLoss>(scale_mm);
+    case Loss::cauchy: return std::make_unique<ceres::CauchyLoss>(scale_mm);
+    case Loss::none: break;
+  }
   return nullptr;
 }
 
@@ -175,91 +180,6 @@ void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, con
   if (report == Report::progress && opt.progress) so.callbacks.push_back(&prog);
   ceres::Solve(so, &problem, &summary);
   all.finish();
-}
-
-/// "source:line: cause" of a measured row.
-std::string where(const MeasurementSet& data, const Measurement& r) {
-  return data.source + ":" + std::to_string(r.line);
-}
-
-/// InputError unless every row has the robot's number of joint angles.
-void check_rows(const Model& nominal, const MeasurementSet& data) {
-  for (const auto& r : data.rows)
-    if (r.q_deg.size() != nominal.dof())
-      throw InputError(where(data, r) + ": " + std::to_string(r.q_deg.size()) + " joint angles but the robot has " +
-                       std::to_string(nominal.dof()));
-}
-
-bool same_effect(const Effect& a, const Effect& b) { return a.name == b.name && a.joint == b.joint; }
-
-/// The extra effects: those asked for, then those the starting model carries (held at their values),
-/// but its drift: a property of the campaign it was measured on, not of the robot.
-std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt) {
-  std::vector<Effect> effects = opt.effects;
-  for (const EffectValue& ev : nominal.spec().effects) {
-    if (ev.effect.name == "drift") continue;
-    bool asked = false;
-    for (const Effect& e : effects) asked = asked || same_effect(e, ev.effect);
-    if (!asked) effects.push_back(ev.effect);
-  }
-  return effects;
-}
-
-bool has_thermal(const std::vector<Effect>& effects) {
-  return std::any_of(effects.begin(), effects.end(), [](const Effect& e) { return e.name == "thermal_expansion"; });
-}
-
-/// InputError unless the effects are valid for the robot and the data carry the columns they read
-/// (temperature_c for thermal_expansion, dir1..dirN for backlash).
-void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
-  for (const Effect& e : effects) check_effect(e, nominal.dof(), "");
-  if (has_thermal(effects))
-    for (const auto& r : data.rows)
-      if (std::isnan(r.temperature_c))
-        throw InputError(where(data, r) + ": thermal_expansion needs the temperature_c column");
-  for (const Effect& e : effects)
-    if (e.name == "drift")
-      for (const auto& r : data.rows)
-        if (std::isnan(r.time_s)) throw InputError(where(data, r) + ": drift needs the time_s column");
-  for (const Effect& e : effects)
-    if (e.name == "backlash")
-      for (const auto& r : data.rows)
-        if (r.dir.size() != nominal.dof())
-          throw InputError(where(data, r) + ": backlash needs the dir1..dir" + std::to_string(nominal.dof()) +
-                           " columns");
-}
-
-/// The reference temperature of thermal_expansion: the starting model's, or the mean of the data's
-/// when the effect is new to the model.
-double reference_temperature(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
-  if (!has_thermal(effects) || nominal.thermal_alpha() != 0) return nominal.spec().t_ref_c;
-  double sum = 0;
-  for (const auto& r : data.rows) sum += r.temperature_c;
-  return sum / data.rows.size();
-}
-
-/// The drift's reference time: the data's mean time (the placements are those of that moment).
-double reference_time(const MeasurementSet& data, const std::vector<Effect>& effects) {
-  if (std::none_of(effects.begin(), effects.end(), [](const Effect& e) { return e.name == "drift"; })) return 0;
-  double sum = 0;
-  for (const auto& r : data.rows) sum += r.time_s;
-  return sum / data.rows.size();
-}
-
-/// Effects the starting model carries start from its values; those not asked for are held there.
-void start_carried_effects(const Model& nominal, const IdentifyOptions& opt, IdentifyResult& res) {
-  const ParamLayout& L = res.layout;
-  for (size_t e = 0; e < L.effect_list.size(); ++e)
-    for (const EffectValue& ev : nominal.spec().effects)
-      if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size() &&
-          ev.effect.name != "drift") {
-        const bool asked = e < opt.effects.size();
-        for (size_t k = 0; k < ev.p.size(); ++k) {
-          const int i = L.effect_offset[e] + static_cast<int>(k);
-          res.start[i] = ev.p[k];
-          if (!asked) res.fix(i, "carried by the starting model (not asked for)");
-        }
-      }
 }
 
 /// Target t of the parameter vector x.
@@ -296,7 +216,8 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   res.nominal_fitted = pm.spec();
   res.nominal_fitted.name = nominal.spec().name;
   if (L.drift >= 0) {  // the "before" model sees the points from the same drifting instrument
-    res.nominal_fitted.effects.push_back({Effect{"drift", -1, {}}, std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)});
+    res.nominal_fitted.effects.push_back({Effect{effect_kind(EffectId::drift).name, -1, {}},
+                                          std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)});
     res.nominal_fitted.t_mean_s = L.t_mean;
   }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
@@ -307,26 +228,6 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
     res.nominal_max_mm = std::max(res.nominal_max_mm, e);
   }
   res.nominal_rms_mm = std::sqrt(ss / data.rows.size());
-}
-
-/// The free parameters; InputError when the data give no more equations than them or, with priors,
-/// fewer measured points than there are free parameters without a prior (the frames: what only the
-/// data can determine).
-std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResult& res, const std::vector<double>& sd) {
-  std::vector<int> free_idx;
-  size_t unconstrained = 0;
-  for (int i = 0; i < res.layout.size; ++i)
-    if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
-  size_t nres = 0;  // a reflector row among 6-D rows gives 3 equations
-  for (const auto& r : data.rows) nres += data.orientation && r.has_abc ? 6 : 3;
-  const std::string points = data.source + ": " + std::to_string(data.rows.size()) + " measured points";
-  if (unconstrained == free_idx.size() && nres <= free_idx.size())
-    throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
-                     " free parameters: too few to identify the model");
-  if (unconstrained < free_idx.size() && data.rows.size() < unconstrained)
-    throw InputError(points + " for " + std::to_string(unconstrained) +
-                     " free parameters without a prior (frames and targets): too few to identify the model");
-  return free_idx;
 }
 
 /// The solution x into res: the calibrated model (carrying every identified effect), the targets,
@@ -494,7 +395,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   // stage 2: everything identifiable, its first evaluation the linearization at the start
   Stage2 s2(pm, data, x, opt, res);
   const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double v) { return std::isfinite(v); });
-  if (!priors && (opt.loss_scale_mm > 0 || opt.loss == "none")) {
+  if (!priors && (opt.loss_scale_mm > 0 || opt.loss == Loss::none)) {
     s2.solve(free_idx, &at_start, opt.loss_scale_mm, {});
   } else {
     // the noise from a least-squares start on what the data determine (one Gauss-Newton step from the
@@ -506,7 +407,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     res.noise_mm = least_squares_noise(at_start, determined, s2.row_size());
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
-      s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == "none" ? 0.0 : scale,
+      s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == Loss::none ? 0.0 : scale,
                prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
       if (pass == 1) break;
       // res.noise_mm stays the one the final solve weighed the priors and set the loss with

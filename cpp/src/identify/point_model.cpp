@@ -8,14 +8,11 @@
 #include "kincal/identify/so3.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <set>
 #include <stdexcept>
-#include <thread>
 
 namespace kincal {
 
@@ -27,12 +24,13 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
   scale = 1.0;
   double b[128];
   for (const Effect& e : eff) {
-    if (e.name == "thermal_expansion") {
-      if (std::isnan(m.temperature_c)) throw InputError("thermal_expansion needs the temperature_c column");
+    const EffectKind& kind = e.kind();
+    if (kind.scales_lengths()) {
+      if (std::isnan(m.temperature_c)) throw InputError(e.name + " needs the temperature_c column");
       scale *= 1.0 + p[0] * (m.temperature_c - t_ref);
-    } else if (e.name != "drift") {  // the drift moves the instrument, not the robot
-      if (e.name == "backlash" && m.dir.size() != m.q_deg.size()) throw InputError("backlash needs the dir1..dirN columns");
-      joint_basis(e, m.q_deg[e.joint] * kDeg, e.name == "backlash" ? m.dir[e.joint] : 0.0, b);
+    } else if (!kind.of_instrument()) {  // the drift moves the instrument, not the robot
+      if (kind.reads_dir() && m.dir.size() != m.q_deg.size()) throw InputError(e.name + " needs the dir1..dirN columns");
+      joint_basis(e, m.q_deg[e.joint] * kDeg, kind.reads_dir() ? m.dir[e.joint] : 0.0, b);
       for (int k = 0; k < e.size(); ++k) dq[e.joint] += p[k] * b[k];
     }
     p += e.size();
@@ -60,10 +58,10 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
   size = effects;
   for (const Effect& e : effect_list) {
     check_effect(e, dof, "");
-    if (e.name == "joint_compliance")
+    if (e.kind().gravity_loaded_only)
       throw InputError("joint_compliance is identified through IdentifyOptions::compliance, not as an extra effect");
-    if (e.name == "drift") {
-      if (drift >= 0) throw InputError("drift is given twice");
+    if (e.kind().of_instrument()) {
+      if (drift >= 0) throw InputError(e.name + " is given twice");
       drift = size;
     }
     effect_offset.push_back(size);
@@ -372,10 +370,11 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
-    if (ef.name == "drift") continue;  // the instrument's, above
-    if (ef.name != "thermal_expansion") {  // joint-angle effects: dq_j = p . basis
+    const EffectKind& kind = ef.kind();
+    if (kind.of_instrument()) continue;  // the instrument's, above
+    if (!kind.scales_lengths()) {  // joint-angle effects: dq_j = p . basis
       double b[128];
-      joint_basis(ef, q[ef.joint], ef.name == "backlash" ? m.dir[ef.joint] : 0.0, b);
+      joint_basis(ef, q[ef.joint], kind.reads_dir() ? m.dir[ef.joint] : 0.0, b);
       for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb * jp[ef.joint] * b[k];
       if (ang)
         for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb * jw[ef.joint] * b[k];
@@ -388,7 +387,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
     // the drift's)
     J.leftCols(layout_.base) *= scale;
     for (size_t e = 0; e < layout_.effect_list.size(); ++e)
-      if (layout_.effect_list[e].name != "thermal_expansion" && layout_.effect_list[e].name != "drift")
+      if (!layout_.effect_list[e].kind().scales_lengths() && !layout_.effect_list[e].kind().of_instrument())
         J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
   }
   return y;
@@ -420,81 +419,6 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
     for (int k = 0; k < 3; ++k) x[o + k] = dt[k], x[o + 3 + k] = phi[k];
   }
   return x;
-}
-
-int row_residuals(const PointModel& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
-                  double* J) {
-  const int P = pm.layout().size;
-  // a reflector row among 6-D rows: its orientation rows are zero (no equation), the layout stays
-  const bool orientation = kind == ResidualKind::pose && m.has_abc;
-  Mat3 rot;
-  thread_local std::vector<double> jw;
-  if (J && orientation) jw.resize(3 * static_cast<size_t>(P));
-  const Vec3 y = pm.predict(m, J, orientation ? &rot : nullptr, (J && orientation) ? jw.data() : nullptr);
-  for (int k = 0; k < 3; ++k) r[k] = y[k] - m.xyz[k];
-  if (kind == ResidualKind::pose && !orientation) {
-    for (int k = 3; k < 6; ++k) r[k] = 0;
-    if (J) std::fill_n(J + 3 * static_cast<size_t>(P), 3 * static_cast<size_t>(P), 0.0);
-    return 6;
-  }
-  if (!orientation) return 3;
-  const Vec3 e = so3::log(abc_to_rotation(m.abc).transpose() * rot);
-  for (int k = 0; k < 3; ++k) r[3 + k] = orientation_weight * e[k];
-  if (J) {
-    // e' = log(Rm^T Exp(w) R) ~ e + Jr^-1(e) R^T w. predict() wrote the 3 position rows at J, which
-    // are already the top rows of the 6-row layout (row-major, P wide): only the bottom rows are new
-    const Mat3 d = orientation_weight * so3::right_jacobian_inv(e) * rot.transpose();
-    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jw.data(), 3, P);
-    Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>> JJ(J, 6, P);
-    JJ.bottomRows(3) = d * W;
-  }
-  return 6;
-}
-
-namespace {
-
-/// Run f(i) for i in [0, n) on all cores (rows are independent; PointModel::predict is const). An
-/// exception stops its chunk and is rethrown once every thread is joined: the one of the first row
-/// that failed, as in a serial loop.
-template <class F>
-void parallel_rows(size_t n, F&& f) {
-  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), n / 256 + 1);
-  if (threads <= 1) {
-    for (size_t i = 0; i < n; ++i) f(i);
-    return;
-  }
-  const size_t chunk = (n + threads - 1) / threads;
-  std::vector<std::exception_ptr> errors(threads);
-  auto run = [&](size_t t) {
-    try {
-      for (size_t i = t * chunk; i < std::min(n, (t + 1) * chunk); ++i) f(i);
-    } catch (...) {
-      errors[t] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < threads; ++t) pool.emplace_back(run, t);
-  run(0);
-  for (auto& th : pool) th.join();
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
-}
-
-}  // namespace
-
-void all_residuals(const PointModel& pm, const MeasurementSet& data, double orientation_weight,
-                   const std::vector<int>& columns, double* r, double* J) {
-  const ResidualKind kind = residual_kind(data);
-  const size_t RS = residual_size(kind), P = pm.layout().size, F = columns.size();
-  parallel_rows(data.rows.size(), [&](size_t i) {
-    thread_local std::vector<double> full;
-    if (J) full.resize(6 * P);
-    double row_r[6];
-    row_residuals(pm, data.rows[i], kind, orientation_weight, r ? r + RS * i : row_r, J ? full.data() : nullptr);
-    if (J)
-      for (size_t k = 0; k < RS; ++k)
-        for (size_t c = 0; c < F; ++c) J[(RS * i + k) * F + c] = full[k * P + columns[c]];
-  });
 }
 
 }  // namespace kincal

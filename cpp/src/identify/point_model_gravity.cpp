@@ -12,12 +12,11 @@
 
 namespace kincal {
 
-bool gravity_fitted(const Model& nominal, const std::string& mode) {
+bool gravity_fitted(const Model& nominal, GravityTorques mode) {
   bool masses = false;
   for (const JointSpec& j : nominal.spec().joints) masses = masses || j.mass_kg > 0;
-  if (mode == "fit") return true;
-  if (mode == "auto") return !masses;
-  if (mode != "masses") throw InputError("identify: unknown gravity mode '" + mode + "' (auto, masses, fit)");
+  if (mode == GravityTorques::fit) return true;
+  if (mode == GravityTorques::automatic) return !masses;
   if (!masses)
     throw InputError("identify: --gravity masses, but the model '" + nominal.spec().name +
                      "' has no link masses (no inertial data): use --gravity fit (or auto)");

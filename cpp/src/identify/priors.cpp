@@ -12,6 +12,38 @@
 
 namespace kincal {
 
+Loss parse_loss(const std::string& word) {
+  if (word == "none") return Loss::none;
+  if (word == "huber") return Loss::huber;
+  if (word == "cauchy") return Loss::cauchy;
+  throw InputError("identify: unknown loss '" + word + "' (none, huber, cauchy)");
+}
+
+std::string loss_word(Loss loss) {
+  switch (loss) {
+    case Loss::none: return "none";
+    case Loss::huber: return "huber";
+    case Loss::cauchy: return "cauchy";
+  }
+  return "";
+}
+
+GravityTorques parse_gravity(const std::string& word) {
+  if (word == "auto") return GravityTorques::automatic;
+  if (word == "masses") return GravityTorques::masses;
+  if (word == "fit") return GravityTorques::fit;
+  throw InputError("identify: unknown gravity mode '" + word + "' (auto, masses, fit)");
+}
+
+std::string gravity_word(GravityTorques gravity) {
+  switch (gravity) {
+    case GravityTorques::automatic: return "auto";
+    case GravityTorques::masses: return "masses";
+    case GravityTorques::fit: return "fit";
+  }
+  return "";
+}
+
 std::vector<std::pair<std::string, double>> default_prior_sd() {
   const double deg = M_PI / 180.0;
   return {{"joint_mm", 1.0}, {"joint_rad", 0.1 * deg}, {"tool_mm", 5.0}, {"tool_rad", 1.0 * deg}};

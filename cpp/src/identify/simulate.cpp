@@ -78,7 +78,7 @@ ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& e
   ModelSpec s = truth;
   if (effects.empty()) return s;
   bool thermal = false;
-  for (const auto& e : s.effects) thermal = thermal || e.effect.name == "thermal_expansion";
+  for (const auto& e : s.effects) thermal = thermal || e.effect.kind().scales_lengths();
   if (!thermal) s.t_ref_c = t_ref;
   for (const auto& e : effects) s.effects.push_back(e);
   return s;
@@ -89,7 +89,7 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
   if (!(opt.duration_s >= 0) || !std::isfinite(opt.duration_s))
     throw InputError("simulate: the campaign's duration must be a finite non-negative number of seconds");
   bool hidden_drift = false;
-  for (const auto& e : opt.effects) hidden_drift = hidden_drift || e.effect.name == "drift";
+  for (const auto& e : opt.effects) hidden_drift = hidden_drift || e.effect.kind().of_instrument();
   // a drift hidden without a duration: the campaign lasts 3 h; the drift is centred on its mean time
   const double duration = opt.duration_s > 0 ? opt.duration_s : (hidden_drift ? kDefaultDriftDuration_s : 0.0);
   ModelSpec truth_spec = with_effects(truth_in.spec(), opt.effects, opt.t_ref);

@@ -27,8 +27,8 @@ json effect_json(const Effect& e, const std::vector<double>& p) {
   for (size_t k = 0; k < p.size(); ++k)
     params.push_back(json{{"name", names[k]}, {"value", p[k] * scale[k]}, {"unit", units[k]}});
   json o{{"effect", e.name}, {"joint", e.joint >= 0 ? json(e.joint + 1) : json(nullptr)}, {"parameters", params}};
-  if (e.name == "transmission_error") o["harmonics"] = e.harmonics;
-  if (e.name == "joint_map") o["order"] = e.order();
+  if (e.id() == EffectId::joint_map) o["order"] = e.order();  // its harmonics are 1..order
+  else if (e.harmonic()) o["harmonics"] = e.harmonics;
   return o;
 }
 
@@ -38,7 +38,8 @@ json effects_json(const ModelSpec& s) {
   json out = json::array();
   for (size_t j = 0; j < s.joints.size(); ++j)
     if (s.joints[j].compliance_deg_per_knm != 0)
-      out.push_back(effect_json(Effect{"joint_compliance", static_cast<int>(j), {}}, {s.joints[j].compliance_deg_per_knm}));
+      out.push_back(effect_json(Effect{effect_kind(EffectId::joint_compliance).name, static_cast<int>(j), {}},
+                                {s.joints[j].compliance_deg_per_knm}));
   for (const EffectValue& ev : s.effects) out.push_back(effect_json(ev.effect, ev.p));
   return out;
 }
@@ -74,7 +75,7 @@ json spec_json(const ModelSpec& s) {
     o["setups"] = setups;
   }
   for (const EffectValue& ev : s.effects)
-    if (ev.effect.name == "drift") o["t_mean_s"] = s.t_mean_s;
+    if (ev.effect.kind().of_instrument()) o["t_mean_s"] = s.t_mean_s;
   if (!s.fitted_deg.empty()) {
     json r = json::array();
     for (const JointRange& j : s.fitted_deg) r.push_back(json::array({j[0], j[1]}));
@@ -191,7 +192,7 @@ struct Reader {
     EffectValue ev;
     const json& name = at(eo, "effect", w);
     if (!name.is_string()) fail(w + ".effect", "not a string");
-    ev.effect.name = name.get<std::string>();
+    ev.effect = Effect(name.get<std::string>());
     try {
       effect_kind(ev.effect.name);
     } catch (const InputError& e) {
@@ -214,13 +215,13 @@ struct Reader {
         ev.effect.harmonics.push_back(k.get<int>());
       }
     }
-    if (ev.effect.name == "joint_map") {
+    if (ev.effect.id() == EffectId::joint_map) {
       // joint_map: harmonics 1..K from its order K
       const json& k = at(eo, "order", w);
       if (!k.is_number_integer() || k.get<int>() < 1 || k.get<int>() > 64)
         fail(w + ".order", "joint_map needs its order K, an integer 1..64");
       ev.effect = joint_map(ev.effect.joint, k.get<int>());
-    } else if (ev.effect.name != "transmission_error") {
+    } else if (!ev.effect.harmonic()) {
       ev.effect.harmonics.clear();
     }
     const json& params = at(eo, "parameters", w);

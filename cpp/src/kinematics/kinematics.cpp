@@ -161,10 +161,11 @@ VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd) {
 
 void check_context(const Model& m, const EffectContext& ctx, const std::string& who) {
   if (m.needs_dir() && ctx.dir.size() != m.dof()) {
-    std::string joints;
+    std::string joints, name;
     for (const EffectValue& e : m.joint_effects())
-      if (e.effect.name == "backlash") joints += (joints.empty() ? "" : ", ") + std::to_string(e.effect.joint + 1);
-    throw InputError(who + "the model has backlash on joint(s) " + joints +
+      if (e.effect.kind().reads_dir())
+        joints += (joints.empty() ? "" : ", ") + std::to_string(e.effect.joint + 1), name = e.effect.name;
+    throw InputError(who + "the model has " + name + " on joint(s) " + joints +
                      ": the direction of motion into each pose is needed (dir1..dir" + std::to_string(m.dof()) +
                      ")");
   }
@@ -182,7 +183,7 @@ VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ*
   double b[128], db[128];
   for (const EffectValue& ev : m.joint_effects()) {
     const int j = ev.effect.joint;
-    joint_basis(ev.effect, q[j], ev.effect.name == "backlash" ? ctx.dir[j] : 0.0, b, dqd ? db : nullptr);
+    joint_basis(ev.effect, q[j], ev.effect.kind().reads_dir() ? ctx.dir[j] : 0.0, b, dqd ? db : nullptr);
     double d = 0, dd = 0;
     for (size_t k = 0; k < ev.p.size(); ++k) {
       d += ev.p[k] * b[k];

@@ -47,18 +47,19 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
       for (const EffectValue& o : rest)
         if (o.effect.name == ev.effect.name && o.effect.joint == ev.effect.joint)
           throw InputError(who + ev.effect.label() + " is given twice");
-      if (ev.effect.name == "joint_compliance") {
+      const EffectKind& kind = ev.effect.kind();
+      if (kind.gravity_loaded_only) {  // joint_compliance: the joint's own compliance
         spec_.joints[ev.effect.joint].compliance_deg_per_knm = ev.p[0];
         continue;
       }
       rest.push_back(ev);
-      if (ev.effect.name == "thermal_expansion") {
+      if (kind.scales_lengths()) {
         thermal_alpha_ = ev.p[0];
-      } else if (ev.effect.name == "drift") {
+      } else if (kind.of_instrument()) {
         drift_ = static_cast<int>(rest.size()) - 1;  // carried for the measurement, never applied
       } else {
         joint_effects_.push_back(ev);
-        needs_dir_ = needs_dir_ || ev.effect.name == "backlash";
+        needs_dir_ = needs_dir_ || kind.reads_dir();
       }
     }
     spec_.effects = rest;

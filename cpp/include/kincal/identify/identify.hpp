@@ -27,8 +27,8 @@ std::vector<std::pair<std::string, double>> default_prior_sd();
 
 struct IdentifyOptions {
   bool compliance = true;          ///< identify the joint compliances
-  std::string gravity = "auto";    ///< their torques: "masses" (the model's), "fit" (moments), "auto" (fit without masses)
-  std::string loss = "huber";      ///< "none", "huber", "cauchy"
+  GravityTorques gravity = GravityTorques::automatic;  ///< their torques
+  Loss loss = Loss::huber;         ///< the robust loss
   /// where the robust loss bends on a row's residual norm (mm); 0: from the data (after a
   /// least-squares start, from the residuals' robust spread, re-estimated once after the robust fit)
   double loss_scale_mm = 0.1;

@@ -45,6 +45,7 @@
 // 3 orientation residuals at zero.
 #pragma once
 
+#include "kincal/identify/fit_modes.hpp"
 #include "kincal/io/measurements.hpp"
 #include "kincal/model/model.hpp"
 
@@ -64,7 +65,7 @@ constexpr double kMomentUnit = 1e6;
 
 /// Whether identification fits the gravity's mass moments: mode "fit", or "auto" and no link of the
 /// model has a mass; "masses" uses the model's (InputError when it has none, or for another mode).
-bool gravity_fitted(const Model& nominal, const std::string& mode);
+bool gravity_fitted(const Model& nominal, GravityTorques mode);
 
 /// Layout of the identification parameter vector for a model, a number of targets and the setups.
 struct ParamLayout {

@@ -1,0 +1,116 @@
+// kincal: what a fit asks of the data and the effects before Ceres runs (fit_setup.hpp).
+#include "fit_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kincal::fit_setup {
+
+namespace {
+
+bool same_effect(const Effect& a, const Effect& b) { return a.name == b.name && a.joint == b.joint; }
+
+bool has_thermal(const std::vector<Effect>& effects) {
+  return std::any_of(effects.begin(), effects.end(), [](const Effect& e) { return e.kind().scales_lengths(); });
+}
+
+}  // namespace
+
+/// "source:line: cause" of a measured row.
+std::string where(const MeasurementSet& data, const Measurement& r) {
+  return data.source + ":" + std::to_string(r.line);
+}
+
+/// InputError unless every row has the robot's number of joint angles.
+void check_rows(const Model& nominal, const MeasurementSet& data) {
+  for (const auto& r : data.rows)
+    if (r.q_deg.size() != nominal.dof())
+      throw InputError(where(data, r) + ": " + std::to_string(r.q_deg.size()) + " joint angles but the robot has " +
+                       std::to_string(nominal.dof()));
+}
+
+/// The extra effects: those asked for, then those the starting model carries (held at their values),
+/// but its drift: a property of the campaign it was measured on, not of the robot.
+std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt) {
+  std::vector<Effect> effects = opt.effects;
+  for (const EffectValue& ev : nominal.spec().effects) {
+    if (ev.effect.kind().of_instrument()) continue;
+    bool asked = false;
+    for (const Effect& e : effects) asked = asked || same_effect(e, ev.effect);
+    if (!asked) effects.push_back(ev.effect);
+  }
+  return effects;
+}
+
+/// InputError unless the effects are valid for the robot and the data carry the columns they read
+/// (the registry's needs: temperature_c, time_s, dir1..dirN).
+void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
+  for (const Effect& e : effects) check_effect(e, nominal.dof(), "");
+  for (const Effect& e : effects) {  // the column each effect reads (the registry's "needs")
+    const std::string& column = e.kind().needs;
+    for (const auto& r : data.rows) {
+      if (column == "temperature_c" && std::isnan(r.temperature_c))
+        throw InputError(where(data, r) + ": " + e.name + " needs the temperature_c column");
+      if (column == "time_s" && std::isnan(r.time_s))
+        throw InputError(where(data, r) + ": " + e.name + " needs the time_s column");
+      if (column == "dir" && r.dir.size() != nominal.dof())
+        throw InputError(where(data, r) + ": " + e.name + " needs the dir1..dir" + std::to_string(nominal.dof()) +
+                         " columns");
+    }
+  }
+}
+
+/// The reference temperature of thermal_expansion: the starting model's, or the mean of the data's
+/// when the effect is new to the model.
+double reference_temperature(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
+  if (!has_thermal(effects) || nominal.thermal_alpha() != 0) return nominal.spec().t_ref_c;
+  double sum = 0;
+  for (const auto& r : data.rows) sum += r.temperature_c;
+  return sum / data.rows.size();
+}
+
+/// The drift's reference time: the data's mean time (the placements are those of that moment).
+double reference_time(const MeasurementSet& data, const std::vector<Effect>& effects) {
+  if (std::none_of(effects.begin(), effects.end(), [](const Effect& e) { return e.kind().of_instrument(); })) return 0;
+  double sum = 0;
+  for (const auto& r : data.rows) sum += r.time_s;
+  return sum / data.rows.size();
+}
+
+/// Effects the starting model carries start from its values; those not asked for are held there.
+void start_carried_effects(const Model& nominal, const IdentifyOptions& opt, IdentifyResult& res) {
+  const ParamLayout& L = res.layout;
+  for (size_t e = 0; e < L.effect_list.size(); ++e)
+    for (const EffectValue& ev : nominal.spec().effects)
+      if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size() &&
+          !ev.effect.kind().of_instrument()) {
+        const bool asked = e < opt.effects.size();
+        for (size_t k = 0; k < ev.p.size(); ++k) {
+          const int i = L.effect_offset[e] + static_cast<int>(k);
+          res.start[i] = ev.p[k];
+          if (!asked) res.fix(i, "carried by the starting model (not asked for)");
+        }
+      }
+}
+
+/// The free parameters; InputError when the data give no more equations than them or, with priors,
+/// fewer measured points than there are free parameters without a prior (the frames: what only the
+/// data can determine).
+std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResult& res, const std::vector<double>& sd) {
+  std::vector<int> free_idx;
+  size_t unconstrained = 0;
+  for (int i = 0; i < res.layout.size; ++i)
+    if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
+  size_t nres = 0;  // a reflector row among 6-D rows gives 3 equations
+  for (const auto& r : data.rows) nres += data.orientation && r.has_abc ? 6 : 3;
+  const std::string points = data.source + ": " + std::to_string(data.rows.size()) + " measured points";
+  if (unconstrained == free_idx.size() && nres <= free_idx.size())
+    throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
+                     " free parameters: too few to identify the model");
+  if (unconstrained < free_idx.size() && data.rows.size() < unconstrained)
+    throw InputError(points + " for " + std::to_string(unconstrained) +
+                     " free parameters without a prior (frames and targets): too few to identify the model");
+  return free_idx;
+}
+
+}  // namespace kincal::fit_setup

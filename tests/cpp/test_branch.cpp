@@ -230,9 +230,6 @@ TEST(Branch, BorderToleranceUnwrapsAJointReadBackAcrossItsBorder) {
 // 1e-4 deg the selection is to take the taught side's neighbour (branch.hpp: "a joint that close to a border
 // counts on either side of it"), 179.999998 and -180.000002, as KUKA's and ABB's do above.
 TEST(Branch, FanucBorderToleranceAtTheTurnBorder) {
-  GTEST_SKIP() << "bug: select_branch (branch.cpp, unwrap) ignores border_tolerance for FANUC LS: J6 taught at 180 "
-                  "(turn 1) read back at 179.999998 is selected at 539.999998, J4 taught at -180 (turn 0) read back "
-                  "at -180.000002 at 179.999998: a whole turn away";
   const Robot r = nominal_kr500();
   Vec6 q;
   q << 0, -65, 90, -180, -60, 180;

@@ -271,12 +271,9 @@ TEST(ControllerProgram, NativeStraightLineWithTolerance) {
 // A FANUC LS position taught with J6 exactly on its turn border (180 deg: CONFIG 'N U T, 0, 0, 1') and filtered on
 // the calibrated robot, whose compensation moves J6 0.4 deg down across the border: to be written with the new
 // turn and a warning, as when it is taught 0.3 deg above the border (180.3: accepted with "moves a joint across
-// its turn's border"). The taught solution's reference comes from select_branch with a border tolerance, which
-// FANUC's unwrapping ignores (test_branch.cpp, Branch.FanucBorderToleranceAtTheTurnBorder): it is 539.9999, and
-// the program is refused ("another turn: A6 179.5960 deg (taught solution 539.9999)").
+// its turn's border"). The taught solution's reference comes from select_branch with a border tolerance (found
+// by this test: FANUC's unwrapping ignored it, the reference was 539.9999 and the program was refused).
 TEST(ControllerProgram, LsPositionTaughtOnItsTurnBorder) {
-  GTEST_SKIP() << "bug: an LS position taught at J6 = 180 (turn 1) is refused as leaving its taught branch (taught "
-                  "solution 539.9999 deg): select_branch's FANUC unwrapping ignores the border tolerance (branch.cpp)";
   KINCAL_SEED_TRACE(9);
   const Robot r = test::kr500_calibrated();
   for (const double j6 : {180.3, 180.0}) {

@@ -47,7 +47,10 @@ double unwrap(ControllerFormat f, int j, double q, const ControllerTarget& t, do
   const size_t c = t.fanuc_config.find(',');
   if (c == std::string::npos || std::sscanf(t.fanuc_config.c_str() + c + 1, "%d , %d , %d", &turns[0], &turns[1], &turns[2]) != 3)
     return std::nan("");
-  return w + 360.0 * turns[idx];
+  // turn n is [-180 + 360 n, 180 + 360 n): a joint within tol below its upper border (+180, which belongs
+  // to turn n + 1) is taken as the lower border of turn n, which the turn includes (taught at exactly
+  // J6 = 180 with turn 1, the inverse kinematics' 179.999998 is that joint, not 539.999998)
+  return w + 360.0 * (w > 180.0 - tol ? turns[idx] - 1 : turns[idx]);
 }
 
 bool same_branch(ControllerFormat f, const ControllerTarget& a, const ControllerTarget& b) {

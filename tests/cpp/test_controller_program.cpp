@@ -39,14 +39,7 @@ constexpr double kMm = 1e-3, kDegTol = 1e-4;
 
 std::string dir() { return ::testing::TempDir(); }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 std::string fmt(double v, int decimals) {
   char b[64];

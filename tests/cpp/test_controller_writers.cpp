@@ -132,14 +132,7 @@ std::vector<Vec6> joints_read_back(ControllerFormat f, const std::vector<OutputF
   return out;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 /// Whether the lines appear in the text in this order (each a whole line).
 bool lines_in_order(const std::string& text, const std::vector<std::string>& lines) {

@@ -5,6 +5,7 @@
 #include "kincal/io/native.hpp"
 
 #include "test_files.hpp"
+#include "test_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -37,14 +38,7 @@ std::string krl(const std::string& name, const std::string& src, const std::stri
   return test::tmp(name + ".src", "DEF " + name + "( )\n" + src + "END\n");
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 const std::string kPose = "X 2000.0,Y -600.0,Z 520.0,A 0.0,B 90.0,C 0.0";
 const std::string kTools =  // tool 1, tool 2, base 1, base 2 in a $config.dat

@@ -26,14 +26,7 @@ using namespace kincal;
 
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 double sd_of(const std::vector<double>& v) {
   double m = 0, s = 0;

@@ -12,12 +12,23 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <initializer_list>
 #include <random>
 #include <stdexcept>
 #include <string>
 
 namespace kincal::test {
+
+/// The InputError message f throws, or "(no error)".
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
 
 /// Number of random cases: KINCAL_TEST_COUNT overrides the default.
 inline int count(int dflt) {

@@ -23,21 +23,22 @@ ranges of that angle. Candidates are scored on the robust pseudo-residual (robus
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
 
 import numpy as np
 
 from .. import _core
 from ..stats import stepwise as engine
 from .._core import Robot
-from .fitting import FitOptions, folds as grouped_folds, gravity_fitted, point_errors, subset
+from .candidates import (MAX_MAP_ORDER as MAX_MAP_ORDER, Candidate as Candidate, JointCompliance as JointCompliance,
+                         applicable_joints as applicable_joints, candidates as candidates, check_data as check_data,
+                         expand as expand)
+from .fitting import FitOptions, folds as grouped_folds, point_errors, subset
 from ..stats.robust_scores import loss_threshold, robust_noise, robust_weights
 
 if TYPE_CHECKING:
     from ..typing_ import BoolArray, FloatArray
 
-#: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
-MAX_MAP_ORDER = 8
 #: joint_map's smoothness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k (the
 #: penalty is lambda s / pi times the integral of the map's squared slope over a turn; s: the mean
 #: squared norm of the joint's order-1 columns, so lambda is relative to what the data see); the
@@ -51,108 +52,6 @@ PERIODIC = ("transmission_error", "joint_map")
 #: the significance rule of a step (the diagnosis's): F-test p below ALPHA and a linear
 #: cross-validated gain above MIN_GAIN
 ALPHA, MIN_GAIN = 1e-6, 0.03
-
-
-class JointCompliance:
-    """The library's joint_compliance on every gravity-loaded joint (as ``--effects joint_compliance``):
-    one candidate, its gravity torques from the model's link masses (``gravity`` "masses") or from
-    mass moments fitted with it ("fit": a model without link masses, or --gravity fit)."""
-    name = "joint_compliance"
-    joint = 0
-    order = 0
-    harmonics: tuple[int, ...] = ()
-
-    def __init__(self, gravity: str = "masses") -> None:
-        if gravity not in ("masses", "fit"):
-            raise ValueError(f"joint compliance's gravity is 'masses' or 'fit', not '{gravity}'")
-        self.gravity = gravity
-
-    @property
-    def label(self) -> str:
-        return "joint_compliance" if self.gravity == "masses" else "joint_compliance (fitted mass moments)"
-
-    def __eq__(self, other: object) -> bool:
-        return isinstance(other, JointCompliance) and other.gravity == self.gravity
-
-    def __hash__(self) -> int:
-        return hash(self.label)
-
-    def __repr__(self) -> str:
-        return self.label
-
-
-#: a candidate of the serial robot's search, and an effect of its model: an effect of the core's
-#: registry, or joint compliance on every gravity-loaded joint as one
-Candidate = Union[_core.Effect, JointCompliance]
-
-
-def applicable_joints(robot: Robot, kind: _core.EffectKind) -> list[int]:
-    """Joints (from 1) where a joint-wise effect applies: the gravity-loaded ones (from the
-    identification layout) for an effect that needs gravity, every joint otherwise."""
-    if kind.gravity_loaded_only:
-        return list(_core.PointModel(robot, 1).layout.loaded)
-    return list(range(1, robot.dof + 1))
-
-
-def _needs_column(kind: _core.EffectKind) -> str:
-    """The measurement-set key of the column an effect kind reads ('' when none)."""
-    return "dir" if kind.needs == "dir" else kind.needs
-
-
-def candidates(robot: Robot, data: dict[str, Any], start: Sequence[Candidate] = (),
-               gravity: str = "auto") -> tuple[list[Candidate], list[str]]:
-    """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
-    compliance as one JointCompliance in the form ``gravity`` gives) the data can support, and notes
-    on those skipped. Effects of ``start`` (the model the search starts from) are no candidates."""
-    out: list[Candidate] = []
-    notes: list[str] = []
-    have = {(e.name, e.joint) for e in start}
-    for kind in _core.effect_kinds():
-        if kind.domain != "serial":
-            continue
-        col = _needs_column(kind)
-        if col == "dir" and col not in data:
-            notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
-            continue
-        if col == "temperature_c" and (col not in data or np.ptp(data[col]) <= 0.5):
-            notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
-            continue
-        if col == "time_s" and (col not in data or np.ptp(data[col]) <= 0):
-            notes.append(f"{kind.name} skipped: no time_s column, or it does not vary")
-            continue
-        if col and col not in data:
-            notes.append(f"{kind.name} skipped: the data have no {col} column")
-            continue
-        joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
-        if kind.name == "joint_compliance":  # one candidate: every gravity-loaded joint
-            if joints and not any(e.name == kind.name for e in start):
-                fitted = gravity_fitted(robot, gravity)
-                out.append(JointCompliance("fit" if fitted else "masses"))
-                if fitted:
-                    why = "--gravity fit" if gravity == "fit" else "the model has no link masses"
-                    notes.append(f"{kind.name} on joints {', '.join(map(str, joints))}: the gravity torques' mass "
-                                 f"moments fitted with it ({why})")
-            continue
-        if kind.name == "joint_map":  # the highest order: the engine chooses among its variants
-            out += [_core.Effect(kind.name, j, order=MAX_MAP_ORDER) for j in joints if (kind.name, j) not in have]
-        else:
-            out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
-    return out, notes
-
-
-def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effect], Optional[str]]:
-    """The core's effects of a model (JointCompliance as joint_compliance on every gravity-loaded
-    joint) and the gravity mode it needs (None: the options' own)."""
-    out: list[_core.Effect] = []
-    gravity = None
-    for e in effects:
-        if isinstance(e, JointCompliance):
-            gravity = e.gravity
-            out += [_core.Effect("joint_compliance", j)
-                    for j in applicable_joints(robot, _core.effect_kind("joint_compliance"))]
-        else:
-            out.append(e)
-    return out, gravity
 
 
 class Spec:
@@ -501,18 +400,3 @@ def start_fit(choice: Choice) -> _core.IdentifyResult:
         return choice.problem.fits[0][1]
     assert choice.fit is not None, "a choice without a search carries its fit"
     return choice.fit
-
-
-def check_data(effects: Sequence[Candidate], data: dict[str, Any], robot: Robot) -> None:
-    """The data columns the effects read (the registry's ``needs``) are present: a clear error names
-    the file and the column otherwise."""
-    src = data.get("source", "<data>")
-    for e in effects:
-        need = _core.effect_kind(e.name).needs
-        if need == "dir" and "dir" not in data:
-            raise ValueError(f"{src}: {e.label} needs the dir1..dir{robot.dof} columns (the sign of each joint's "
-                             "last motion into the pose)")
-        if need == "temperature_c" and "temperature_c" not in data:
-            raise ValueError(f"{src}: {e.label} needs the temperature_c column")
-        if need == "time_s" and "time_s" not in data:
-            raise ValueError(f"{src}: {e.label} needs the time_s column (when each point was measured, s)")

@@ -425,41 +425,54 @@ void define_identify(py::module_& m) {
       "the parameters are corrections to it, e.g. to refit only the base frame and targets). progress:\n"
       "called with (iteration, cost).");
 
-  py::class_<PointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
+  // Python's PointModel: the robot's model (kept alive), the layout's options and the measurement
+  // model built from them; residuals() builds one for the data's payloads
+  struct PyPointModel {
+    std::shared_ptr<const Model> model;
+    LayoutOptions options;
+    PointModel pm;
+  };
+  py::class_<PyPointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
       .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
                        bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
                        std::optional<double> t_mean_s, bool fit_gravity) {
-             const Model& m = from_calibrated ? *r.calibrated : *r.nominal;
-             return new PointModel(m, n_targets, effects, t_ref, setup_names_or_model(setups, m),
-                                   t_mean_s ? *t_mean_s : m.spec().t_mean_s, fit_gravity);
+             std::shared_ptr<const Model> m = from_calibrated ? r.calibrated : r.nominal;
+             LayoutOptions o{n_targets, effects, t_ref, setup_names_or_model(setups, *m),
+                             t_mean_s ? *t_mean_s : m->spec().t_mean_s, fit_gravity};
+             PointModel pm(*m, o);
+             return new PyPointModel{std::move(m), std::move(o), std::move(pm)};
            }),
            py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
            py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
-           py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false, py::keep_alive<1, 2>(),
+           py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false,
            "setups: the data's setup names (default: the model's setups); t_mean_s: the drift's reference\n"
            "time (default: the model's); fit_gravity: the compliances' torques from fitted mass moments\n"
            "(parameters of kind 'gravity_moment', 2 per link) instead of the model's masses")
-      .def_property_readonly("layout", [](const PointModel& p) -> const ParamLayout& { return p.layout(); },
+      .def_property_readonly("layout", [](const PyPointModel& p) -> const ParamLayout& { return p.pm.layout(); },
                              py::return_value_policy::reference_internal)
-      .def_property_readonly("names", [](const PointModel& p) { return p.layout().names; })
-      .def("start", [](const PointModel& p, const py::dict& d) { return p.start(measurements_from_dict(d, p.layout().dof)); },
-           py::arg("data"))
+      .def_property_readonly("names", [](const PyPointModel& p) { return p.pm.layout().names; })
+      .def("start", [](const PyPointModel& p, const py::dict& d) {
+             return p.pm.start(measurements_from_dict(d, p.pm.layout().dof));
+           }, py::arg("data"))
       .def(
           "residuals",
-          [](PointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
-            const MeasurementSet data = measurements_from_dict(d, p.layout().dof);
-            if (static_cast<int>(x.size()) != p.layout().size) throw InputError("PointModel: wrong parameter count");
-            if (!p.layout().setup_names.empty() && data.setup_names != p.layout().setup_names)
+          [](const PyPointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
+            const ParamLayout& L = p.pm.layout();
+            const MeasurementSet data = measurements_from_dict(d, L.dof);
+            if (static_cast<int>(x.size()) != L.size) throw InputError("PointModel: wrong parameter count");
+            if (!L.setup_names.empty() && data.setup_names != L.setup_names)
               throw InputError(data.source + ": the data's setups are not the layout's (" +
-                               std::to_string(p.layout().n_setups) + " setups in that order)");
-            p.prepare_payloads(data);
-            p.set_params(x);
+                               std::to_string(L.n_setups) + " setups in that order)");
+            const PointState at = PointModel(*p.model, p.options, &data).at(x);
             const size_t n = residual_size(residual_kind(data)) * data.rows.size();
-            std::vector<int> every(p.layout().size);
+            std::vector<int> every(L.size);
             std::iota(every.begin(), every.end(), 0);
             Eigen::VectorXd r(n);
-            RowMatrix J(jac ? n : 0, p.layout().size);
-            all_residuals(p, data, weight, every, r.data(), jac ? J.data() : nullptr);
+            RowMatrix J(jac ? n : 0, L.size);
+            {
+              py::gil_scoped_release free;  // the rows run on the core's threads
+              all_residuals(at, data, weight, every, r.data(), jac ? J.data() : nullptr);
+            }
             return py::make_tuple(r, J);
           },
           py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0);

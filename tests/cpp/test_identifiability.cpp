@@ -43,8 +43,7 @@ MeasurementSet campaign(unsigned truth_seed, unsigned seed, int poses, const std
 }
 
 /// The result as identify() starts it: the layout of the data, the start values, nothing held.
-IdentifyResult fresh(PointModel& pm, const MeasurementSet& d) {
-  pm.prepare_payloads(d);
+IdentifyResult fresh(const PointModel& pm, const MeasurementSet& d) {
   IdentifyResult res(pm.layout());
   res.start = pm.start(d);
   res.fixed.assign(static_cast<size_t>(res.layout.size), false);
@@ -66,7 +65,7 @@ TEST(Identifiability, UnloadedComplianceIsHeldWithItsReason) {
   const Model nominal(kr500_spec());
   MeasurementSet d = campaign(111, 112, 40, {Vec3::Zero(), Vec3(120, 0, 30)});
   for (auto& r : d.rows) r.target = 0;  // the second target never measured
-  PointModel pm(nominal, d.n_targets);
+  PointModel pm(nominal, {d.n_targets});
   IdentifyResult res = fresh(pm, d);
   const ParamLayout& L = res.layout;
   ASSERT_EQ(L.loaded.size(), 5u);  // A2..A6
@@ -127,7 +126,7 @@ TEST(Identifiability, RedundantParametersAreHeld) {
   KINCAL_SEED_TRACE(113, 114);
   const Model nominal(kr500_spec());
   const MeasurementSet d = campaign(113, 114, 60, kTargets);
-  PointModel pm(nominal, d.n_targets);
+  PointModel pm(nominal, {d.n_targets});
   IdentifyOptions opt;
   opt.compliance = false;
   IdentifyResult at_start = fresh(pm, d);
@@ -179,7 +178,7 @@ TEST(Identifiability, TooFewOrTooSimilarPosesAreRefused) {
   KINCAL_SEED_TRACE(115, 116);
   const Model nominal(kr500_spec());
   const auto refusal = [&](const MeasurementSet& d) {
-    PointModel pm(nominal, d.n_targets);
+    PointModel pm(nominal, {d.n_targets});
     IdentifyResult res = fresh(pm, d);
     fix_unobservable(nominal, d, IdentifyOptions(), res);
     std::vector<double> x = res.start;
@@ -195,7 +194,7 @@ TEST(Identifiability, TooFewOrTooSimilarPosesAreRefused) {
   ASSERT_EQ(e.substr(e.size() - tail.size()), tail) << e;
   // the parameters named are the layout's
   const std::string list = e.substr(head.size(), e.size() - head.size() - tail.size());
-  const ParamLayout layout(nominal, 1);
+  const ParamLayout layout(nominal, {1});
   for (size_t at = 0; at < list.size();) {
     const size_t comma = std::min(list.find(", ", at), list.size());
     const std::string name = list.substr(at, comma - at);
@@ -209,7 +208,7 @@ TEST(Identifiability, TooFewOrTooSimilarPosesAreRefused) {
   EXPECT_NE(refusal(alike).find("measured points of 40 poses cannot determine"), std::string::npos) << refusal(alike);
   // held by request, and an unknown name
   const MeasurementSet d = campaign(115, 118, 30, {Vec3::Zero()});
-  PointModel pm(nominal, 1);
+  PointModel pm(nominal, {1});
   IdentifyResult res = fresh(pm, d);
   IdentifyOptions opt;
   opt.fix = {"joint3.tilt_u"};
@@ -228,7 +227,7 @@ TEST(Identifiability, WithPriorsTooFewPosesLeaveParametersToThem) {
   KINCAL_SEED_TRACE(115, 116);
   const Model nominal(kr500_spec());
   const MeasurementSet few = campaign(115, 116, 6, {Vec3::Zero()});
-  PointModel pm(nominal, 1);
+  PointModel pm(nominal, {1});
   IdentifyResult res = fresh(pm, few);
   IdentifyOptions opt;
   opt.prior_scale = 1;

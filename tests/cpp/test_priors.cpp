@@ -42,7 +42,7 @@ double sd_of(const std::vector<double>& v) {
 // others none (infinity); no priors at scale 0; unknown kinds, non-positive deviations and scales refused.
 TEST(Priors, StandardDeviationsFollowTheKinds) {
   const Model m(kr500_spec());
-  const ParamLayout L(m, 2, {Effect{"backlash", 1, {}}});
+  const ParamLayout L(m, {2, {Effect{"backlash", 1, {}}}});
   IdentifyOptions opt;
   opt.prior_scale = 2;
   const double inf = std::numeric_limits<double>::infinity(), deg = kPi / 180;

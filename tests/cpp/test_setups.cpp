@@ -115,7 +115,7 @@ TEST(Setups, JacobianOfSetupsAndDriftMatchesFiniteDifferences) {
     for (auto& r : d.rows) r.setup = r.pose % 2;
     const Model nominal(kr500_spec());
     const std::vector<Effect> eff = {{"drift", -1, {}}, {"thermal_expansion", -1, {}}};
-    PointModel pm(nominal, d.n_targets, eff, 24.0, d.setup_names, 5400.0);
+    PointModel pm(nominal, {d.n_targets, eff, 24.0, d.setup_names, 5400.0});
     const ParamLayout& L = pm.layout();
     ASSERT_EQ(L.n_setups, 2);
     ASSERT_EQ(L.targets - L.base, 12);
@@ -135,9 +135,9 @@ TEST(Setups, JacobianOfSetupsAndDriftMatchesFiniteDifferences) {
     double worst = 0;
     std::string worst_name;
     for (const auto& row : d.rows) {
-      pm.set_params(x);
+      const PointState at_x = pm.at(x);
       std::vector<double> J(6 * L.size), r(6);
-      row_residuals(pm, row, kind, 100.0, r.data(), J.data());
+      row_residuals(at_x, row, kind, 100.0, r.data(), J.data());
       for (int i = 0; i < L.size; ++i) {
         // the steps of the other Jacobian tests: rad 1e-5 on positions (rounding of 5 m coordinates),
         // 1e-6 on orientations; mm 1e-3
@@ -146,10 +146,10 @@ TEST(Setups, JacobianOfSetupsAndDriftMatchesFiniteDifferences) {
         std::vector<double> xp = x, xm = x, rp(6), rm(6);
         xp[i] += h;
         xm[i] -= h;
-        pm.set_params(xp);
-        row_residuals(pm, row, kind, 100.0, rp.data(), nullptr);
-        pm.set_params(xm);
-        row_residuals(pm, row, kind, 100.0, rm.data(), nullptr);
+        const PointState at_xp = pm.at(xp);
+        row_residuals(at_xp, row, kind, 100.0, rp.data(), nullptr);
+        const PointState at_xm = pm.at(xm);
+        row_residuals(at_xm, row, kind, 100.0, rm.data(), nullptr);
         double scale = 1.0;
         for (int k = 0; k < R; ++k) scale = std::max(scale, std::abs(J[k * L.size + i]));
         for (int k = 0; k < R; ++k) {
@@ -171,13 +171,13 @@ TEST(Setups, OneSetupNamedIsTheLayoutWithoutSetups) {
   so.targets = kTargets;
   const MeasurementSet d = simulate(Model(truth_spec(3, 0.003)), so);
   const Model nominal(kr500_spec());
-  PointModel a(nominal, 3), b(nominal, 3, {}, 20.0, {"only"});
+  PointModel a(nominal, {3}), b(nominal, {3, {}, 20.0, {"only"}});
   EXPECT_EQ(a.layout().names, b.layout().names);
   const std::vector<double> x = a.start(d);
   EXPECT_EQ(x, b.start(d));
-  a.set_params(x);
-  b.set_params(x);
-  for (const auto& r : d.rows) EXPECT_EQ(a.predict(r, nullptr), b.predict(r, nullptr));
+  const PointState a_x = a.at(x);
+  const PointState b_x = b.at(x);
+  for (const auto& r : d.rows) EXPECT_EQ(a_x.predict(r, nullptr), b_x.predict(r, nullptr));
 }
 
 TEST(Setups, DriftIsCarriedInertAndPlacementsRoundTrip) {

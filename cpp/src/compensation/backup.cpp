@@ -3,8 +3,9 @@
 #include "kincal/io/file.hpp"
 #include "kincal/io/native.hpp"
 
+#include "../core/thread_pool.hpp"
+
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <filesystem>
 #include <map>
@@ -12,7 +13,6 @@
 #include <mutex>
 #include <numeric>
 #include <set>
-#include <thread>
 
 namespace kincal {
 
@@ -118,30 +118,13 @@ struct UnionFind {
   void join(size_t a, size_t b) { parent[find(a)] = find(b); }
 };
 
-// runs f(i) for i in [0, n) on `threads` threads (0: every core); the first exception f lets out (a progress
-// callback interrupted) stops the handing out of indices and is rethrown once every thread has joined
+// runs f(i) for i in [0, n) on `threads` threads of the process's pool (0: every core; no more than
+// the cores); the first exception f lets out (a progress callback interrupted) stops the handing out
+// of indices and is rethrown once every running index is done
 void parallel_for(size_t n, int threads, const std::function<void(size_t)>& f) {
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const size_t k = std::min(n, static_cast<size_t>(threads > 0 ? static_cast<unsigned>(threads) : hw));
-  std::atomic<size_t> next{0};
-  std::mutex m;
-  std::exception_ptr error;
-  auto work = [&] {
-    for (size_t i = next++; i < n; i = next++) {
-      try {
-        f(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(m);
-        if (!error) error = std::current_exception();
-        next = n;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < k; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  detail::parallel_pieces(n, 1, threads > 0 ? static_cast<size_t>(threads) : 0, [&](size_t begin, size_t end, size_t) {
+    for (size_t i = begin; i < end; ++i) f(i);
+  });
 }
 
 }  // namespace

@@ -180,9 +180,9 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
   return generic;
 }
 
-/// The Jacobian of every parameter and the residuals of data at x (set on pm).
-Linearization linearize(PointModel& pm, const MeasurementSet& data, const std::vector<double>& x, double weight) {
-  pm.set_params(x);
+/// The Jacobian of every parameter and the residuals of data at x.
+Linearization linearize(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x, double weight) {
+  const PointState at_x = pm.at(x);
   const int P = pm.layout().size;
   const size_t n = residual_size(residual_kind(data)) * data.rows.size();
   std::vector<int> every(P);
@@ -190,7 +190,7 @@ Linearization linearize(PointModel& pm, const MeasurementSet& data, const std::v
   RowMatrix J(n, P);
   Linearization lin;
   lin.residuals.assign(n, 0.0);
-  all_residuals(pm, data, weight, every, lin.residuals.data(), J.data());
+  all_residuals(at_x, data, weight, every, lin.residuals.data(), J.data());
   lin.jacobian = J;
   return lin;
 }
@@ -250,7 +250,7 @@ ScaledStep scaled_step(const Linearization& lin, const std::vector<int>& cols) {
 /// points still see the product, but the solve would crawl along the valley compliance x moment =
 /// const, out to a huge compliance on a vanishing moment (hundreds of iterations, a worse prediction):
 /// the compliance is held at the held one's value instead (the moments carry the product).
-void hold_undetermined_ratios(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt,
+void hold_undetermined_ratios(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt,
                               IdentifyResult& res, const std::vector<double>& xs) {
   const ParamLayout& L = res.layout;
   const Linearization lin = linearize(pm, data, xs, opt.orientation_weight);
@@ -279,7 +279,7 @@ void hold_undetermined_ratios(PointModel& pm, const MeasurementSet& data, const 
 /// from them stays below opt.min_torque_share of the largest held. Returns x with those moments: the
 /// point at which the data's columns are judged (at zero moments no compliance has an effect, and
 /// at generic ones a joint that gravity barely loads would look identifiable).
-std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
+std::vector<double> fitted_moments(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
                                    const IdentifyOptions& opt, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
   std::vector<double> xs = pm.probe(x, res.fixed);  // compliances set; its generic moments dropped:
@@ -314,8 +314,7 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
     res.fix(i + 1, buf);
   }
   // the joints' torques from those moments over the measured poses
-  pm.set_params(xs);
-  const Model fitted(pm.spec());
+  const Model fitted(pm.at(xs).spec());
   std::vector<double> tmax(L.dof, 0.0);
   VecQ tau;
   for (const auto& row : data.rows) {
@@ -346,7 +345,7 @@ std::vector<double> fitted_moments(PointModel& pm, const MeasurementSet& data, c
 /// show, every free compliance at the held one's value) rather than at zero moments, where no
 /// compliance has an effect and the bilinear compliance x moment problem is at its saddle; what the
 /// analysis held keeps its start value. x becomes that start; returns the data's linearization there.
-Linearization start_at(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, const IdentifyResult& res,
+Linearization start_at(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, const IdentifyResult& res,
                        std::vector<double> xp, std::vector<double>& x, const Linearization& lin_xp) {
   if (xp == x) return lin_xp;
   const ParamLayout& L = res.layout;
@@ -406,7 +405,7 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
   }
 }
 
-Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
+Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
                                  const std::vector<double>& prior_sd) {
   const ParamLayout& L = res.layout;
@@ -445,7 +444,7 @@ Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const Mea
   return lin;
 }
 
-void observability(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
+void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
   const Eigen::MatrixXd J = linearize(pm, data, res.x, opt.orientation_weight).jacobian;
   std::vector<int> free_idx;
   for (int i = 0; i < res.layout.size; ++i)  // what the data determine (not the priors)

@@ -26,8 +26,9 @@ class AllRows : public ceres::EvaluationCallback {
  public:
   /// x: the full parameter vector (held values stay, free ones are written back by finish());
   /// Ceres sees only the free parameters (z), so no manifold is needed.
-  AllRows(PointModel& pm, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx, double weight)
-      : pm_(pm), d_(d), x_(x), free_(std::move(free_idx)), F_(static_cast<int>(free_.size())),
+  /// base: the measurement model at some parameters (its mode: full, or the frames alone).
+  AllRows(PointState base, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx, double weight)
+      : state_(std::move(base)), d_(d), x_(x), free_(std::move(free_idx)), F_(static_cast<int>(free_.size())),
         RS_(residual_size(residual_kind(d))), w_(weight), r_(RS_ * d.rows.size()), j_(RS_ * d.rows.size() * F_) {
     for (int i : free_) z_.push_back(x_[i]);
   }
@@ -35,8 +36,8 @@ class AllRows : public ceres::EvaluationCallback {
     // rows already evaluated at this very point (Ceres's repeated calls, or the seed) are kept
     if (valid_ && z_ == at_ && (!jacobians || have_j_)) return;
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
-    pm_.set_params(x_);
-    all_residuals(pm_, d_, w_, free_, r_.data(), jacobians ? j_.data() : nullptr);
+    state_ = state_.with_params(x_);
+    all_residuals(state_, d_, w_, free_, r_.data(), jacobians ? j_.data() : nullptr);
     valid_ = true;
     have_j_ = jacobians;
     at_ = z_;
@@ -53,7 +54,6 @@ class AllRows : public ceres::EvaluationCallback {
   }
   void finish() {
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
-    pm_.set_params(x_);
   }
   /// The residuals at the current point (Ceres's last evaluation may have been a rejected step).
   void refresh() { PrepareForEvaluation(false, true); }
@@ -65,7 +65,7 @@ class AllRows : public ceres::EvaluationCallback {
   size_t rows() const { return d_.rows.size(); }
 
  private:
-  PointModel& pm_;
+  PointState state_;  ///< the model at the last evaluation's point
   const MeasurementSet& d_;
   std::vector<double>& x_;
   std::vector<int> free_;
@@ -190,7 +190,7 @@ Vec3 target_of(const ParamLayout& L, const std::vector<double>& x, int t) {
 /// Stage 1: the base frame of every setup, the targets and the drift fitted on the nominal geometry
 /// (the "before" of the summary, and a start where the targets are where they are, so that the
 /// identifiability analysis sees the real geometry). x: from the start to the fitted frames.
-void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
+void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
                 std::vector<double>& x, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
   std::vector<int> frames;
@@ -204,16 +204,14 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
     for (int i = L.drift; i < L.drift + 6; ++i)
       if (!res.fixed[i]) frames.push_back(i);
   ceres::Solver::Summary summary;
-  AllRows all(pm, data, x, frames, opt.orientation_weight);
+  // only the base and target columns are needed here: every row's flange frame computed once
+  AllRows all(pm.at_frames_only(x, data), data, x, frames, opt.orientation_weight);
   ceres::Problem problem(problem_options(all));
   std::unique_ptr<ceres::LossFunction> loss = make_loss(opt, opt.loss_scale_mm);  // a scale from the data: none yet
-  pm.set_params(x);
-  pm.set_frames_only(true, &data);  // only the base and target columns are needed here
   solve(problem, all, loss.get(), opt, summary, Report::silent);
-  pm.set_frames_only(false);
   res.nominal_x = x;
-  pm.set_params(x);
-  res.nominal_fitted = pm.spec();
+  const PointState fitted = pm.at(x);
+  res.nominal_fitted = fitted.spec();
   res.nominal_fitted.name = nominal.spec().name;
   if (L.drift >= 0) {  // the "before" model sees the points from the same drifting instrument
     res.nominal_fitted.effects.push_back({Effect{effect_kind(EffectId::drift).name, -1, {}},
@@ -223,7 +221,7 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
   double ss = 0;
   for (const auto& r : data.rows) {
-    const double e = (pm.predict(r, nullptr) - r.xyz).norm();
+    const double e = (fitted.predict(r, nullptr) - r.xyz).norm();
     ss += e * e;
     res.nominal_max_mm = std::max(res.nominal_max_mm, e);
   }
@@ -232,12 +230,12 @@ void fit_frames(PointModel& pm, const Model& nominal, const MeasurementSet& data
 
 /// The solution x into res: the calibrated model (carrying every identified effect), the targets,
 /// the effects' values and the errors on the fitted rows.
-void store_solution(PointModel& pm, const Model& nominal, const MeasurementSet& data, const std::vector<double>& x,
+void store_solution(const PointModel& pm, const Model& nominal, const MeasurementSet& data, const std::vector<double>& x,
                     IdentifyResult& res) {
   const ParamLayout& L = res.layout;
   res.x = x;
-  pm.set_params(x);
-  res.calibrated = pm.spec();
+  const PointState solution = pm.at(x);
+  res.calibrated = solution.spec();
   res.calibrated.name = nominal.spec().name + "-calibrated";
   // 6-D rows measured the tool frame; reflectors alone leave it where it started (redundant with
   // their offsets): every pose then carries the tool's error
@@ -293,14 +291,14 @@ void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summ
 /// last problem stays for the covariance.
 class Stage2 {
  public:
-  Stage2(PointModel& pm, const MeasurementSet& data, std::vector<double>& x, const IdentifyOptions& opt,
+  Stage2(const PointModel& pm, const MeasurementSet& data, std::vector<double>& x, const IdentifyOptions& opt,
          const IdentifyResult& res)
       : pm_(pm), data_(data), x_(x), opt_(opt), res_(res) {}
   /// start: the linearization at x when x is the start (its first evaluation reused).
   void solve(const std::vector<int>& free_idx, const Linearization* start, double scale_mm,
              std::vector<PenaltyTerm> priors) {
     problem_.reset();  // before the rows and the loss it refers to
-    all_ = std::make_unique<AllRows>(pm_, data_, x_, free_idx, opt_.orientation_weight);
+    all_ = std::make_unique<AllRows>(pm_.at(x_), data_, x_, free_idx, opt_.orientation_weight);
     if (start) all_->seed(*start);
     loss_ = make_loss(opt_, scale_mm);
     scale_ = loss_ ? scale_mm : 0.0;
@@ -353,7 +351,7 @@ class Stage2 {
   double initial_cost = 0;
 
  private:
-  PointModel& pm_;
+  const PointModel& pm_;
   const MeasurementSet& data_;
   std::vector<double>& x_;
   const IdentifyOptions& opt_;
@@ -377,9 +375,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
   const double t_ref = reference_temperature(nominal, data, effects);
   const double t_mean = reference_time(data, effects);
   const bool fit_gravity = opt.compliance && gravity_fitted(nominal, opt.gravity);
-  IdentifyResult res(ParamLayout(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity));
-  PointModel pm(nominal, data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity);
-  pm.prepare_payloads(data);
+  const PointModel pm(nominal, {data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity}, &data);
+  IdentifyResult res(pm.layout());
   res.start = pm.start(data);
   res.fixed.assign(res.layout.size, false);
   res.fixed_reason.assign(res.layout.size, "");

@@ -2,7 +2,7 @@
 // of a row with its analytic Jacobian (geometry, compliance through the gravity torque, tool and
 // base frames of every setup, targets, extra effects, the instrument's drift) and the residuals of a
 // row and of a whole measurement set.
-#include "kincal/identify/point_model.hpp"
+#include "point_eval.hpp"
 
 #include "kincal/core/rigid.hpp"
 #include "kincal/identify/so3.hpp"
@@ -39,10 +39,10 @@ void effect_offsets(const std::vector<Effect>& eff, const double* p, const Measu
 
 }  // namespace
 
-ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>& eff, double tr,
-                         const std::vector<std::string>& setups, double tm, bool fit_g)
-    : dof(nominal.dof()), n_targets(nt), fit_gravity(fit_g), effect_list(eff), t_ref(tr), t_mean(tm) {
-  if (setups.size() > 1) setup_names = setups;
+ParamLayout::ParamLayout(const Model& nominal, const LayoutOptions& o)
+    : dof(nominal.dof()), n_targets(o.n_targets), fit_gravity(o.fit_gravity), effect_list(o.effects), t_ref(o.t_ref),
+      t_mean(o.t_mean) {
+  if (o.setups.size() > 1) setup_names = o.setups;
   n_setups = setup_names.empty() ? 1 : static_cast<int>(setup_names.size());
   for (int j = 0; j < dof; ++j)
     if (nominal.gravity_loaded(j)) loaded.push_back(j);
@@ -91,39 +91,46 @@ ParamLayout::ParamLayout(const Model& nominal, int nt, const std::vector<Effect>
   }
 }
 
-PointModel::PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects, double t_ref,
-                       const std::vector<std::string>& setups, double t_mean, bool fit_gravity)
-    : nominal_(nominal), layout_(nominal, n_targets, effects, t_ref, setups, t_mean, fit_gravity) {
+namespace detail {
+
+PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, const MeasurementSet* payload_rows)
+    : nominal(nom), layout(nom, options) {
   const int n = nominal.dof();
   // every setup's corrections are relative to the model's frame of that name, or its base frame
-  place_.resize(static_cast<size_t>(layout_.n_setups));
-  for (int s = 0; s < layout_.n_setups; ++s) {
+  for (int s = 0; s < layout.n_setups; ++s) {
     Eigen::Isometry3d f = nominal.base_in_instrument();
-    if (!layout_.setup_names.empty())
+    if (!layout.setup_names.empty())
       for (const SetupFrame& sf : nominal.spec().setups)
-        if (sf.name == layout_.setup_names[static_cast<size_t>(s)]) f = pose_to_iso(sf.base_in_instrument);
-    place_[static_cast<size_t>(s)].r0 = f.linear();
-    place_[static_cast<size_t>(s)].t0 = f.translation();
+        if (sf.name == layout.setup_names[static_cast<size_t>(s)]) f = pose_to_iso(sf.base_in_instrument);
+    r0.push_back(f.linear());
+    t0.push_back(f.translation());
   }
   for (int j = 0; j < n; ++j) {
     const Vec3 w = nominal.axis(j);
-    u_.push_back(w.unitOrthogonal());
-    v_.push_back(w.cross(u_.back()));
+    u.push_back(w.unitOrthogonal());
+    v.push_back(w.cross(u.back()));
   }
-  w_.resize(n);
-  p_.resize(n);
-  init_fitted_gravity();
-  std::vector<double> x(layout_.size, 0.0);
-  for (size_t i = 0; i < layout_.loaded.size(); ++i)
-    x[layout_.compliance + i] = nominal.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
-  set_params(x);
+  com0 = zero_moment_centres(nominal, layout);
+  if (payload_rows) {
+    std::set<double> pays;
+    for (const auto& r : payload_rows->rows)
+      if (!std::isnan(r.payload_kg) && r.payload_kg != nominal.spec().payload_kg) pays.insert(r.payload_kg);
+    payloads.assign(pays.begin(), pays.end());
+  }
 }
 
-void PointModel::set_params(const std::vector<double>& x) {
-  x_ = x;
+PointEval::PointEval(std::shared_ptr<const PointStructure> s, const std::vector<double>& x,
+                     std::shared_ptr<const FlangeCache> flanges)
+    : s_(std::move(s)), nominal_(s_->nominal), layout_(s_->layout), u_(s_->u), v_(s_->v), x_(x),
+      flanges_(std::move(flanges)) {
+  if (static_cast<int>(x.size()) != layout_.size)
+    throw InputError("PointModel: " + std::to_string(x.size()) + " parameters for a layout of " +
+                     std::to_string(layout_.size));
   spec_ = nominal_.spec();
   spec_.effects.clear();  // the layout's effects act through x, never twice through the model
   const int n = layout_.dof;
+  w_.resize(n);
+  p_.resize(n);
   for (int j = 0; j < n; ++j) {
     const double* a = &x[4 * j];
     w_[j] = (nominal_.axis(j) + a[0] * u_[j] + a[1] * v_[j]).normalized();
@@ -144,13 +151,14 @@ void PointModel::set_params(const std::vector<double>& x) {
   t.translation() = tm_;
   spec_.tool = iso_to_pose(t);
   spec_.setups.clear();
+  place_.resize(static_cast<size_t>(layout_.n_setups));
   for (int s = 0; s < layout_.n_setups; ++s) {
     Placement& b = place_[static_cast<size_t>(s)];
     const double* xb = &x[layout_.base + 6 * s];
     const Vec3 phib(xb[3], xb[4], xb[5]);
-    b.r = b.r0 * so3::exp(phib);
+    b.r = s_->r0[static_cast<size_t>(s)] * so3::exp(phib);
     b.jr = so3::right_jacobian(phib);
-    b.t = b.t0 + Vec3(xb[0], xb[1], xb[2]);
+    b.t = s_->t0[static_cast<size_t>(s)] + Vec3(xb[0], xb[1], xb[2]);
     t.linear() = b.r;
     t.translation() = b.t;
     // the first setup's frame is the model's base_in_instrument; several are listed by name
@@ -158,32 +166,22 @@ void PointModel::set_params(const std::vector<double>& x) {
     if (!layout_.setup_names.empty()) spec_.setups.push_back({layout_.setup_names[static_cast<size_t>(s)], iso_to_pose(t)});
   }
   current_ = std::make_shared<const Model>(spec_);
-  for (auto& pm : payload_models_) {
-    ModelSpec s = spec_;
-    s.payload_kg = pm.first;
-    pm.second = std::make_shared<const Model>(s);
+  for (double pay : s_->payloads) {
+    ModelSpec ps = spec_;
+    ps.payload_kg = pay;
+    payload_models_.emplace_back(pay, std::make_shared<const Model>(ps));
   }
 }
 
-void PointModel::prepare_payloads(const MeasurementSet& data) {
-  std::set<double> pays;
-  for (const auto& r : data.rows)
-    if (!std::isnan(r.payload_kg) && r.payload_kg != spec_.payload_kg) pays.insert(r.payload_kg);
-  payload_models_.clear();
-  for (double p : pays) payload_models_.emplace_back(p, nullptr);
-  set_params(x_);
-}
-
-const Model& PointModel::model_for(double payload) const {
+const Model& PointEval::model_for(double payload) const {
   if (std::isnan(payload) || payload == spec_.payload_kg) return *current_;
   for (const auto& pm : payload_models_)
     if (pm.first == payload) return *pm.second;
-  throw std::logic_error("PointModel: payload not prepared");
+  throw InputError("a row with a payload of " + std::to_string(payload) +
+                   " kg that the measurement model was not built for (PointModel's payload_rows)");
 }
 
-ModelSpec PointModel::spec() const { return spec_; }
-
-void PointModel::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr,
+void PointEval::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr,
                               std::array<Vec3, kMaxJoints + 1>& gt) const {
   gr[0].setIdentity();
   gt[0].setZero();
@@ -195,7 +193,7 @@ void PointModel::chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& g
   }
 }
 
-void PointModel::row_frames(const Model& model, const Measurement& m, GravityState& gs,
+void PointEval::row_frames(const Model& model, const Measurement& m, GravityState& gs,
                             std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt,
                             double& scale) const {
   const int n = layout_.dof;
@@ -221,41 +219,41 @@ void PointModel::row_frames(const Model& model, const Measurement& m, GravitySta
   }
 }
 
-void PointModel::set_frames_only(bool on, const MeasurementSet* data) {
-  frames_only_ = on;
-  flange_.clear();
-  flange_rows_ = nullptr;
-  if (!on || !data || data->rows.empty()) return;
+std::shared_ptr<const FlangeCache> PointEval::compute_flanges(const MeasurementSet& data) const {
+  auto out = std::make_shared<FlangeCache>();
   const int n = layout_.dof;
-  flange_.resize(data->rows.size());
-  for (size_t i = 0; i < data->rows.size(); ++i) {
-    const Measurement& m = data->rows[i];
+  out->rows.resize(data.rows.size());
+  out->first = data.rows.data();
+  for (size_t i = 0; i < data.rows.size(); ++i) {
+    const Measurement& m = data.rows[i];
+    FlangeCache::Flange& f = out->rows[i];
     GravityState gs;
     std::array<Mat3, kMaxJoints + 1> gr;
     std::array<Vec3, kMaxJoints + 1> gt;
-    row_frames(model_for(m.payload_kg), m, gs, gr, gt, flange_[i].scale);
-    flange_[i].r = gr[n];
-    flange_[i].t = gt[n];
+    row_frames(model_for(m.payload_kg), m, gs, gr, gt, f.scale);
+    f.r = gr[n];
+    f.t = gt[n];
   }
-  flange_rows_ = data->rows.data();
+  return out;
 }
 
-const PointModel::Flange* PointModel::cached_flange(const Measurement& m) const {
-  if (flange_.empty()) return nullptr;
-  const auto a = reinterpret_cast<std::uintptr_t>(&m), b = reinterpret_cast<std::uintptr_t>(flange_rows_);
+const FlangeCache::Flange* PointEval::cached_flange(const Measurement& m) const {
+  if (!flanges_ || flanges_->rows.empty()) return nullptr;
+  const std::vector<FlangeCache::Flange>& flange_ = flanges_->rows;
+  const auto a = reinterpret_cast<std::uintptr_t>(&m), b = reinterpret_cast<std::uintptr_t>(flanges_->first);
   if (a < b || (a - b) % sizeof(Measurement) != 0) return nullptr;
   const size_t i = (a - b) / sizeof(Measurement);
   return i < flange_.size() ? &flange_[i] : nullptr;
 }
 
-const PointModel::Placement& PointModel::placement(const Measurement& m) const {
+const PointEval::Placement& PointEval::placement(const Measurement& m) const {
   if (m.setup < 0 || m.setup >= layout_.n_setups)
     throw InputError("a row of setup code " + std::to_string(m.setup) + " but the layout has " +
                      std::to_string(layout_.n_setups) + " setup(s)");
   return place_[static_cast<size_t>(m.setup)];
 }
 
-void PointModel::drifted(const Measurement& m, const Placement& pl, Mat3& rb, Vec3& tb, double& tau, Vec3& dw) const {
+void PointEval::drifted(const Measurement& m, const Placement& pl, Mat3& rb, Vec3& tb, double& tau, Vec3& dw) const {
   if (std::isnan(m.time_s)) throw InputError("drift needs the time_s column");
   tau = (m.time_s - layout_.t_mean) / 3600.0;
   const double* d = &x_[layout_.drift];
@@ -264,7 +262,7 @@ void PointModel::drifted(const Measurement& m, const Placement& pl, Mat3& rb, Ve
   tb = pl.t + tau * Vec3(d[0], d[1], d[2]);
 }
 
-void PointModel::drift_columns(double tau, const Vec3& dw, const Vec3& rx, double* jac, double* jac_rot) const {
+void PointEval::drift_columns(double tau, const Vec3& dw, const Vec3& rx, double* jac, double* jac_rot) const {
   // y = Exp(tau w) R x + t + tau v: Exp(a + d) = Exp(Jl(a) d) Exp(a), Jl(a) = Jr(-a)
   const int P = layout_.size;
   Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
@@ -277,7 +275,7 @@ void PointModel::drift_columns(double tau, const Vec3& dw, const Vec3& rx, doubl
   }
 }
 
-Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
+Vec3 PointEval::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
   const Model& model = model_for(m.payload_kg);
   const int n = layout_.dof;
   const VecQ q = m.q_deg * kDeg;
@@ -285,7 +283,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   double scale;
   std::array<Mat3, kMaxJoints + 1> gr;
   std::array<Vec3, kMaxJoints + 1> gt;
-  if (const Flange* f = frames_only_ ? cached_flange(m) : nullptr) {
+  if (const FlangeCache::Flange* f = cached_flange(m)) {
     gr[n] = f->r;  // only the flange frame is read on the frames-only path
     gt[n] = f->t;
     scale = f->scale;
@@ -328,7 +326,7 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   J.block<3, 3>(0, base + 3) = -rb * so3::skew(x) * jrb;
   if (drift) drift_columns(tau, dw, rb * x, jac, ang ? jac_rot : nullptr);
   J.block<3, 3>(0, layout_.targets + 3 * m.target) = scale * rbn * rm_;
-  if (frames_only_) {
+  if (flanges_) {
     J.block<3, 3>(0, layout_.tool) = scale * rbn;  // with measured orientations the tool frame is a frame
     J.block<3, 3>(0, layout_.tool + 3) = -scale * rbn * rm_ * so3::skew(tkv) * jrm_;
     if (ang) W.block<3, 3>(0, layout_.tool + 3) = rbn * rm_ * jrm_;
@@ -393,12 +391,17 @@ Vec3 PointModel::predict(const Measurement& m, double* jac, Mat3* rot, double* j
   return y;
 }
 
+}  // namespace detail
+
+PointModel::PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* payload_rows)
+    : s_(std::make_shared<const detail::PointStructure>(nominal, options, payload_rows)) {}
+
 std::vector<double> PointModel::start(const MeasurementSet& data) const {
-  std::vector<double> x(layout_.size, 0.0);
-  for (size_t i = 0; i < layout_.loaded.size(); ++i)
-    x[layout_.compliance + i] = nominal_.spec().joints[layout_.loaded[i]].compliance_deg_per_knm;
+  std::vector<double> x(s_->layout.size, 0.0);
+  for (size_t i = 0; i < s_->layout.loaded.size(); ++i)
+    x[s_->layout.compliance + i] = s_->nominal.spec().joints[s_->layout.loaded[i]].compliance_deg_per_knm;
   // nominal prediction of the tool point in the base frame, matched to each setup's measurements (Horn)
-  for (int s = 0; s < layout_.n_setups; ++s) {
+  for (int s = 0; s < s_->layout.n_setups; ++s) {
     std::vector<size_t> rows;
     for (size_t i = 0; i < data.rows.size(); ++i)
       if (data.rows[i].setup == s) rows.push_back(i);
@@ -406,19 +409,38 @@ std::vector<double> PointModel::start(const MeasurementSet& data) const {
     const size_t m = rows.size();
     Eigen::Matrix3Xd a(3, m), b(3, m);
     for (size_t k = 0; k < m; ++k) {
-      a.col(k) = fk_compliant(nominal_, data.rows[rows[k]].q_deg * kDeg).translation();
+      a.col(k) = fk_compliant(s_->nominal, data.rows[rows[k]].q_deg * kDeg).translation();
       b.col(k) = data.rows[rows[k]].xyz;
     }
     const Eigen::Isometry3d fit = rigid_fit(a, b);
     const Mat3 r = fit.linear();
     const Vec3 t = fit.translation();
-    const Placement& pl = place_[static_cast<size_t>(s)];
-    const Vec3 dt = t - pl.t0;
-    const Vec3 phi = so3::log(pl.r0.transpose() * r);
-    const int o = layout_.base + 6 * s;
+    const Vec3 dt = t - s_->t0[static_cast<size_t>(s)];
+    const Vec3 phi = so3::log(s_->r0[static_cast<size_t>(s)].transpose() * r);
+    const int o = s_->layout.base + 6 * s;
     for (int k = 0; k < 3; ++k) x[o + k] = dt[k], x[o + 3 + k] = phi[k];
   }
   return x;
+}
+
+const ParamLayout& PointModel::layout() const { return s_->layout; }
+
+PointState PointModel::at(const std::vector<double>& x) const {
+  return PointState(std::make_shared<const detail::PointEval>(s_, x));
+}
+
+PointState PointModel::at_frames_only(const std::vector<double>& x, const MeasurementSet& data) const {
+  return PointState(std::make_shared<const detail::PointEval>(s_, x, detail::PointEval(s_, x).compute_flanges(data)));
+}
+
+const ParamLayout& PointState::layout() const { return e_->structure().layout; }
+const std::vector<double>& PointState::x() const { return e_->x(); }
+const ModelSpec& PointState::spec() const { return e_->spec(); }
+PointState PointState::with_params(const std::vector<double>& x) const {
+  return PointState(std::make_shared<const detail::PointEval>(e_->structure_ptr(), x, e_->flanges()));
+}
+Vec3 PointState::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
+  return e_->predict(m, jac, rot, jac_rot);
 }
 
 }  // namespace kincal

@@ -4,7 +4,7 @@
 // frame moves the payload. This adds d(point)/d(parameter) through K d(tau)/d(parameter), and the
 // columns of the fitted gravity's mass moments (point_model.hpp), which act only through tau.
 // K tau itself acts in row_frames() (point_model.cpp); these are its derivatives.
-#include "kincal/identify/point_model.hpp"
+#include "point_eval.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -23,54 +23,33 @@ bool gravity_fitted(const Model& nominal, GravityTorques mode) {
   return false;
 }
 
-void PointModel::init_fitted_gravity() {
-  const int n = layout_.dof;
+namespace detail {
+
+std::vector<Vec3> zero_moment_centres(const Model& nominal, const ParamLayout& layout) {
+  const int n = layout.dof;
   // zero moments: a_k = m (c_k - p_k) + M_{k+1} (p_{k+1} - p_k) = 0 with every fitted link's mass m
-  com0_.assign(static_cast<size_t>(n), Vec3::Zero());
-  for (int k : layout_.moment_links) {
+  std::vector<Vec3> com0(static_cast<size_t>(n), Vec3::Zero());
+  for (int k : layout.moment_links) {
     const double beyond = n - 1 - k;  // the fitted links beyond k, kUnitMass each
-    Vec3 c = nominal_.point(k);
-    if (k + 1 < n) c -= beyond * (nominal_.point(k + 1) - nominal_.point(k));
-    com0_[static_cast<size_t>(k)] = c;
+    Vec3 c = nominal.point(k);
+    if (k + 1 < n) c -= beyond * (nominal.point(k + 1) - nominal.point(k));
+    com0[static_cast<size_t>(k)] = c;
   }
+  return com0;
 }
 
-void PointModel::fitted_masses(const std::vector<double>& x) {  // the moments as a mass table (point_model.hpp)
+void PointEval::fitted_masses(const std::vector<double>& x) {  // the moments as a mass table (point_model.hpp)
   const int n = layout_.dof;
   for (int j = 0; j < n; ++j) spec_.joints[j].mass_kg = 0, spec_.joints[j].com.setZero();
   for (size_t i = 0; i < layout_.moment_links.size(); ++i) {
     const int k = layout_.moment_links[i];
     const double* a = &x[layout_.moments + 2 * i];
     spec_.joints[k].mass_kg = kUnitMass;
-    spec_.joints[k].com = com0_[static_cast<size_t>(k)] + (a[0] * u_[k] + a[1] * v_[k]) * (kMomentUnit / kUnitMass);
+    spec_.joints[k].com = s_->com0[static_cast<size_t>(k)] + (a[0] * u_[k] + a[1] * v_[k]) * (kMomentUnit / kUnitMass);
   }
 }
 
-std::vector<double> PointModel::probe(std::vector<double> x, const std::vector<bool>& fixed) const {
-  const ParamLayout& L = layout_;
-  if (!L.fit_gravity) return x;
-  double held = 0;  // the held compliance (the scale), else the largest
-  for (size_t i = 0; i < L.loaded.size(); ++i) {
-    const int c = L.compliance + static_cast<int>(i);
-    if (fixed[c] && x[c] != 0) held = x[c];
-  }
-  for (size_t i = 0; i < L.loaded.size() && held == 0; ++i) held = x[L.compliance + i];
-  if (held == 0) held = kUnitCompliance;
-  for (size_t i = 0; i < L.loaded.size(); ++i) {
-    const int c = L.compliance + static_cast<int>(i);
-    if (!fixed[c] && x[c] == 0) x[c] = held;
-  }
-  // generic moments of a robot's size: a fixed irregular pattern, none zero, none alike
-  double reach = 0;
-  for (int j = 0; j < L.dof; ++j) reach = std::max(reach, nominal_.point(j).norm());
-  reach = std::max(reach, nominal_.tool().translation().norm());
-  const double pattern[] = {0.83, -0.41, 0.57, 0.29, -0.66, 0.72, 0.38, -0.91, 0.47, 0.62, -0.35, 0.78};
-  for (int i = L.moments; i < L.tool; ++i)
-    if (!fixed[i] && x[i] == 0) x[i] = kUnitMass * std::max(reach, 100.0) * pattern[(i - L.moments) % 12] / kMomentUnit;
-  return x;
-}
-
-void PointModel::gravity_state(const Model& model, const Measurement& m, GravityState& gs) const {
+void PointEval::gravity_state(const Model& model, const Measurement& m, GravityState& gs) const {
   const int n = layout_.dof;
   const ModelSpec& sp = model.spec();
   chain_frames(m.q_deg * kDeg, gs.gr, gs.gt);
@@ -96,7 +75,7 @@ void PointModel::gravity_state(const Model& model, const Measurement& m, Gravity
   }
 }
 
-void PointModel::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
+void PointEval::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
                                   const std::array<Vec3, kMaxJoints>& jw, const Mat3& rb, double* jac,
                                   double* jac_rot) const {
   const int n = layout_.dof, P = layout_.size;
@@ -210,6 +189,32 @@ void PointModel::add_torque_terms(const Model& model, const GravityState& gs, co
       apply(layout_.tool + c, dtau);
     }
   }
+}
+
+}  // namespace detail
+
+std::vector<double> PointModel::probe(std::vector<double> x, const std::vector<bool>& fixed) const {
+  const ParamLayout& L = s_->layout;
+  if (!L.fit_gravity) return x;
+  double held = 0;  // the held compliance (the scale), else the largest
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int c = L.compliance + static_cast<int>(i);
+    if (fixed[c] && x[c] != 0) held = x[c];
+  }
+  for (size_t i = 0; i < L.loaded.size() && held == 0; ++i) held = x[L.compliance + i];
+  if (held == 0) held = kUnitCompliance;
+  for (size_t i = 0; i < L.loaded.size(); ++i) {
+    const int c = L.compliance + static_cast<int>(i);
+    if (!fixed[c] && x[c] == 0) x[c] = held;
+  }
+  // generic moments of a robot's size: a fixed irregular pattern, none zero, none alike
+  double reach = 0;
+  for (int j = 0; j < L.dof; ++j) reach = std::max(reach, s_->nominal.point(j).norm());
+  reach = std::max(reach, s_->nominal.tool().translation().norm());
+  const double pattern[] = {0.83, -0.41, 0.57, 0.29, -0.66, 0.72, 0.38, -0.91, 0.47, 0.62, -0.35, 0.78};
+  for (int i = L.moments; i < L.tool; ++i)
+    if (!fixed[i] && x[i] == 0) x[i] = kUnitMass * std::max(reach, 100.0) * pattern[(i - L.moments) % 12] / kMomentUnit;
+  return x;
 }
 
 }  // namespace kincal

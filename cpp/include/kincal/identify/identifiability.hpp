@@ -39,16 +39,15 @@ struct Linearization {
 /// step from x): a link's moments that do not stand out of their noise are held at zero, and the
 /// compliance of a joint they barely load (opt.min_torque_share) is held, all of them when no moment
 /// is seen; x is then moved there (those moments, the free compliances at the held one's value, what
-/// was held at its value): the start of the solve. Returns the data's linearization at x (pm's
-/// parameters are then x). With priors
+/// was held at its value): the start of the solve. Returns the data's linearization at x. With priors
 /// (prior_sd: one per parameter, finite where it has one) what only the data leave undetermined is
 /// no error: it stays free, determined by its prior (res.at_prior), or is held when it has none.
-Linearization fix_unidentifiable(PointModel& pm, const Model& nominal, const MeasurementSet& data,
+Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
                                  const std::vector<double>& prior_sd = {});
 
 /// The condition number and the observability index of the free parameters (the unit-scaled
 /// Jacobian at res.x), into res.
-void observability(PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res);
+void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res);
 
 }  // namespace kincal

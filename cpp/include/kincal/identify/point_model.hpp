@@ -67,7 +67,23 @@ constexpr double kMomentUnit = 1e6;
 /// model has a mass; "masses" uses the model's (InputError when it has none, or for another mode).
 bool gravity_fitted(const Model& nominal, GravityTorques mode);
 
-/// Layout of the identification parameter vector for a model, a number of targets and the setups.
+/// What a layout is built from besides the model: the targets, the extra effects, the setups and
+/// the references of the temperature and time effects.
+struct LayoutOptions {
+  LayoutOptions() = default;
+  LayoutOptions(int targets, std::vector<Effect> extra = {}, double t_ref_c = 20.0, std::vector<std::string> setup_names = {},
+                double t_mean_s = 0, bool fit_moments = false)
+      : n_targets(targets), effects(std::move(extra)), t_ref(t_ref_c), setups(std::move(setup_names)), t_mean(t_mean_s),
+        fit_gravity(fit_moments) {}
+  int n_targets = 1;
+  std::vector<Effect> effects;          ///< extra effects (not joint_compliance: IdentifyOptions::compliance)
+  double t_ref = 20.0;                  ///< thermal reference temperature (deg C)
+  std::vector<std::string> setups;      ///< the data's setup names by code; none or one: one placement "base.*"
+  double t_mean = 0;                    ///< the drift's reference time (s)
+  bool fit_gravity = false;             ///< the moments of every link from the first loaded joint's on are parameters
+};
+
+/// Layout of the identification parameter vector for a model and its options.
 struct ParamLayout {
   int dof = 0, n_targets = 0, n_setups = 1;
   int joints = 0, compliance = 0, moments = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
@@ -82,32 +98,32 @@ struct ParamLayout {
   std::vector<std::string> setup_names;  ///< by setup code (empty: one setup, no setup column)
   std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry", "base[B].ry"
   std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm", "t m"
-  /// setups: the names of the data's setups (by code); none or one: a single placement "base.*".
-  /// fit_gravity: the moments of every link from the first loaded joint's on are parameters.
-  ParamLayout(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,
-              const std::vector<std::string>& setups = {}, double t_mean = 0, bool fit_gravity = false);
+  ParamLayout(const Model& nominal, const LayoutOptions& options);
 };
 
-/// Evaluates the measurement model and its analytic Jacobian for one parameter vector.
+namespace detail {
+struct PointStructure;
+class PointEval;
+}  // namespace detail
+
+class PointState;
+
+/// The measurement model of one robot, layout and data: immutable after construction, so one
+/// PointModel serves every thread. Its predictions are made by a PointState, the model at one
+/// parameter vector (pinocchio's Model and Data: the model here, the state and the threads'
+/// scratch apart).
 class PointModel {
  public:
-  PointModel(const Model& nominal, int n_targets, const std::vector<Effect>& effects = {}, double t_ref = 20.0,
-             const std::vector<std::string>& setups = {}, double t_mean = 0, bool fit_gravity = false);
-  const ParamLayout& layout() const { return layout_; }
-  /// Set the parameters (size layout().size); builds the current model.
-  void set_params(const std::vector<double>& x);
-  /// Build the model variants for the payloads named in the data (payload_kg column).
-  void prepare_payloads(const MeasurementSet& data);
-  /// The current geometry as a model spec (base_in_instrument and tool included).
-  ModelSpec spec() const;
-  /// Jacobian columns of the base frame and targets only (the others left zero), for fitting the frames.
-  /// With the data, every row's flange frame is computed here once and reused while only the frames
-  /// move (set_params must not change the robot's own parameters until it is switched off).
-  void set_frames_only(bool on, const MeasurementSet* data = nullptr);
-  /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.
-  /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
-  /// (instrument frame) per parameter.
-  Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
+  /// nominal: must outlive the model and its states. payload_rows: the payloads named in these rows'
+  /// payload_kg column get their model variants (a row with another payload is refused).
+  PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* payload_rows = nullptr);
+  const ParamLayout& layout() const;
+  /// The model at parameters x (size layout().size).
+  PointState at(const std::vector<double>& x) const;
+  /// The model at x for fitting the frames alone: every row of data has its flange frame computed
+  /// once; predictions of those rows give the Jacobian columns of the base frame, tool and targets
+  /// only (the others left zero). Reuse it only while the robot's own parameters stay at x's.
+  PointState at_frames_only(const std::vector<double>& x, const MeasurementSet& data) const;
   /// Starting parameters: nominal geometry, each setup's base frame from the best rigid fit (Horn)
   /// of the nominal prediction of the tool point to that setup's rows, targets at the tool point.
   /// With the gravity fitted: every moment zero (no link torque), compliances nominal.
@@ -118,63 +134,28 @@ class PointModel {
   std::vector<double> probe(std::vector<double> x, const std::vector<bool>& fixed) const;
 
  private:
-  const Model& nominal_;
-  ParamLayout layout_;
-  std::vector<Vec3> u_, v_;
-  std::vector<double> x_;
-  bool frames_only_ = false;
-  struct Flange {
-    Mat3 r;
-    Vec3 t;
-    double scale;
-  };
-  std::vector<Flange> flange_;          ///< per row of flange_rows_, while frames_only_
-  const Measurement* flange_rows_ = nullptr;
-  const Flange* cached_flange(const Measurement& m) const;
-  ModelSpec spec_;
-  std::shared_ptr<const Model> current_;
-  std::vector<std::pair<double, std::shared_ptr<const Model>>> payload_models_;
-  /// One instrument placement: its reference frame (r0, t0) and, at the current parameters, its
-  /// frame (r, t) and the right Jacobian of its rotation vector.
-  struct Placement {
-    Mat3 r0, r, jr;
-    Vec3 t0, t;
-  };
-  std::vector<Placement> place_;
-  /// The row's placement (InputError for a setup code out of the layout); kept out of line with the
-  /// drift's parts, so that predict()'s common path stays as compact as with one placement.
-  [[gnu::noinline]] const Placement& placement(const Measurement& m) const;
-  /// The placement at the row's time (rb, tb), tau in hours and the drift's rotation vector dw.
-  [[gnu::noinline]] void drifted(const Measurement& m, const Placement& pl, Mat3& rb, Vec3& tb, double& tau,
-                                 Vec3& dw) const;
-  /// The drift's Jacobian columns at a row (rx: the rotated point R x).
-  [[gnu::noinline]] void drift_columns(double tau, const Vec3& dw, const Vec3& rx, double* jac, double* jac_rot) const;
-  Mat3 rm_, jrm_;
-  Vec3 tm_;
-  std::vector<Vec3> w_, p_;
-  std::vector<Vec3> com0_;  ///< with the gravity fitted: each link's centre of mass at zero moments
-  void init_fitted_gravity();                       ///< com0_ from the nominal geometry
-  void fitted_masses(const std::vector<double>& x);  ///< the moments of x as spec_'s mass table
-  const Model& model_for(double payload) const;
-  void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;
-  /// Gravity at the commanded angles: frames, centres of mass, moment arms and joint torques.
-  struct GravityState {
-    std::array<Mat3, kMaxJoints + 1> gr;
-    std::array<Vec3, kMaxJoints + 1> gt, S;
-    std::array<double, kMaxJoints + 1> M;
-    std::array<Vec3, kMaxJoints> wc, oc, arm;
-    std::array<double, kMaxJoints> tau{};
-    Vec3 cp;
-    double mp = 0;
-  };
-  void gravity_state(const Model& model, const Measurement& m, GravityState& gs) const;
-  /// The joint frames G_0..G_n of row m with compliance and effects acting, and the thermal scale.
-  void row_frames(const Model& model, const Measurement& m, GravityState& gs, std::array<Mat3, kMaxJoints + 1>& gr,
-                  std::array<Vec3, kMaxJoints + 1>& gt, double& scale) const;
-  /// rb: the row's instrument placement (rotation).
-  void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
-                        const std::array<Vec3, kMaxJoints>& jw, const Mat3& rb, double* jac,
-                        double* jac_rot) const;
+  std::shared_ptr<const detail::PointStructure> s_;
+};
+
+/// The measurement model at one parameter vector: immutable, cheap to copy, safe to share between
+/// threads.
+class PointState {
+ public:
+  const ParamLayout& layout() const;
+  const std::vector<double>& x() const;
+  /// The geometry at these parameters as a model spec (base_in_instrument, setups and tool included).
+  const ModelSpec& spec() const;
+  /// The same model (frames-only mode and its cached flange frames included) at parameters x.
+  PointState with_params(const std::vector<double>& x) const;
+  /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.
+  /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
+  /// (instrument frame) per parameter.
+  Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
+
+ private:
+  friend class PointModel;
+  explicit PointState(std::shared_ptr<const detail::PointEval> e) : e_(std::move(e)) {}
+  std::shared_ptr<const detail::PointEval> e_;
 };
 
 /// What the residual of a row holds: its point (3 position components, mm) or its full pose (the
@@ -193,14 +174,15 @@ inline ResidualKind residual_kind(const MeasurementSet& data) {
 /// times the rotation vector log(R_measured^T R_model), zero for a row without one) and, when J is
 /// not null, its Jacobian
 /// (row-major, rows x size; J must hold 6 x size). Returns the number of residuals.
-int row_residuals(const PointModel& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
-                  double* J);
+/// scratch: 3 x size doubles for the orientation's Jacobian (null: allocated here).
+int row_residuals(const PointState& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
+                  double* J, double* scratch = nullptr);
 
 /// The residuals of every row of data at pm's parameters (residual_size(residual_kind(data)) per
 /// row, in order, into r; r null: not kept) and, when J is not null, the Jacobian's columns
 /// `columns` in that order (row-major: a row per residual, columns.size() wide). The rows are
-/// evaluated on all cores; nothing is allocated per row.
-void all_residuals(const PointModel& pm, const MeasurementSet& data, double orientation_weight,
+/// evaluated on the process's thread pool, 256 rows or more per thread; nothing is allocated per row.
+void all_residuals(const PointState& pm, const MeasurementSet& data, double orientation_weight,
                    const std::vector<int>& columns, double* r, double* J);
 
 }  // namespace kincal

@@ -49,6 +49,48 @@ std::vector<std::string> codes_from(const py::dict& d, const char* key, size_t n
 
 }  // namespace
 
+namespace {
+
+/// The probe rows' kinds, stations, radii and lengths and the artifact of a measurement dict into m.
+void probe_from_dict(const py::dict& d, size_t n, MeasurementSet& m) {
+  m.station_names = d["station_names"].cast<std::vector<std::string>>();
+  for (const auto& k : d["station_kinds"].cast<std::vector<std::string>>()) {
+    MeasureKind kind = MeasureKind::point;
+    for (MeasureKind c : {MeasureKind::sphere, MeasureKind::plane, MeasureKind::distance})
+      if (k == to_string(c)) kind = c;
+    if (kind == MeasureKind::point) throw InputError(m.source + ": station kind '" + k + "' is not a probe's");
+    m.station_kinds.push_back(kind);
+  }
+  if (m.station_kinds.size() != m.station_names.size()) throw InputError(m.source + ": a station without its kind");
+  const auto kind = d["kind"].cast<Codes>(), station = d["station"].cast<Codes>();
+  const auto radius = d["radius_mm"].cast<Eigen::VectorXd>(), length = d["length_mm"].cast<Eigen::VectorXd>();
+  if (static_cast<size_t>(kind.size()) != n || static_cast<size_t>(station.size()) != n ||
+      static_cast<size_t>(radius.size()) != n || static_cast<size_t>(length.size()) != n)
+    throw InputError(m.source + ": probe columns of a different length");
+  for (size_t i = 0; i < n; ++i) {
+    Measurement& r = m.rows[i];
+    if (kind[i] < 0 || kind[i] > static_cast<int64_t>(MeasureKind::distance))
+      throw InputError(m.source + ": kind code " + std::to_string(kind[i]) + " at row " + std::to_string(i));
+    r.kind = static_cast<MeasureKind>(kind[i]);
+    if (r.kind == MeasureKind::point && r.has_abc) r.kind = MeasureKind::pose;
+    if (!is_probe(r.kind)) continue;
+    if (station[i] < 0 || station[i] >= static_cast<int64_t>(m.station_names.size()) ||
+        m.station_kinds[static_cast<size_t>(station[i])] != r.kind)
+      throw InputError(m.source + ": row " + std::to_string(i) + " names no " + to_string(r.kind) + " station");
+    r.station = static_cast<int>(station[i]);
+    r.radius_mm = radius[i];
+    r.length_mm = length[i];
+  }
+  if (!d.contains("artifact")) return;
+  std::string text = "a,b,distance_mm,angle_deg\n";  // through the reader: its checks, its messages
+  auto num = [](double v) { return std::isnan(v) ? std::string() : py::str(py::float_(v)).cast<std::string>(); };
+  for (const auto& t : d["artifact"].cast<std::vector<std::tuple<std::string, std::string, double, double, std::string>>>())
+    text += std::get<0>(t) + "," + std::get<1>(t) + "," + num(std::get<2>(t)) + "," + num(std::get<3>(t)) + "\n";
+  parse_artifact(text, m.source + " (artifact)", m);
+}
+
+}  // namespace
+
 py::dict measurements_to_dict(const MeasurementSet& m, int dof) {
   const size_t n = m.rows.size();
   Eigen::VectorXi pose(n), target(n), line(n);
@@ -93,6 +135,32 @@ py::dict measurements_to_dict(const MeasurementSet& m, int dof) {
     for (size_t i = 0; i < n; ++i) c[i] = m.rows[i].setup;
     d["setup"] = c;
     d["setup_names"] = m.setup_names;
+  }
+  if (m.has_probe()) {  // probe rows: their kind, station (-1: a point or a pose), radius and length
+    Codes kind(n), station(n);
+    Eigen::VectorXd radius(n), length(n);
+    for (size_t i = 0; i < n; ++i) {
+      const Measurement& r = m.rows[i];
+      kind[i] = static_cast<int64_t>(r.kind);
+      station[i] = r.station;
+      radius[i] = r.radius_mm;
+      length[i] = r.length_mm;
+    }
+    std::vector<std::string> kinds;
+    for (MeasureKind k : m.station_kinds) kinds.emplace_back(to_string(k));
+    d["kind"] = kind;
+    d["station"] = station;
+    d["station_names"] = m.station_names;
+    d["station_kinds"] = kinds;
+    d["radius_mm"] = radius;
+    d["length_mm"] = length;
+  }
+  if (!m.artifact.empty()) {
+    py::list art;
+    for (const ArtifactTerm& a : m.artifact)
+      art.append(py::make_tuple(m.station_names.at(static_cast<size_t>(a.a)), m.station_names.at(static_cast<size_t>(a.b)),
+                                a.distance_mm, a.angle_deg, a.where));
+    d["artifact"] = art;
   }
   return d;
 }
@@ -170,6 +238,7 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
     m.setup_names = codes_from(d, "setup", n, m.source, codes);
     for (size_t i = 0; i < n; ++i) m.rows[i].setup = static_cast<int>(codes[i]);
   }
+  if (d.contains("station_names")) probe_from_dict(d, n, m);
   m.n_targets = nt;
   return m;
 }
@@ -192,5 +261,17 @@ void define_measurements(py::module_& m) {
   m.def(
       "format_measurements",
       [](const py::dict& d, int dof) { return format_measurements(measurements_from_dict(d, dof), dof); },
+      py::arg("data"), py::arg("dof"));
+  m.def(
+      "read_artifact",
+      [](const std::string& path, const py::dict& d, int dof) {
+        MeasurementSet ms = measurements_from_dict(d, dof);
+        read_artifact(path, ms);
+        return measurements_to_dict(ms, dof);
+      },
+      py::arg("path"), py::arg("data"), py::arg("dof"),
+      "The data with the artifact file's known distances and angles between their stations");
+  m.def(
+      "format_artifact", [](const py::dict& d, int dof) { return format_artifact(measurements_from_dict(d, dof)); },
       py::arg("data"), py::arg("dof"));
 }

@@ -176,7 +176,17 @@ TEST(Priors, LeastSquaresNoiseIsTheResidualsSpreadAfterTheFit) {
       lin.residuals[static_cast<size_t>(i)] = clean[i] + (i % row < 3 ? sigma * nd(rng) : 0.0);
     std::vector<int> all(p);
     for (int k = 0; k < p; ++k) all[static_cast<size_t>(k)] = k;
-    EXPECT_NEAR(least_squares_noise(lin, all, row), sigma, 0.05 * sigma);
-    EXPECT_GT(least_squares_noise(lin, {0, 1, 2, 3}, row), 20 * sigma);
+    MeasurementSet points;  // the rows' kind: points (3 position equations each)
+    points.rows.resize(static_cast<size_t>(rows));
+    EXPECT_NEAR(least_squares_noise(lin, all, points, row), sigma, 0.05 * sigma);
+    EXPECT_GT(least_squares_noise(lin, {0, 1, 2, 3}, points, row), 20 * sigma);
+    // plane rows of a probe: one equation each (the first component); the other two, noise-free
+    // here, are not counted
+    MeasurementSet planes = points;
+    for (auto& r : planes.rows) r.kind = MeasureKind::plane;
+    Linearization one = lin;
+    for (int i = 0; i < n; ++i)
+      if (i % row != 0) one.residuals[static_cast<size_t>(i)] = clean[i];
+    EXPECT_NEAR(least_squares_noise(one, all, planes, row), sigma, 0.08 * sigma);
   }
 }

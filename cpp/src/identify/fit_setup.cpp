@@ -1,6 +1,10 @@
 // kincal: what a fit asks of the data and the effects before Ceres runs (fit_setup.hpp).
 #include "fit_setup.hpp"
 
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 
@@ -21,12 +25,51 @@ std::string where(const MeasurementSet& data, const Measurement& r) {
   return data.source + ":" + std::to_string(r.line);
 }
 
-/// InputError unless every row has the robot's number of joint angles.
+/// InputError unless every row has the robot's number of joint angles and every probe station enough
+/// rows (a plane's ball centres not on one line).
 void check_rows(const Model& nominal, const MeasurementSet& data) {
   for (const auto& r : data.rows)
     if (r.q_deg.size() != nominal.dof())
       throw InputError(where(data, r) + ": " + std::to_string(r.q_deg.size()) + " joint angles but the robot has " +
                        std::to_string(nominal.dof()));
+  for (size_t k = 0; k < data.station_names.size(); ++k) {
+    std::vector<const Measurement*> rows;
+    for (const auto& r : data.rows)
+      if (r.station == static_cast<int>(k)) rows.push_back(&r);
+    if (rows.empty()) continue;  // a station of the campaign none of these rows touch (a fold)
+    const MeasureKind kind = data.station_kinds[k];
+    // a station's own unknowns take 3 equations: a sphere's 2 rows, a plane's or a ballbar's 3 rows
+    // leave nothing for the robot; one row more at the least
+    const size_t need = kind == MeasureKind::sphere ? 3 : 4;
+    const std::string name = "station '" + data.station_names[k] + "'";
+    if (rows.size() < need)
+      throw InputError(where(data, *rows.front()) + ": " + name + " has " + std::to_string(rows.size()) + " row(s); a " +
+                       to_string(kind) + " station needs " + std::to_string(need) + " at least");
+    if (kind != MeasureKind::plane) continue;
+    // the ball centres on the nominal model: spread over the plane, not along one line
+    Eigen::Matrix3Xd y(3, rows.size());
+    for (size_t j = 0; j < rows.size(); ++j)
+      y.col(static_cast<Eigen::Index>(j)) = fk_compliant(nominal, rows[j]->q_deg * kDeg).translation();
+    const Eigen::Matrix3Xd c = y.colwise() - y.rowwise().mean();
+    const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(c);
+    const Vec3 sv = svd.singularValues() / std::sqrt(static_cast<double>(rows.size()));
+    if (sv[1] < std::max(0.5, 1e-3 * sv[0]))  // mm RMS across the line
+      throw InputError(where(data, *rows.front()) + ": " + name + ": its touches lie on a line (" +
+                       std::to_string(sv[1]).substr(0, 5) + " mm across it); a plane needs touches spread over it");
+  }
+}
+
+const MeasurementSet& measured_artifact(const MeasurementSet& data, MeasurementSet& copy) {
+  std::vector<bool> touched(data.station_names.size(), false);
+  for (const auto& r : data.rows)
+    if (r.station >= 0) touched[static_cast<size_t>(r.station)] = true;
+  auto kept = [&](const ArtifactTerm& a) { return touched[static_cast<size_t>(a.a)] && touched[static_cast<size_t>(a.b)]; };
+  if (std::all_of(data.artifact.begin(), data.artifact.end(), kept)) return data;
+  copy = data;
+  copy.artifact.clear();
+  for (const ArtifactTerm& a : data.artifact)
+    if (kept(a)) copy.artifact.push_back(a);
+  return copy;
 }
 
 /// The extra effects: those asked for, then those the starting model carries (held at their values),
@@ -102,7 +145,8 @@ std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResul
   for (int i = 0; i < res.layout.size; ++i)
     if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
   size_t nres = 0;  // a reflector row among 6-D rows gives 3 equations
-  for (const auto& r : data.rows) nres += data.orientation && r.has_abc ? 6 : 3;
+  for (const auto& r : data.rows) nres += data.orientation && r.has_abc ? 6 : position_equations(r);
+  nres += data.artifact.size();
   const std::string points = data.source + ": " + std::to_string(data.rows.size()) + " measured points";
   if (unconstrained == free_idx.size() && nres <= free_idx.size())
     throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +

@@ -14,6 +14,9 @@ namespace kincal::fit_setup {
 std::string where(const MeasurementSet& data, const Measurement& r);
 /// InputError unless every row has the robot's number of joint angles.
 void check_rows(const Model& nominal, const MeasurementSet& data);
+/// The data, or in copy the data without the artifact's terms that name a station none of its rows
+/// touch (a fold of a campaign): those stations' unknowns are held (fix_unobservable).
+const MeasurementSet& measured_artifact(const MeasurementSet& data, MeasurementSet& copy);
 /// The extra effects: those asked for, then those the starting model carries (held at their values),
 /// but its drift: a property of the campaign it was measured on, not of the robot.
 std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt);

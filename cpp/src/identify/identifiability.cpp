@@ -158,6 +158,9 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
   generic.n_targets = data.n_targets;
   generic.orientation = data.orientation;
   generic.setup_names = data.setup_names;
+  generic.station_names = data.station_names;
+  generic.station_kinds = data.station_kinds;
+  generic.artifact = data.artifact;
   std::mt19937_64 rng(12345);
   std::uniform_real_distribution<double> ud(-0.45, 0.45);
   for (int p = 0; p < 100; ++p) {
@@ -171,6 +174,10 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
     row.dir.resize(dof);
     for (int j = 0; j < dof; ++j) row.dir[j] = ud(rng) < 0 ? -1.0 : 1.0;
     const Measurement& like = data.rows[rng() % data.rows.size()];
+    row.kind = like.kind;  // a probe row sees what its kind of constraint sees, wherever it is
+    row.station = like.station;
+    row.radius_mm = like.radius_mm;
+    row.length_mm = like.length_mm;
     row.temperature_c = like.temperature_c;
     row.time_s = like.time_s;
     row.setup = like.setup;
@@ -192,6 +199,14 @@ Linearization linearize(const PointModel& pm, const MeasurementSet& data, const 
   lin.residuals.assign(n, 0.0);
   all_residuals(at_x, data, weight, every, lin.residuals.data(), J.data());
   lin.jacobian = J;
+  // the artifact's known lengths and angles follow the rows, one residual each
+  const Eigen::Index rows = static_cast<Eigen::Index>(n);
+  lin.jacobian.conservativeResize(rows + static_cast<Eigen::Index>(data.artifact.size()), P);
+  std::vector<double> grad(static_cast<size_t>(P));
+  for (size_t k = 0; k < data.artifact.size(); ++k) {
+    lin.residuals.push_back(at_x.artifact_residual(data.artifact[k], grad.data()));
+    for (int c = 0; c < P; ++c) lin.jacobian(rows + static_cast<Eigen::Index>(k), c) = grad[static_cast<size_t>(c)];
+  }
   return lin;
 }
 
@@ -381,12 +396,22 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
       res.start[L.targets + 3 * six_d + k] = 0;
       res.fix(L.targets + 3 * six_d + k, "the frame a 6-D row measures is the tool frame (no offset)");
     }
-  std::vector<bool> placed(static_cast<size_t>(L.n_setups), false);
+  // a placement is seen by the points and poses of its setup; its probe rows alone see it moved
+  // with their stations (which the data place in the instrument frame of nothing measured)
+  std::vector<int> placed(static_cast<size_t>(L.n_setups), 0);  // 0: no row, 1: probe rows only, 2: points
   for (const auto& r : data.rows)
-    if (r.setup >= 0 && r.setup < L.n_setups) placed[static_cast<size_t>(r.setup)] = true;
+    if (r.setup >= 0 && r.setup < L.n_setups)
+      placed[static_cast<size_t>(r.setup)] = std::max(placed[static_cast<size_t>(r.setup)], is_probe(r.kind) ? 1 : 2);
   for (int s = 0; s < L.n_setups; ++s)
-    if (!placed[static_cast<size_t>(s)])
-      for (int k = 0; k < 6; ++k) res.fix(L.base + 6 * s + k, "setup never measured");
+    if (placed[static_cast<size_t>(s)] < 2)
+      for (int k = 0; k < 6; ++k)
+        res.fix(L.base + 6 * s + k, placed[static_cast<size_t>(s)] == 0 ? kSetupNeverMeasured : kProbeOnlySetup);
+  std::vector<bool> touched(L.station_names.size(), false);
+  for (const auto& r : data.rows)
+    if (r.station >= 0 && r.station < static_cast<int>(touched.size())) touched[static_cast<size_t>(r.station)] = true;
+  for (size_t k = 0; k < touched.size(); ++k)
+    if (!touched[k])
+      for (int c = 0; c < 3; ++c) res.fix(L.stations + 3 * static_cast<int>(k) + c, "station never touched");
   if (!opt.compliance)
     for (int i = L.compliance; i < L.tool; ++i) res.fix(i, "not asked for (--effects)");
   else if (!opt.compliance_joints.empty())

@@ -29,7 +29,8 @@ class AllRows : public ceres::EvaluationCallback {
   /// base: the measurement model at some parameters (its mode: full, or the frames alone).
   AllRows(PointState base, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx, double weight)
       : state_(std::move(base)), d_(d), x_(x), free_(std::move(free_idx)), F_(static_cast<int>(free_.size())),
-        RS_(residual_size(residual_kind(d))), w_(weight), r_(RS_ * d.rows.size()), j_(RS_ * d.rows.size() * F_) {
+        RS_(residual_size(residual_kind(d))), w_(weight), r_(RS_ * d.rows.size()), j_(RS_ * d.rows.size() * F_),
+        ar_(d.artifact.size()), aj_(d.artifact.size() * F_) {
     for (int i : free_) z_.push_back(x_[i]);
   }
   void PrepareForEvaluation(bool jacobians, bool /*new_point*/) override {
@@ -38,6 +39,12 @@ class AllRows : public ceres::EvaluationCallback {
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
     state_ = state_.with_params(x_);
     all_residuals(state_, d_, w_, free_, r_.data(), jacobians ? j_.data() : nullptr);
+    std::vector<double> grad(jacobians ? x_.size() : 0);
+    for (size_t k = 0; k < d_.artifact.size(); ++k) {
+      ar_[k] = state_.artifact_residual(d_.artifact[k], jacobians ? grad.data() : nullptr);
+      if (jacobians)
+        for (int c = 0; c < F_; ++c) aj_[k * F_ + c] = grad[free_[c]];
+    }
     valid_ = true;
     have_j_ = jacobians;
     at_ = z_;
@@ -45,9 +52,14 @@ class AllRows : public ceres::EvaluationCallback {
   /// Rows already evaluated at the start point (the residuals and the Jacobian of every parameter,
   /// at the same x): the first evaluation reuses them.
   void seed(const Linearization& start) {
-    for (size_t i = 0; i < RS_ * d_.rows.size(); ++i) {
+    const size_t n = RS_ * d_.rows.size();
+    for (size_t i = 0; i < n; ++i) {
       r_[i] = start.residuals[i];
       for (int k = 0; k < F_; ++k) j_[i * F_ + k] = start.jacobian(static_cast<Eigen::Index>(i), free_[k]);
+    }
+    for (size_t a = 0; a < ar_.size(); ++a) {  // the artifact's terms follow the rows
+      ar_[a] = start.residuals[n + a];
+      for (int k = 0; k < F_; ++k) aj_[a * F_ + k] = start.jacobian(static_cast<Eigen::Index>(n + a), free_[k]);
     }
     valid_ = have_j_ = true;
     at_ = z_;
@@ -60,6 +72,9 @@ class AllRows : public ceres::EvaluationCallback {
   double* z() { return z_.data(); }
   const double* residual(size_t i) const { return &r_[RS_ * i]; }
   const double* jacobian(size_t i) const { return &j_[RS_ * i * F_]; }
+  double artifact_residual(size_t k) const { return ar_[k]; }
+  const double* artifact_jacobian(size_t k) const { return &aj_[k * F_]; }
+  size_t artifact_terms() const { return ar_.size(); }
   int row_size() const { return RS_; }
   int size() const { return F_; }
   size_t rows() const { return d_.rows.size(); }
@@ -72,6 +87,7 @@ class AllRows : public ceres::EvaluationCallback {
   int F_, RS_;
   double w_;
   std::vector<double> z_, r_, j_, at_;  // at_: the point r_ (and j_ if have_j_) were evaluated at
+  std::vector<double> ar_, aj_;         // the artifact's terms and their Jacobian rows
   bool valid_ = false, have_j_ = false;
 };
 
@@ -90,6 +106,24 @@ class RowCost : public ceres::CostFunction {
  private:
   const AllRows& all_;
   size_t i_;
+};
+
+/// A known length or angle of the artifact (the --artifact file): one residual, no robust loss.
+class ArtifactCost : public ceres::CostFunction {
+ public:
+  ArtifactCost(const AllRows& all, size_t k) : all_(all), k_(k) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(all.size());
+  }
+  bool Evaluate(double const* const*, double* residuals, double** jacobians) const override {
+    residuals[0] = all_.artifact_residual(k_);
+    if (jacobians && jacobians[0]) std::copy_n(all_.artifact_jacobian(k_), all_.size(), jacobians[0]);
+    return true;
+  }
+
+ private:
+  const AllRows& all_;
+  size_t k_;
 };
 
 /// Ridge penalties and Gaussian priors: residual w_k (z_k - m_k) for the free parameters that carry one.
@@ -168,6 +202,7 @@ enum class Report { silent, progress };
 void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, const IdentifyOptions& opt,
            ceres::Solver::Summary& summary, Report report, const std::vector<PenaltyTerm>& penalties = {}) {
   for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, all.z());
+  for (size_t k = 0; k < all.artifact_terms(); ++k) problem.AddResidualBlock(new ArtifactCost(all, k), nullptr, all.z());
   if (!penalties.empty()) problem.AddResidualBlock(new PenaltyCost(penalties, all.size()), nullptr, all.z());
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -199,7 +234,11 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
   if (data.orientation)
     for (int i = L.tool; i < L.tool + 6; ++i) frames.push_back(i);
   for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
-    if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != "setup never measured")) frames.push_back(i);
+    if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != kSetupNeverMeasured &&
+                          res.fixed_reason[i] != kProbeOnlySetup))
+      frames.push_back(i);
+  for (int i = L.stations; i < L.size; ++i)  // the probe stations are the campaign's frames too
+    if (!res.fixed[i]) frames.push_back(i);
   if (L.drift >= 0)  // the instrument's own motion belongs to the frames
     for (int i = L.drift; i < L.drift + 6; ++i)
       if (!res.fixed[i]) frames.push_back(i);
@@ -220,8 +259,7 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
   }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
   double ss = 0;
-  for (const auto& r : data.rows) {
-    const double e = (fitted.predict(r, nullptr) - r.xyz).norm();
+  for (double e : row_errors(fitted, data)) {
     ss += e * e;
     res.nominal_max_mm = std::max(res.nominal_max_mm, e);
   }
@@ -250,7 +288,9 @@ void store_solution(const PointModel& pm, const Model& nominal, const Measuremen
   res.calibrated.effects = res.effects;  // the model carries every identified effect (the drift inert)
   res.calibrated.t_ref_c = L.t_ref;
   res.calibrated.t_mean_s = L.t_mean;
-  const std::vector<double> e = point_errors(Model(res.calibrated), res.targets, data);
+  // a probe row's error is along its constraint, with the campaign's stations (not in the model)
+  const std::vector<double> e =
+      data.has_probe() ? row_errors(solution, data) : point_errors(Model(res.calibrated), res.targets, data);
   double ss = 0;
   for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
   res.rms_mm = std::sqrt(ss / e.size());
@@ -338,7 +378,8 @@ class Stage2 {
     all_->refresh();
     std::vector<double> position;
     position.reserve(3 * all_->rows());
-    for (size_t i = 0; i < all_->rows(); ++i) position.insert(position.end(), all_->residual(i), all_->residual(i) + 3);
+    for (size_t i = 0; i < all_->rows(); ++i)
+      position.insert(position.end(), all_->residual(i), all_->residual(i) + position_equations(data_.rows[i]));
     return robust_noise(position, p);
   }
   int row_size() const { return residual_size(residual_kind(data_)); }
@@ -368,14 +409,19 @@ class Stage2 {
 
 }  // namespace
 
-IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt) {
-  check_rows(nominal, data);
+IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, const IdentifyOptions& opt) {
+  check_rows(nominal, all_data);
+  MeasurementSet copy;
+  const MeasurementSet& data = measured_artifact(all_data, copy);
   const std::vector<Effect> effects = effects_to_identify(nominal, opt);
   check_effect_columns(nominal, data, effects);
   const double t_ref = reference_temperature(nominal, data, effects);
   const double t_mean = reference_time(data, effects);
   const bool fit_gravity = opt.compliance && gravity_fitted(nominal, opt.gravity);
-  const PointModel pm(nominal, {data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity}, &data);
+  LayoutOptions lo(data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity);
+  lo.station_names = data.station_names;
+  lo.station_kinds = data.station_kinds;
+  const PointModel pm(nominal, lo, &data);
   IdentifyResult res(pm.layout());
   res.start = pm.start(data);
   res.fixed.assign(res.layout.size, false);
@@ -401,7 +447,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const 
     std::vector<int> determined;
     for (int i : free_idx)
       if (!res.at_prior[i]) determined.push_back(i);
-    res.noise_mm = least_squares_noise(at_start, determined, s2.row_size());
+    res.noise_mm = least_squares_noise(at_start, determined, data, s2.row_size());
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
       s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == Loss::none ? 0.0 : scale,

@@ -17,7 +17,8 @@ namespace kincal::detail {
 /// axis, each setup's reference frame, the fitted gravity's zero-moment centres of mass and the
 /// payloads that get a model of their own.
 struct PointStructure {
-  PointStructure(const Model& nominal, const LayoutOptions& options, const MeasurementSet* payload_rows);
+  /// data: its payloads get their model variants, its planes their reference normals.
+  PointStructure(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data);
   const Model& nominal;
   ParamLayout layout;
   std::vector<Vec3> u, v;
@@ -25,7 +26,23 @@ struct PointStructure {
   std::vector<Vec3> t0;  ///< and translation
   std::vector<Vec3> com0;  ///< with the gravity fitted: each link's centre of mass at zero moments
   std::vector<double> payloads;  ///< payloads other than the model's named in the data (kg)
+  /// every station's reference normal (planes: towards the flange; stations.cpp) and two unit
+  /// directions normal to it, along which its tilt parameters turn it
+  std::vector<Vec3> station_normal, station_u, station_v;
+  void init_stations(const MeasurementSet* data);
 };
+
+/// Every setup's instrument placement at the start: the best rigid fit (Horn) of the nominal tool
+/// point to that setup's point and pose rows (three at least), else its reference frame.
+std::vector<Eigen::Isometry3d> start_placements(const PointStructure& s, const MeasurementSet& data);
+/// The stations' start values into x (their parameters): a sphere's centre the mean of its rows'
+/// nominal tool points, a pivot the point at the rows' lengths from them (least squares), a plane at
+/// its reference normal through them.
+void start_stations(const PointStructure& s, const MeasurementSet& data, const std::vector<Eigen::Isometry3d>& place,
+                    std::vector<double>& x);
+
+/// mm of artifact residual per radian of an angle between planes (a 1 m lever)
+constexpr double kArtifactLever = 1000.0;
 
 /// With the gravity fitted: each link's centre of mass at zero moments (point_model.hpp), from the
 /// nominal geometry.
@@ -57,6 +74,8 @@ class PointEval {
   const std::vector<double>& x() const { return x_; }
   const ModelSpec& spec() const { return spec_; }
   Vec3 predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const;
+  int probe_residuals(const Measurement& m, int size, double* r, double* J) const;
+  double artifact_residual(const ArtifactTerm& a, double* J) const;
 
  private:
   std::shared_ptr<const PointStructure> s_;
@@ -87,6 +106,15 @@ class PointEval {
   Mat3 rm_, jrm_;
   Vec3 tm_;
   std::vector<Vec3> w_, p_;
+  /// A station at the current parameters: its point c (sphere, pivot) or plane n . y = d with the
+  /// normal's derivatives along its two tilt parameters.
+  struct StationState {
+    Vec3 c = Vec3::Zero(), n = Vec3::UnitZ();
+    double d = 0;
+    Vec3 dn[2] = {Vec3::Zero(), Vec3::Zero()};
+  };
+  std::vector<StationState> station_;
+  void init_stations();
   void fitted_masses(const std::vector<double>& x);  ///< the moments of x as spec_'s mass table
   const Model& model_for(double payload) const;
   void chain_frames(const VecQ& q, std::array<Mat3, kMaxJoints + 1>& gr, std::array<Vec3, kMaxJoints + 1>& gt) const;

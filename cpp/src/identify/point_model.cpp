@@ -4,7 +4,6 @@
 // row and of a whole measurement set.
 #include "point_eval.hpp"
 
-#include "kincal/core/rigid.hpp"
 #include "kincal/identify/so3.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
@@ -56,6 +55,9 @@ ParamLayout::ParamLayout(const Model& nominal, const LayoutOptions& o)
   targets = base + 6 * n_setups;
   effects = targets + 3 * n_targets;
   size = effects;
+  station_names = o.station_names;
+  station_kinds = o.station_kinds;
+  if (station_kinds.size() != station_names.size()) throw std::logic_error("ParamLayout: a station without its kind");
   for (const Effect& e : effect_list) {
     check_effect(e, dof, "");
     if (e.kind().gravity_loaded_only)
@@ -89,11 +91,22 @@ ParamLayout::ParamLayout(const Model& nominal, const LayoutOptions& o)
     for (const auto& n : e.parameter_names()) names.push_back(p + n);
     for (const auto& u : e.units()) units.push_back(u);
   }
+  stations = size;
+  size += 3 * static_cast<int>(station_names.size());
+  for (size_t k = 0; k < station_names.size(); ++k) {
+    const std::string p = "station[" + station_names[k] + "]";
+    if (station_kinds[k] == MeasureKind::plane) {
+      for (const char* s : {".tilt_u", ".tilt_v"}) names.push_back(p + s), units.push_back("rad");
+      names.push_back(p + ".offset"), units.push_back("mm");
+    } else {
+      for (const char* s : {".x", ".y", ".z"}) names.push_back(p + s), units.push_back("mm");
+    }
+  }
 }
 
 namespace detail {
 
-PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, const MeasurementSet* payload_rows)
+PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, const MeasurementSet* data)
     : nominal(nom), layout(nom, options) {
   const int n = nominal.dof();
   // every setup's corrections are relative to the model's frame of that name, or its base frame
@@ -111,12 +124,13 @@ PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, c
     v.push_back(w.cross(u.back()));
   }
   com0 = zero_moment_centres(nominal, layout);
-  if (payload_rows) {
+  if (data) {
     std::set<double> pays;
-    for (const auto& r : payload_rows->rows)
+    for (const auto& r : data->rows)
       if (!std::isnan(r.payload_kg) && r.payload_kg != nominal.spec().payload_kg) pays.insert(r.payload_kg);
     payloads.assign(pays.begin(), pays.end());
   }
+  init_stations(data);
 }
 
 PointEval::PointEval(std::shared_ptr<const PointStructure> s, const std::vector<double>& x,
@@ -171,6 +185,7 @@ PointEval::PointEval(std::shared_ptr<const PointStructure> s, const std::vector<
     ps.payload_kg = pay;
     payload_models_.emplace_back(pay, std::make_shared<const Model>(ps));
   }
+  init_stations();
 }
 
 const Model& PointEval::model_for(double payload) const {
@@ -393,33 +408,24 @@ Vec3 PointEval::predict(const Measurement& m, double* jac, Mat3* rot, double* ja
 
 }  // namespace detail
 
-PointModel::PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* payload_rows)
-    : s_(std::make_shared<const detail::PointStructure>(nominal, options, payload_rows)) {}
+PointModel::PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data)
+    : s_(std::make_shared<const detail::PointStructure>(nominal, options, data)) {}
 
 std::vector<double> PointModel::start(const MeasurementSet& data) const {
-  std::vector<double> x(s_->layout.size, 0.0);
-  for (size_t i = 0; i < s_->layout.loaded.size(); ++i)
-    x[s_->layout.compliance + i] = s_->nominal.spec().joints[s_->layout.loaded[i]].compliance_deg_per_knm;
-  // nominal prediction of the tool point in the base frame, matched to each setup's measurements (Horn)
-  for (int s = 0; s < s_->layout.n_setups; ++s) {
-    std::vector<size_t> rows;
-    for (size_t i = 0; i < data.rows.size(); ++i)
-      if (data.rows[i].setup == s) rows.push_back(i);
-    if (rows.size() < 3) continue;  // too few to place: the setup's frame starts at its reference
-    const size_t m = rows.size();
-    Eigen::Matrix3Xd a(3, m), b(3, m);
-    for (size_t k = 0; k < m; ++k) {
-      a.col(k) = fk_compliant(s_->nominal, data.rows[rows[k]].q_deg * kDeg).translation();
-      b.col(k) = data.rows[rows[k]].xyz;
-    }
-    const Eigen::Isometry3d fit = rigid_fit(a, b);
-    const Mat3 r = fit.linear();
-    const Vec3 t = fit.translation();
-    const Vec3 dt = t - s_->t0[static_cast<size_t>(s)];
-    const Vec3 phi = so3::log(s_->r0[static_cast<size_t>(s)].transpose() * r);
-    const int o = s_->layout.base + 6 * s;
+  const ParamLayout& L = s_->layout;
+  std::vector<double> x(L.size, 0.0);
+  for (size_t i = 0; i < L.loaded.size(); ++i)
+    x[L.compliance + i] = s_->nominal.spec().joints[L.loaded[i]].compliance_deg_per_knm;
+  // each setup's frame from the nominal prediction of the tool point matched to its points (Horn)
+  const std::vector<Eigen::Isometry3d> place = detail::start_placements(*s_, data);
+  for (int s = 0; s < L.n_setups; ++s) {
+    const Eigen::Isometry3d& f = place[static_cast<size_t>(s)];
+    const Vec3 dt = f.translation() - s_->t0[static_cast<size_t>(s)];
+    const Vec3 phi = so3::log(s_->r0[static_cast<size_t>(s)].transpose() * f.linear());
+    const int o = L.base + 6 * s;
     for (int k = 0; k < 3; ++k) x[o + k] = dt[k], x[o + 3 + k] = phi[k];
   }
+  detail::start_stations(*s_, data, place, x);
   return x;
 }
 
@@ -442,5 +448,9 @@ PointState PointState::with_params(const std::vector<double>& x) const {
 Vec3 PointState::predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const {
   return e_->predict(m, jac, rot, jac_rot);
 }
+int PointState::probe_residuals(const Measurement& m, int size, double* r, double* J) const {
+  return e_->probe_residuals(m, size, r, J);
+}
+double PointState::artifact_residual(const ArtifactTerm& a, double* J) const { return e_->artifact_residual(a, J); }
 
 }  // namespace kincal

@@ -1,6 +1,8 @@
 // kincal: identification's priors and the data's noise scale (priors.hpp).
 #include "kincal/identify/priors.hpp"
 
+#include "kincal/identify/point_model.hpp"
+
 #include "kincal/effects/effects.hpp"
 #include "kincal/identify/identifiability.hpp"
 
@@ -106,16 +108,18 @@ double loss_threshold(double noise_mm, int row_size) { return noise_mm * std::sq
 
 /// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
 /// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r).
-double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, int row_size) {
+double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, const MeasurementSet& data,
+                           int row_size) {
   const Eigen::Index n = static_cast<Eigen::Index>(lin.residuals.size());
   Eigen::MatrixXd J(n, static_cast<Eigen::Index>(determined.size()));
   for (size_t k = 0; k < determined.size(); ++k) J.col(static_cast<Eigen::Index>(k)) = lin.jacobian.col(determined[k]);
   const Eigen::Map<const Eigen::VectorXd> r(lin.residuals.data(), n);
   const Eigen::VectorXd step = (J.transpose() * J).ldlt().solve(J.transpose() * r);
   const Eigen::VectorXd after = r - J * step;
-  std::vector<double> position;
-  for (Eigen::Index i = 0; i < n; i += row_size)
-    for (int c = 0; c < 3; ++c) position.push_back(after[i + c]);
+  std::vector<double> position;  // the data's rows (an artifact's terms follow them)
+  for (size_t i = 0; i < data.rows.size(); ++i)
+    for (int c = 0; c < position_equations(data.rows[i]); ++c)
+      position.push_back(after[static_cast<Eigen::Index>(i) * row_size + c]);
   return robust_noise(position, determined.size());
 }
 

@@ -16,6 +16,10 @@ namespace kincal {
 int row_residuals(const PointState& pm, const Measurement& m, ResidualKind kind, double orientation_weight, double* r,
                   double* J, double* scratch) {
   const int P = pm.layout().size;
+  if (is_probe(m.kind)) {  // along its constraint, the rest of its block zero
+    pm.probe_residuals(m, residual_size(kind), r, J);
+    return residual_size(kind);
+  }
   // a reflector row among 6-D rows: its orientation rows are zero (no equation), the layout stays
   const bool orientation = kind == ResidualKind::pose && m.has_abc;
   Mat3 rot;
@@ -60,6 +64,15 @@ void all_residuals(const PointState& pm, const MeasurementSet& data, double orie
           for (size_t c = 0; c < F; ++c) J[(RS * i + k) * F + c] = full[k * P + columns[c]];
     }
   });
+}
+
+std::vector<double> row_errors(const PointState& pm, const MeasurementSet& data) {
+  const size_t RS = residual_size(residual_kind(data));
+  std::vector<double> r(RS * data.rows.size()), e(data.rows.size());
+  all_residuals(pm, data, 0.0, {}, r.data(), nullptr);
+  for (size_t i = 0; i < e.size(); ++i)
+    e[i] = Eigen::Map<const Eigen::VectorXd>(&r[RS * i], position_equations(data.rows[i])).norm();
+  return e;
 }
 
 }  // namespace kincal

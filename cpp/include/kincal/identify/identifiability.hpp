@@ -25,6 +25,11 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
 
 /// The Jacobian of every parameter (a row per residual, as all_residuals) and the residuals of a
 /// measurement set at one parameter vector.
+/// The reasons a setup's placement is held when the data cannot see it.
+inline constexpr const char* kSetupNeverMeasured = "setup never measured";
+inline constexpr const char* kProbeOnlySetup = "probe rows only: the stations' unknowns absorb the base frame";
+
+/// The data's residuals (every row's block, then one per artifact term) and their Jacobian.
 struct Linearization {
   Eigen::MatrixXd jacobian;
   std::vector<double> residuals;

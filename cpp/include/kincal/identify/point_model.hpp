@@ -24,7 +24,16 @@
 //        or to its base_in_instrument;
 //   per target 3: offset in the tool frame (mm, absolute);
 //   per extra effect (transmission_error 2 per harmonic order, backlash 1, thermal_expansion 1,
-//   drift 6), see effects.hpp (the registry).
+//   drift 6), see effects.hpp (the registry);
+//   per probe station 3 (instrument frame of the row's setup): a sphere's centre or a ballbar's
+//        pivot (mm, absolute); a plane's normal tilted from its reference normal along two
+//        directions normal to it (rad) and its offset, n . y = offset for the points y of the plane
+//        (mm, absolute). The reference normal is the plane through the rows' ball centres on the
+//        nominal model, turned towards the flange.
+// A probe row's residual is along its constraint: a sphere row's ball centre minus the station's
+// point (3), a plane row's distance of the ball centre from the plane minus the ball's radius (1), a
+// ballbar row's distance from the pivot minus its length (1); the unused components of the row's
+// residual block are zero.
 // Gravity without a mass table ("fit"): the torque about joint j is tau_j = w_j . (A_j x g) with
 // A_j = sum_{k>=j} G_{k+1} a_k (+ the payload's known part), a_k a constant vector of link k (its mass
 // times its centre of mass from p_k, plus the mass beyond it times p_{k+1} - p_k): linear in the
@@ -81,12 +90,14 @@ struct LayoutOptions {
   std::vector<std::string> setups;      ///< the data's setup names by code; none or one: one placement "base.*"
   double t_mean = 0;                    ///< the drift's reference time (s)
   bool fit_gravity = false;             ///< the moments of every link from the first loaded joint's on are parameters
+  std::vector<std::string> station_names;  ///< the data's probe stations by code (none without probe rows)
+  std::vector<MeasureKind> station_kinds;  ///< and their kinds
 };
 
 /// Layout of the identification parameter vector for a model and its options.
 struct ParamLayout {
   int dof = 0, n_targets = 0, n_setups = 1;
-  int joints = 0, compliance = 0, moments = 0, tool = 0, base = 0, targets = 0, effects = 0, size = 0;
+  int joints = 0, compliance = 0, moments = 0, tool = 0, base = 0, targets = 0, effects = 0, stations = 0, size = 0;
   bool fit_gravity = false;           ///< the gravity's mass moments are parameters (no mass table)
   std::vector<int> moment_links;      ///< the link (joint index) of every pair of moment parameters
   int drift = -1;                     ///< offset of the drift's 6 parameters (-1: no drift)
@@ -96,6 +107,8 @@ struct ParamLayout {
   double t_ref = 20.0;
   double t_mean = 0;                  ///< the drift's reference time (s)
   std::vector<std::string> setup_names;  ///< by setup code (empty: one setup, no setup column)
+  std::vector<std::string> station_names;  ///< by station code; 3 parameters each from `stations` on
+  std::vector<MeasureKind> station_kinds;
   std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry", "base[B].ry"
   std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm", "t m"
   ParamLayout(const Model& nominal, const LayoutOptions& options);
@@ -114,9 +127,10 @@ class PointState;
 /// scratch apart).
 class PointModel {
  public:
-  /// nominal: must outlive the model and its states. payload_rows: the payloads named in these rows'
-  /// payload_kg column get their model variants (a row with another payload is refused).
-  PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* payload_rows = nullptr);
+  /// nominal: must outlive the model and its states. data: the payloads named in its rows' payload_kg
+  /// column get their model variants (a row with another payload is refused), its planes their
+  /// reference normals (without it: the z axis).
+  PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data = nullptr);
   const ParamLayout& layout() const;
   /// The model at parameters x (size layout().size).
   PointState at(const std::vector<double>& x) const;
@@ -125,7 +139,8 @@ class PointModel {
   /// only (the others left zero). Reuse it only while the robot's own parameters stay at x's.
   PointState at_frames_only(const std::vector<double>& x, const MeasurementSet& data) const;
   /// Starting parameters: nominal geometry, each setup's base frame from the best rigid fit (Horn)
-  /// of the nominal prediction of the tool point to that setup's rows, targets at the tool point.
+  /// of the nominal prediction of the tool point to that setup's points, targets at the tool point,
+  /// the stations through the nominal tool points of their rows.
   /// With the gravity fitted: every moment zero (no link torque), compliances nominal.
   std::vector<double> start(const MeasurementSet& data) const;
   /// With the gravity fitted: generic non-zero moments (and free zero compliances at the held one's
@@ -151,6 +166,12 @@ class PointState {
   /// rot: the tool frame's orientation (instrument frame); jac_rot (3 x size): its angular velocity
   /// (instrument frame) per parameter.
   Vec3 predict(const Measurement& m, double* jac, Mat3* rot = nullptr, double* jac_rot = nullptr) const;
+  /// A probe row's residual (its components along the constraint, then zeros up to `size`) and, when
+  /// J is not null, its Jacobian (size x layout().size, row-major). Returns the components used.
+  int probe_residuals(const Measurement& m, int size, double* r, double* J) const;
+  /// An artifact term's residual (mm: a length error; an angle error in rad times a 1 m lever) and,
+  /// when J is not null, its gradient (layout().size).
+  double artifact_residual(const ArtifactTerm& a, double* J) const;
 
  private:
   friend class PointModel;
@@ -164,6 +185,12 @@ enum class ResidualKind { position = 3, pose = 6 };
 
 /// The number of residuals of a row of that kind.
 constexpr int residual_size(ResidualKind kind) { return static_cast<int>(kind); }
+
+/// The position components of a row's residual that carry an equation: a point's or a sphere row's 3,
+/// a plane or ballbar row's 1 (the first; the rest of its block is zero).
+constexpr int position_equations(const Measurement& m) {
+  return m.kind == MeasureKind::plane || m.kind == MeasureKind::distance ? 1 : 3;
+}
 
 /// The residual kind of every row of a set: pose when it carries measured orientations.
 inline ResidualKind residual_kind(const MeasurementSet& data) {
@@ -184,5 +211,10 @@ int row_residuals(const PointState& pm, const Measurement& m, ResidualKind kind,
 /// evaluated on the process's thread pool, 256 rows or more per thread; nothing is allocated per row.
 void all_residuals(const PointState& pm, const MeasurementSet& data, double orientation_weight,
                    const std::vector<int>& columns, double* r, double* J);
+
+/// Every row's error at pm's parameters (mm): a point's distance from its prediction, a probe row's
+/// residual along its constraint (a sphere row's distance from the station's point, a plane or ballbar
+/// row's error of distance). Orientations are not counted.
+std::vector<double> row_errors(const PointState& pm, const MeasurementSet& data);
 
 }  // namespace kincal

@@ -3,6 +3,8 @@
 // the residuals' robust spread and the robust loss's scale from it.
 #pragma once
 
+#include "kincal/io/measurements.hpp"
+
 #include "kincal/identify/identify.hpp"
 
 #include <cstddef>
@@ -43,8 +45,9 @@ double loss_threshold(double noise_mm, int row_size);
 struct Linearization;
 
 /// The residuals' robust spread after a least-squares fit of the columns `determined`, from the
-/// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r), row_size residuals
-/// per row, the first 3 of each the position.
-double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, int row_size);
+/// linearization at the start (one Gauss-Newton step: r - J (J^T J)^-1 J^T r) of data, row_size
+/// residuals per row, of each the position components that carry an equation (position_equations).
+double least_squares_noise(const Linearization& lin, const std::vector<int>& determined, const MeasurementSet& data,
+                           int row_size);
 
 }  // namespace kincal

@@ -31,6 +31,32 @@ struct SimulationOptions {
   double duration_s = 0;
 };
 
+/// A probe campaign (measurements without a tracker, measurements.hpp's kinds) on a truth.
+struct ProbeSimulationOptions {
+  MeasureKind kind = MeasureKind::sphere;
+  /// spheres or ballbar pivots placed in reach; planes: faces of one block in front of the robot (at
+  /// most 5: top, the face towards the robot, the two sideways, the far one)
+  int stations = 3;
+  int touches = 25;            ///< rows per station
+  double cone_deg = 35;        ///< the probe's axis within this angle of its station's mean direction
+  Vec3 probe = Vec3::Zero();   ///< the ball centre in the tool frame (mm)
+  double radius_mm = 3;        ///< plane: the ball's radius
+  double length_mm = 150;      ///< distance: the ballbar's length
+  double block_mm = 120;       ///< plane: the block's edge; touches spread over 70% of each face
+  double noise_mm = 0.005;     ///< along the constraint (distance: of the ballbar's length)
+  double limit_margin = 0.8;   ///< stations placed from poses in this share of every joint's range
+  unsigned seed = 1;
+  /// the artifact written with the rows: spheres and pivots, the distance of every station from the
+  /// first; planes, the 90 deg angles between the top face and the others and the block's edge
+  /// between opposite faces
+  bool artifact = true;
+};
+
+/// A probe campaign on the truth (its effects acting at each row's context): each row's commanded
+/// angles put the truth's ball centre on its constraint, with the noise along it; stations in the
+/// instrument frame of the truth's base_in_instrument. InputError when a station cannot be reached.
+MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& opt);
+
 /// The campaign's length a hidden drift gets when SimulationOptions::duration_s is not set (3 h).
 constexpr double kDefaultDriftDuration_s = 3 * 3600.0;
 

@@ -4,6 +4,11 @@
 // time_s (when the point was measured), config (rows repeating one configuration share its value)
 // and setup (one instrument placement per value). config and setup are any text; a row carries the
 // code of its value (codes in order of first appearance, the names in the set).
+// Measurements without a tracker (the contract's "kind" column): a probe row names its station and
+// has no x, y, z: `sphere` (the probe's ball centre was at the station's unknown fixed point),
+// `plane` (the ball touched the station's unknown plane; `radius`: the ball centre is that far off
+// the plane on the flange's side), `distance` (a ballbar: the ball centre was `length` mm from the
+// station's unknown pivot). A station is of one kind.
 #pragma once
 
 #include "kincal/core/types.hpp"
@@ -14,6 +19,14 @@
 #include <vector>
 
 namespace kincal {
+
+/// What a row measured: a point (x, y, z), a pose (and a, b, c), or a probe's contact at a station.
+enum class MeasureKind { point, pose, sphere, plane, distance };
+
+/// The word of a kind in the CSV's kind column ("point", "pose", "sphere", "plane", "distance").
+const char* to_string(MeasureKind kind);
+/// Whether a kind is a probe's (sphere, plane, distance): its row names a station, has no x, y, z.
+constexpr bool is_probe(MeasureKind kind) { return kind >= MeasureKind::sphere; }
 
 struct Measurement {
   int pose = 0;
@@ -29,6 +42,19 @@ struct Measurement {
   double time_s = std::numeric_limits<double>::quiet_NaN();  ///< when it was measured (NaN: unknown)
   int config = -1;           ///< code of its config value (-1: no config column)
   int setup = 0;             ///< code of its instrument placement (0 without a setup column)
+  MeasureKind kind = MeasureKind::point;  ///< pose when has_abc; a probe's kind with a station
+  int station = -1;          ///< code of its station (probe rows; -1 for the others)
+  double radius_mm = 0;      ///< plane: the ball's radius (its centre that far off the plane)
+  double length_mm = std::numeric_limits<double>::quiet_NaN();  ///< distance: the ballbar's length
+};
+
+/// Known geometry between two stations (the --artifact file): the distance between two sphere or
+/// pivot stations' points, or between two parallel planes; or the angle between two planes.
+struct ArtifactTerm {
+  int a = -1, b = -1;  ///< station codes
+  double distance_mm = std::numeric_limits<double>::quiet_NaN();
+  double angle_deg = std::numeric_limits<double>::quiet_NaN();
+  std::string where;   ///< file:line of the term
 };
 
 struct MeasurementSet {
@@ -40,6 +66,11 @@ struct MeasurementSet {
   bool orientation = false;
   std::vector<std::string> config_names;  ///< the config values by code (empty: no config column)
   std::vector<std::string> setup_names;   ///< the setup values by code (empty: no setup column)
+  std::vector<std::string> station_names; ///< the probe stations by code (empty: no probe rows)
+  std::vector<MeasureKind> station_kinds; ///< the kind of every station
+  std::vector<ArtifactTerm> artifact;     ///< known lengths and angles between stations
+  /// Some row is a probe's.
+  bool has_probe() const { return !station_names.empty(); }
   /// Number of instrument placements (1 without a setup column).
   int n_setups() const { return setup_names.empty() ? 1 : static_cast<int>(setup_names.size()); }
   /// Whether the rows carry the time they were measured (a time_s column).
@@ -50,6 +81,12 @@ struct MeasurementSet {
 MeasurementSet read_measurements(const std::string& path, int dof);
 MeasurementSet parse_measurements(const std::string& text, const std::string& source, int dof);
 std::string format_measurements(const MeasurementSet& m, int dof);
+/// Read an artifact file (a, b, distance_mm, angle_deg: one of the last two per row) into m.artifact:
+/// InputError (file:line) for a station m lacks, a distance between stations of different kinds or
+/// an angle between stations that are not planes, a distance or an angle out of range.
+void read_artifact(const std::string& path, MeasurementSet& m);
+void parse_artifact(const std::string& text, const std::string& source, MeasurementSet& m);
+std::string format_artifact(const MeasurementSet& m);
 
 struct ModelSpec;
 /// The rows' joint angles, read as the controller numbers them, turned into the model's (its joint

@@ -1,0 +1,203 @@
+// kincal: probe campaigns on a truth (simulate.hpp): spheres, the faces of a block, ballbar pivots.
+// Each row's commanded angles are found by inverse kinematics on the truth itself (its effects
+// acting), so that its ball centre sits on the row's constraint exactly, then moved by the noise.
+#include "kincal/identify/simulate.hpp"
+
+#include "kincal/compensation/pose.hpp"
+#include "kincal/identify/so3.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <cmath>
+#include <random>
+
+namespace kincal {
+
+namespace {
+
+/// A random rotation taking the direction `axis` (unit) within `cone` rad of itself, turned about
+/// the tool's own axis by up to +-60 deg.
+Mat3 tilt(std::mt19937_64& rng, const Vec3& axis, double cone) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double theta = cone * std::sqrt(u01(rng)), phi = 2 * M_PI * u01(rng), psi = (u01(rng) - 0.5) * 2 * M_PI / 3;
+  const Vec3 a = axis.unitOrthogonal(), b = axis.cross(a);
+  return so3::exp((std::cos(phi) * a + std::sin(phi) * b) * theta) * so3::exp(axis * psi);
+}
+
+struct Placer {
+  const Model& truth;
+  const ProbeSimulationOptions& opt;
+  std::mt19937_64& rng;
+  /// Commanded angles that put the truth's ball centre at c with the tool turned to r (base frame),
+  /// near ref; false when out of reach.
+  bool reach(const Vec3& c, const Mat3& r, const VecQ& ref, const VecQ& dir, Measurement& row, int starts = 8) const {
+    Eigen::Isometry3d tool = Eigen::Isometry3d::Identity();
+    tool.linear() = r;
+    tool.translation() = c - r * opt.probe;
+    EffectContext ctx;
+    ctx.dir = dir;
+    CompensationOptions co;
+    co.max_iterations = 50;
+    const auto q = numeric_ik(truth, iso_to_pose(tool), ref, co, starts, ctx);
+    if (!q) return false;
+    row.q_deg = *q;
+    row.dir = dir;
+    return true;
+  }
+};
+
+}  // namespace
+
+MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& opt) {
+  if (!is_probe(opt.kind)) throw InputError("simulate: --kind must be sphere, plane or distance");
+  if (opt.stations < 1 || opt.touches < 1) throw InputError("simulate: at least one station and one touch");
+  if (opt.kind == MeasureKind::plane && opt.stations > 5) throw InputError("simulate: a block has 5 faces to probe");
+  if (truth.dof() != 6) throw InputError("simulate: probe campaigns need a 6-joint robot");
+  std::mt19937_64 rng(opt.seed);
+  std::uniform_real_distribution<double> ud(-0.5, 0.5), u01(0.0, 1.0);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  const int n = truth.dof();
+  const Placer place{truth, opt, rng};
+  const double cone = opt.cone_deg * kDeg;
+  MeasurementSet m;
+  m.source = "simulated";
+  auto random_q = [&] {
+    VecQ q(n);
+    for (int j = 0; j < n; ++j) {
+      const JointSpec& js = truth.spec().joints[j];
+      q[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg) * opt.limit_margin;
+    }
+    return q;
+  };
+  auto random_dir = [&] {
+    VecQ d(n);
+    for (int j = 0; j < n; ++j) d[j] = u01(rng) < 0.5 ? -1.0 : 1.0;
+    return d;
+  };
+  // a seed pose with the probe's ball well in reach: its tool frame (base frame)
+  auto seed_pose = [&](VecQ& q) {
+    q = random_q();
+    return fk_model(truth, q * kDeg, EffectContext{random_dir(), std::nan("")});
+  };
+  std::vector<Vec3> points;  // every sphere's centre or pivot (base frame)
+  // the top, the face towards the robot, the two sideways and the far one (hardest to reach)
+  const char* faces[] = {"top", "x-", "y+", "y-", "x+"};
+  const Vec3 face_normal[] = {Vec3::UnitZ(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitX()};
+  // the block: in front of the robot, where every probed face's centre is in reach with the probe
+  // pointing into it (the first of a few places at fractions of the reach and heights about the
+  // shoulder); its top face's centre `top`
+  VecQ q0 = VecQ::Zero(n);
+  Eigen::Isometry3d block = Eigen::Isometry3d::Identity();
+  block.linear() << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // the probe pointing down
+  Vec3 top = Vec3::Zero();
+  auto face_centre = [&](int s) -> Vec3 { return top - Vec3::UnitZ() * (0.5 * opt.block_mm) + face_normal[s] * (0.5 * opt.block_mm); };
+  auto face_turn = [&](int s) -> Mat3 {  // the probe turned to point into face s
+    return Eigen::Quaterniond::FromTwoVectors(block.linear().col(2), -face_normal[s]).toRotationMatrix() * block.linear();
+  };
+  if (opt.kind == MeasureKind::plane) {
+    VecQ mid(n);
+    for (int j = 0; j < n; ++j) mid[j] = 0.5 * (truth.spec().joints[j].lower_deg + truth.spec().joints[j].upper_deg);
+    const double reach = (fk_compliant(truth, VecQ::Zero(n)) * opt.probe).head<2>().norm();
+    const double shoulder = truth.point(1).z();
+    bool found = false;
+    for (double fr : {0.55, 0.45, 0.65, 0.35})
+      for (double fz : {-0.3, 0.0, -0.5, 0.2})
+        for (double az : {0.0, 30.0, -30.0}) {
+          if (found) break;
+          top = Vec3(fr * reach * std::cos(az * kDeg), fr * reach * std::sin(az * kDeg), shoulder + fz * reach);
+          Measurement probe_row;
+          found = place.reach(face_centre(0) + face_normal[0] * opt.radius_mm, face_turn(0), mid, random_dir(), probe_row, 48);
+          if (!found) continue;
+          q0 = probe_row.q_deg;
+          for (int s = 1; s < opt.stations && found; ++s)
+            found = place.reach(face_centre(s) + face_normal[s] * opt.radius_mm, face_turn(s), q0, random_dir(), probe_row, 48);
+        }
+    if (!found) throw InputError("simulate: no place for a block of " + std::to_string(opt.block_mm) + " mm with " +
+                                 std::to_string(opt.stations) + " faces in the robot's reach");
+  }
+  for (int s = 0; s < opt.stations; ++s) {
+    const std::string name = opt.kind == MeasureKind::plane ? faces[s] : "S" + std::to_string(s + 1);
+    m.station_names.push_back(name);
+    m.station_kinds.push_back(opt.kind);
+    Vec3 axis;   // the probe's mean direction (the tool's z in the seed pose, or towards the face)
+    Vec3 centre, normal = Vec3::UnitZ();
+    VecQ ref;
+    Eigen::Isometry3d seed;
+    if (opt.kind == MeasureKind::plane) {
+      ref = q0;
+      seed = block;
+      normal = face_normal[s];
+      centre = face_centre(s);
+      axis = -normal;  // the probe points into the face
+    } else {
+      seed = seed_pose(ref);
+      centre = seed * opt.probe;
+      axis = seed.linear().col(2);
+      if (opt.kind == MeasureKind::distance) centre -= Vec3::UnitZ() * opt.length_mm;  // the pivot below
+      points.push_back(centre);
+    }
+    int made = 0, tries = 0;
+    while (made < opt.touches) {
+      if (++tries > 40 * opt.touches)
+        throw InputError("simulate: station " + name + " is out of the robot's reach (" + std::to_string(made) +
+                         " of " + std::to_string(opt.touches) + " touches)");
+      Measurement row;
+      row.pose = static_cast<int>(m.rows.size());
+      row.kind = opt.kind;
+      row.station = s;
+      Vec3 c;
+      Mat3 r;
+      if (opt.kind == MeasureKind::plane) {
+        // a point of the face (70% of it), the ball centre radius + noise off it, the probe into it
+        const Vec3 a = normal.unitOrthogonal(), b = normal.cross(a);
+        const Vec3 on = centre + 0.7 * opt.block_mm * (ud(rng) * a + ud(rng) * b);
+        c = on + normal * (opt.radius_mm + opt.noise_mm * nd(rng));
+        r = tilt(rng, axis, cone) * face_turn(s);
+        row.radius_mm = opt.radius_mm;
+      } else if (opt.kind == MeasureKind::sphere) {
+        c = centre + Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
+        r = tilt(rng, axis, cone) * seed.linear();
+      } else {
+        // the bar's direction within the cone about the vertical, the tool turned within half of it
+        const Vec3 d = tilt(rng, Vec3::UnitZ(), cone) * Vec3::UnitZ();
+        c = centre + d * opt.length_mm;
+        r = tilt(rng, axis, 0.5 * cone) * seed.linear();
+        row.length_mm = opt.length_mm + opt.noise_mm * nd(rng);
+      }
+      if (!place.reach(c, r, ref, random_dir(), row)) continue;
+      row.line = 0;
+      m.rows.push_back(row);
+      ++made;
+    }
+  }
+  // (the stations are in the base frame, the artifact's lengths and angles in any)
+  if (opt.artifact) {
+    if (opt.kind != MeasureKind::plane) {
+      for (int s = 1; s < opt.stations; ++s) {
+        ArtifactTerm a;
+        a.a = 0;
+        a.b = s;
+        a.distance_mm = (points[static_cast<size_t>(s)] - points[0]).norm();
+        m.artifact.push_back(a);
+      }
+    } else {
+      for (int s = 1; s < opt.stations; ++s) {
+        ArtifactTerm a;
+        a.a = 0;
+        a.b = s;
+        a.angle_deg = 90;
+        m.artifact.push_back(a);
+      }
+      for (const auto& [fa, fb] : {std::pair<int, int>{2, 3}, {1, 4}}) {  // y+ with y-, x- with x+
+        if (fb >= opt.stations) continue;
+        ArtifactTerm a;
+        a.a = fa;
+        a.b = fb;
+        a.distance_mm = opt.block_mm;
+        m.artifact.push_back(a);
+      }
+    }
+  }
+  return m;
+}
+
+}  // namespace kincal

@@ -1,0 +1,212 @@
+// kincal: the probe stations of the identification (measurements without a tracker): each plane's
+// reference normal, the stations' values at a parameter vector, a probe row's residual along its
+// constraint with its Jacobian, the artifact's known lengths and angles, and the stations' start.
+#include "point_eval.hpp"
+
+#include "kincal/core/rigid.hpp"
+#include "kincal/identify/so3.hpp"
+#include "kincal/kinematics/kinematics.hpp"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+
+namespace kincal::detail {
+
+std::vector<Eigen::Isometry3d> start_placements(const PointStructure& s, const MeasurementSet& data) {
+  std::vector<Eigen::Isometry3d> out;
+  for (int k = 0; k < s.layout.n_setups; ++k) {
+    Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+    f.linear() = s.r0[static_cast<size_t>(k)];
+    f.translation() = s.t0[static_cast<size_t>(k)];
+    std::vector<size_t> rows;  // the measured points of the setup (a probe row has none)
+    for (size_t i = 0; i < data.rows.size(); ++i)
+      if (data.rows[i].setup == k && !is_probe(data.rows[i].kind)) rows.push_back(i);
+    if (rows.size() >= 3) {  // fewer: the setup's frame starts at its reference
+      Eigen::Matrix3Xd a(3, rows.size()), b(3, rows.size());
+      for (size_t j = 0; j < rows.size(); ++j) {
+        a.col(static_cast<Eigen::Index>(j)) = fk_compliant(s.nominal, data.rows[rows[j]].q_deg * kDeg).translation();
+        b.col(static_cast<Eigen::Index>(j)) = data.rows[rows[j]].xyz;
+      }
+      f = rigid_fit(a, b);
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+namespace {
+
+/// The nominal tool points of a station's rows, each seen from its setup's placement.
+Eigen::Matrix3Xd station_points(const PointStructure& s, const MeasurementSet& data,
+                                const std::vector<Eigen::Isometry3d>& place, int station, Eigen::Matrix3Xd* flanges) {
+  std::vector<const Measurement*> rows;
+  for (const Measurement& r : data.rows)
+    if (r.station == station) rows.push_back(&r);
+  Eigen::Matrix3Xd y(3, rows.size());
+  if (flanges) flanges->resize(3, static_cast<Eigen::Index>(rows.size()));
+  const Eigen::Isometry3d tool_inv = s.nominal.tool().inverse();
+  for (size_t j = 0; j < rows.size(); ++j) {
+    const Eigen::Isometry3d& b = place[static_cast<size_t>(rows[j]->setup)];
+    const Eigen::Isometry3d t = fk_compliant(s.nominal, rows[j]->q_deg * kDeg);
+    y.col(static_cast<Eigen::Index>(j)) = b * t.translation();
+    if (flanges) flanges->col(static_cast<Eigen::Index>(j)) = b * (t * tool_inv).translation();
+  }
+  return y;
+}
+
+}  // namespace
+
+void PointStructure::init_stations(const MeasurementSet* data) {
+  const size_t n = layout.station_names.size();
+  station_u.assign(n, Vec3::UnitX());
+  station_v.assign(n, Vec3::UnitY());
+  station_normal.assign(n, Vec3::UnitZ());
+  if (!data || n == 0) return;
+  const std::vector<Eigen::Isometry3d> place = start_placements(*this, *data);
+  for (size_t k = 0; k < n; ++k) {
+    if (layout.station_kinds[k] != MeasureKind::plane) continue;
+    Eigen::Matrix3Xd flanges;
+    const Eigen::Matrix3Xd y = station_points(*this, *data, place, static_cast<int>(k), &flanges);
+    if (y.cols() < 3) continue;
+    const Vec3 c = y.rowwise().mean();
+    const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(y.colwise() - c, Eigen::ComputeFullU);
+    Vec3 nrm = svd.matrixU().col(2);
+    // towards the flange: the ball centres lie on the plane's side where the flange is
+    if ((flanges.colwise() - y.rowwise().mean()).rowwise().mean().dot(nrm) < 0) nrm = -nrm;
+    station_normal[k] = nrm;
+    station_u[k] = nrm.unitOrthogonal();
+    station_v[k] = nrm.cross(station_u[k]);
+  }
+}
+
+void PointEval::init_stations() {
+  const ParamLayout& L = layout_;
+  station_.resize(L.station_names.size());
+  for (size_t k = 0; k < station_.size(); ++k) {
+    StationState& st = station_[k];
+    const double* p = &x_[L.stations + 3 * k];
+    if (L.station_kinds[k] != MeasureKind::plane) {
+      st.c = Vec3(p[0], p[1], p[2]);
+      continue;
+    }
+    const Vec3 w = s_->station_normal[k] + p[0] * s_->station_u[k] + p[1] * s_->station_v[k];
+    const double nw = w.norm();
+    st.n = w / nw;
+    st.dn[0] = (s_->station_u[k] - st.n * st.n.dot(s_->station_u[k])) / nw;
+    st.dn[1] = (s_->station_v[k] - st.n * st.n.dot(s_->station_v[k])) / nw;
+    st.d = p[2];
+  }
+}
+
+int PointEval::probe_residuals(const Measurement& m, int size, double* r, double* J) const {
+  const ParamLayout& L = layout_;
+  if (m.station < 0 || m.station >= static_cast<int>(station_.size()))
+    throw InputError("a probe row of station code " + std::to_string(m.station) + " but the layout has " +
+                     std::to_string(station_.size()) + " station(s)");
+  const int P = L.size, off = L.stations + 3 * m.station;
+  const StationState& st = station_[static_cast<size_t>(m.station)];
+  const Vec3 y = predict(m, J, nullptr, nullptr);
+  std::fill_n(r, size, 0.0);
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> JJ(J, J ? size : 0, P);
+  if (J && size > 3) JJ.bottomRows(size - 3).setZero();
+  switch (m.kind) {
+    case MeasureKind::sphere:
+      for (int k = 0; k < 3; ++k) r[k] = y[k] - st.c[k];
+      if (J) JJ.block(0, off, 3, 3) -= Mat3::Identity();
+      return 3;
+    case MeasureKind::plane:
+      r[0] = st.n.dot(y) - st.d - m.radius_mm;
+      if (J) {
+        JJ.row(0) = st.n.transpose() * JJ.topRows(3);
+        JJ(0, off) += st.dn[0].dot(y);
+        JJ(0, off + 1) += st.dn[1].dot(y);
+        JJ(0, off + 2) -= 1.0;
+        JJ.middleRows(1, 2).setZero();
+      }
+      return 1;
+    case MeasureKind::distance: {
+      const Vec3 v = y - st.c;
+      const double len = v.norm();
+      const Vec3 e = len > 0 ? Vec3(v / len) : Vec3::UnitX();
+      r[0] = len - m.length_mm;
+      if (J) {
+        JJ.row(0) = e.transpose() * JJ.topRows(3);
+        for (int k = 0; k < 3; ++k) JJ(0, off + k) -= e[k];
+        JJ.middleRows(1, 2).setZero();
+      }
+      return 1;
+    }
+    default:
+      break;
+  }
+  throw std::logic_error("probe_residuals: not a probe row");
+}
+
+double PointEval::artifact_residual(const ArtifactTerm& a, double* J) const {
+  const ParamLayout& L = layout_;
+  const int P = L.size, oa = L.stations + 3 * a.a, ob = L.stations + 3 * a.b;
+  const StationState &sa = station_[static_cast<size_t>(a.a)], &sb = station_[static_cast<size_t>(a.b)];
+  if (J) std::fill_n(J, P, 0.0);
+  const bool planes = L.station_kinds[static_cast<size_t>(a.a)] == MeasureKind::plane;
+  if (!std::isnan(a.angle_deg)) {  // the unsigned angle between the planes, on a 1 m lever (mm)
+    const double c = sa.n.dot(sb.n), sign = c < 0 ? -1.0 : 1.0;
+    const double ac = std::min(1.0, std::abs(c)), ang = std::acos(ac);
+    if (J) {
+      const double d = -kArtifactLever / std::max(std::sqrt(1 - ac * ac), 1e-9) * sign;  // d(angle)/dc
+      for (int k = 0; k < 2; ++k) J[oa + k] = d * sb.n.dot(sa.dn[k]), J[ob + k] = d * sa.n.dot(sb.dn[k]);
+    }
+    return kArtifactLever * (ang - a.angle_deg * kDeg);
+  }
+  if (planes) {  // the faces n_a y = d_a and (nearly) parallel n_b y = d_b: |d_a - s d_b|, s = sign(n_a n_b)
+    const double s = sa.n.dot(sb.n) < 0 ? -1.0 : 1.0, gap = sa.d - s * sb.d, sg = gap < 0 ? -1.0 : 1.0;
+    if (J) J[oa + 2] = sg, J[ob + 2] = -s * sg;
+    return std::abs(gap) - a.distance_mm;
+  }
+  const Vec3 v = sa.c - sb.c;
+  const double len = v.norm();
+  const Vec3 e = len > 0 ? Vec3(v / len) : Vec3::UnitX();
+  if (J)
+    for (int k = 0; k < 3; ++k) J[oa + k] = e[k], J[ob + k] = -e[k];
+  return len - a.distance_mm;
+}
+
+void start_stations(const PointStructure& s, const MeasurementSet& data, const std::vector<Eigen::Isometry3d>& place,
+                    std::vector<double>& x) {
+  const ParamLayout& L = s.layout;
+  for (size_t k = 0; k < L.station_names.size(); ++k) {
+    const Eigen::Matrix3Xd y = station_points(s, data, place, static_cast<int>(k), nullptr);
+    if (y.cols() == 0) continue;
+    double* p = &x[L.stations + 3 * k];
+    const Vec3 c = y.rowwise().mean();
+    if (L.station_kinds[k] == MeasureKind::plane) {
+      double sum = 0;
+      int j = 0;
+      for (const Measurement& r : data.rows)
+        if (r.station == static_cast<int>(k)) sum += s.station_normal[k].dot(y.col(j++)) - r.radius_mm;
+      p[0] = p[1] = 0;
+      p[2] = sum / static_cast<double>(y.cols());
+      continue;
+    }
+    Vec3 start = c;
+    if (L.station_kinds[k] == MeasureKind::distance && y.cols() >= 4) {
+      // |y - p|^2 = l^2: 2 y.p - |p|^2 = |y|^2 - l^2, linear in p and |p|^2 (about the mean, for conditioning)
+      Eigen::MatrixXd A(y.cols(), 4);
+      Eigen::VectorXd b(y.cols());
+      int j = 0;
+      for (const Measurement& r : data.rows) {
+        if (r.station != static_cast<int>(k)) continue;
+        const Vec3 yj = y.col(j) - c;
+        A.row(j) << 2 * yj.transpose(), -1.0;
+        b[j] = yj.squaredNorm() - r.length_mm * r.length_mm;
+        ++j;
+      }
+      const Eigen::VectorXd sol = A.colPivHouseholderQr().solve(b);
+      if (sol.allFinite()) start = c + sol.head<3>();
+    }
+    for (int i = 0; i < 3; ++i) p[i] = start[i];
+  }
+}
+
+}  // namespace kincal::detail

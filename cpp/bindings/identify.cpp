@@ -93,6 +93,8 @@ std::vector<Parameter> parameters_of(const ParamLayout& L) {
     } else if (i < L.effects) {
       p.kind = "target";
       p.target = (i - L.targets) / 3;
+    } else if (i >= L.stations) {
+      p.kind = "station";
     } else {
       for (size_t e = 0; e < L.effect_list.size(); ++e)
         if (i >= L.effect_offset[e] && i < L.effect_offset[e] + L.effect_list[e].size()) {
@@ -187,15 +189,55 @@ void define_identify(py::module_& m) {
       "A measurement campaign on the calibrated (true) model of a robot; effects: (Effect, values in core\n"
       "units) hidden in the truth. duration_s > 0: a time_s column, the campaign running from 0 to\n"
       "duration_s in pose order (a hidden drift without it: 3 h, centred on the mean time)");
+  py::class_<StationValue>(m, "StationValue", "A probe station as identified (instrument frame of its rows' setup)")
+      .def_readonly("name", &StationValue::name)
+      .def_property_readonly("kind", [](const StationValue& v) { return to_string(v.kind); },
+                             "'sphere', 'plane' or 'distance' (a ballbar's pivot)")
+      .def_readonly("point", &StationValue::point, "a sphere's centre or a pivot (mm)")
+      .def_readonly("normal", &StationValue::normal, "a plane's unit normal, towards the flange")
+      .def_readonly("offset", &StationValue::offset, "a plane's offset: normal . y = offset (mm)")
+      .def("__repr__", [](const StationValue& v) { return "<StationValue " + v.name + " " + to_string(v.kind) + ">"; });
   m.def(
       "point_errors",
-      [](const Robot& r, const RowMatrix& targets, const py::dict& d) {
-        const auto e = point_errors(*r.calibrated, targets_from(targets), measurements_from_dict(d, r.calibrated->dof()));
+      [](const Robot& r, const RowMatrix& targets, const py::dict& d, const std::vector<StationValue>& stations) {
+        const auto e = point_errors(*r.calibrated, targets_from(targets), measurements_from_dict(d, r.calibrated->dof()),
+                                    stations);
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
-      py::arg("robot"), py::arg("targets"), py::arg("data"),
+      py::arg("robot"), py::arg("targets"), py::arg("data"), py::arg("stations") = std::vector<StationValue>{},
       "Distance (mm) between every measured point and the calibrated model's prediction (its effects acting,\n"
-      "each row seen from its setup's placement, the model's drift at the row's time)");
+      "each row seen from its setup's placement, the model's drift at the row's time); a probe row's error\n"
+      "along its constraint against its station among `stations` (NaN when not among them)");
+  py::class_<ProbeSimulationOptions>(m, "ProbeSimulationOptions", "A probe campaign to simulate (simulate_probe)")
+      .def(py::init<>())
+      .def_property(
+          "kind", [](const ProbeSimulationOptions& o) { return to_string(o.kind); },
+          [](ProbeSimulationOptions& o, const std::string& k) {
+            for (MeasureKind c : {MeasureKind::sphere, MeasureKind::plane, MeasureKind::distance})
+              if (k == to_string(c)) return void(o.kind = c);
+            throw InputError("simulate: --kind " + k + ": expected sphere, plane or distance");
+          },
+          "'sphere', 'plane' or 'distance'")
+      .def_readwrite("stations", &ProbeSimulationOptions::stations,
+                     "spheres or pivots placed in reach; planes: faces of one block (at most 5)")
+      .def_readwrite("touches", &ProbeSimulationOptions::touches, "rows per station")
+      .def_readwrite("cone_deg", &ProbeSimulationOptions::cone_deg, "the probe's axis within this angle of its mean")
+      .def_readwrite("probe", &ProbeSimulationOptions::probe, "the ball centre in the tool frame (mm)")
+      .def_readwrite("radius_mm", &ProbeSimulationOptions::radius_mm, "plane: the ball's radius")
+      .def_readwrite("length_mm", &ProbeSimulationOptions::length_mm, "distance: the ballbar's length")
+      .def_readwrite("block_mm", &ProbeSimulationOptions::block_mm, "plane: the block's edge")
+      .def_readwrite("noise_mm", &ProbeSimulationOptions::noise_mm, "along the constraint (mm)")
+      .def_readwrite("limit_margin", &ProbeSimulationOptions::limit_margin)
+      .def_readwrite("seed", &ProbeSimulationOptions::seed)
+      .def_readwrite("artifact", &ProbeSimulationOptions::artifact, "write the known distances and angles");
+  m.def(
+      "simulate_probe",
+      [](const Robot& truth, const ProbeSimulationOptions& o) {
+        return measurements_to_dict(simulate_probe(*truth.calibrated, o), truth.calibrated->dof());
+      },
+      py::arg("truth"), py::arg("options"),
+      "A probe campaign on the calibrated (true) model of a robot: every row's ball centre on its\n"
+      "constraint, the noise along it; the artifact's terms under 'artifact'");
   m.def(
       "orientation_errors",
       [](const Robot& r, const py::dict& d) {
@@ -241,6 +283,15 @@ void define_identify(py::module_& m) {
       .def_readonly("t_ref", &ParamLayout::t_ref, "reference temperature of thermal_expansion (degC)")
       .def_readonly("t_mean", &ParamLayout::t_mean, "reference time of the drift (s)")
       .def_readonly("setup_names", &ParamLayout::setup_names, "the setups by code (empty: a single one)")
+      .def_readonly("stations", &ParamLayout::stations, "offset of the probe stations' parameters (3 each)")
+      .def_readonly("station_names", &ParamLayout::station_names, "the probe stations by code")
+      .def_property_readonly("station_kinds", [](const ParamLayout& L) {
+             std::vector<std::string> k;
+             for (MeasureKind s : L.station_kinds) k.emplace_back(to_string(s));
+             return k;
+           }, "'sphere', 'plane' or 'distance' per station")
+      .def_readonly("station_normals", &ParamLayout::station_normals,
+                    "every station's reference normal (planes: their tilts are from it)")
       .def_property_readonly("gravity", [](const ParamLayout& L) { return L.fit_gravity ? "fit" : "masses"; },
                              "where the compliances' gravity torques come from: 'masses' (the model's) or 'fit'")
       .def_property_readonly("loaded", [](const ParamLayout& L) { return joints_to_one(L.loaded); },
@@ -362,6 +413,10 @@ void define_identify(py::module_& m) {
                              "the robust loss's scale in the final fit (mm; 0: none)")
       .def_property_readonly("targets", [](const PyIdentifyResult& r) { return targets_to(r.r.targets); })
       .def_property_readonly("nominal_targets", [](const PyIdentifyResult& r) { return targets_to(r.r.nominal_targets); })
+      .def_property_readonly("stations", [](const PyIdentifyResult& r) { return r.r.stations; },
+                             "the probe stations fitted (the campaign's; empty without probe rows)")
+      .def_property_readonly("nominal_stations", [](const PyIdentifyResult& r) { return r.r.nominal_stations; },
+                             "the probe stations fitted with the nominal geometry")
       .def_property_readonly("effects", [](const PyIdentifyResult& r) { return effect_values_to(r.r.effects); },
                              "(Effect, values in core units) of every extra effect")
       .def_property_readonly("t_ref", [](const PyIdentifyResult& r) { return r.r.t_ref; })
@@ -435,17 +490,23 @@ void define_identify(py::module_& m) {
   py::class_<PyPointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
       .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
                        bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
-                       std::optional<double> t_mean_s, bool fit_gravity) {
+                       std::optional<double> t_mean_s, bool fit_gravity, const ParamLayout* stations_of) {
              std::shared_ptr<const Model> m = from_calibrated ? r.calibrated : r.nominal;
              LayoutOptions o{n_targets, effects, t_ref, setup_names_or_model(setups, *m),
                              t_mean_s ? *t_mean_s : m->spec().t_mean_s, fit_gravity};
+             if (stations_of) {
+               o.station_names = stations_of->station_names;
+               o.station_kinds = stations_of->station_kinds;
+               o.station_normals = stations_of->station_normals;
+             }
              PointModel pm(*m, o);
              return new PyPointModel{std::move(m), std::move(o), std::move(pm)};
            }),
            py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
            py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
-           py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false,
-           "setups: the data's setup names (default: the model's setups); t_mean_s: the drift's reference\n"
+           py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false, py::arg("stations_of") = nullptr,
+           "setups: the data's setup names (default: the model's setups); stations_of: a layout whose probe\n"
+           "stations (names, kinds, reference normals) this one has too; t_mean_s: the drift's reference\n"
            "time (default: the model's); fit_gravity: the compliances' torques from fitted mass moments\n"
            "(parameters of kind 'gravity_moment', 2 per link) instead of the model's masses")
       .def_property_readonly("layout", [](const PyPointModel& p) -> const ParamLayout& { return p.pm.layout(); },

@@ -258,6 +258,7 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
     res.nominal_fitted.t_mean_s = L.t_mean;
   }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
+  res.nominal_stations = fitted.stations();
   double ss = 0;
   for (double e : row_errors(fitted, data)) {
     ss += e * e;
@@ -279,6 +280,7 @@ void store_solution(const PointModel& pm, const Model& nominal, const Measuremen
   // their offsets): every pose then carries the tool's error
   res.calibrated.tcp = data.orientation ? "measured" : "nominal";
   for (int t = 0; t < data.n_targets; ++t) res.targets.push_back(target_of(L, x, t));
+  res.stations = solution.stations();
   res.t_ref = L.t_ref;
   res.t_mean_s = L.t_mean;
   for (size_t e = 0; e < L.effect_list.size(); ++e) {
@@ -289,8 +291,7 @@ void store_solution(const PointModel& pm, const Model& nominal, const Measuremen
   res.calibrated.t_ref_c = L.t_ref;
   res.calibrated.t_mean_s = L.t_mean;
   // a probe row's error is along its constraint, with the campaign's stations (not in the model)
-  const std::vector<double> e =
-      data.has_probe() ? row_errors(solution, data) : point_errors(Model(res.calibrated), res.targets, data);
+  const std::vector<double> e = point_errors(Model(res.calibrated), res.targets, data, res.stations);
   double ss = 0;
   for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
   res.rms_mm = std::sqrt(ss / e.size());

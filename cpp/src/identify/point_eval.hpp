@@ -5,6 +5,7 @@
 #pragma once
 
 #include "kincal/identify/point_model.hpp"
+#include "kincal/identify/stations.hpp"
 
 #include <array>
 #include <memory>
@@ -29,7 +30,10 @@ struct PointStructure {
   /// every station's reference normal (planes: towards the flange; stations.cpp) and two unit
   /// directions normal to it, along which its tilt parameters turn it
   std::vector<Vec3> station_normal, station_u, station_v;
+  /// The reference normals: the layout's when it has them, else from the data (the plane through
+  /// each plane station's nominal ball centres, towards the flange), else z; stored in the layout.
   void init_stations(const MeasurementSet* data);
+  void compute_normals(const MeasurementSet& data);
 };
 
 /// Every setup's instrument placement at the start: the best rigid fit (Horn) of the nominal tool
@@ -76,6 +80,7 @@ class PointEval {
   Vec3 predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const;
   int probe_residuals(const Measurement& m, int size, double* r, double* J) const;
   double artifact_residual(const ArtifactTerm& a, double* J) const;
+  std::vector<StationValue> stations() const;
 
  private:
   std::shared_ptr<const PointStructure> s_;
@@ -109,9 +114,8 @@ class PointEval {
   /// A station at the current parameters: its point c (sphere, pivot) or plane n . y = d with the
   /// normal's derivatives along its two tilt parameters.
   struct StationState {
-    Vec3 c = Vec3::Zero(), n = Vec3::UnitZ();
-    double d = 0;
-    Vec3 dn[2] = {Vec3::Zero(), Vec3::Zero()};
+    StationValue v;
+    Vec3 dn[2] = {Vec3::Zero(), Vec3::Zero()};  ///< a plane's normal per unit of its tilt parameters
   };
   std::vector<StationState> station_;
   void init_stations();

@@ -57,6 +57,7 @@ ParamLayout::ParamLayout(const Model& nominal, const LayoutOptions& o)
   size = effects;
   station_names = o.station_names;
   station_kinds = o.station_kinds;
+  station_normals = o.station_normals;
   if (station_kinds.size() != station_names.size()) throw std::logic_error("ParamLayout: a station without its kind");
   for (const Effect& e : effect_list) {
     check_effect(e, dof, "");
@@ -452,5 +453,6 @@ int PointState::probe_residuals(const Measurement& m, int size, double* r, doubl
   return e_->probe_residuals(m, size, r, J);
 }
 double PointState::artifact_residual(const ArtifactTerm& a, double* J) const { return e_->artifact_residual(a, J); }
+std::vector<StationValue> PointState::stations() const { return e_->stations(); }
 
 }  // namespace kincal

@@ -184,6 +184,11 @@ std::vector<double> orientation_errors(const Model& model, const MeasurementSet&
 }
 
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data) {
+  return point_errors(model, targets, data, {});
+}
+
+std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
+                                 const std::vector<StationValue>& stations) {
   const std::vector<Eigen::Isometry3d> frames = setup_frames(model, data);
   std::vector<double> e;
   e.reserve(data.rows.size());
@@ -191,7 +196,14 @@ std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& ta
   for (const auto& r : data.rows) {
     const Model& m = payload_model(model, r.payload_kg, variants);
     const Vec3 t = r.target < static_cast<int>(targets.size()) ? targets[r.target] : Vec3::Zero();
-    e.push_back((simulate_point(m, r, t, row_frame(frames, data, r)) - r.xyz).norm());
+    const Vec3 y = simulate_point(m, r, t, row_frame(frames, data, r));
+    if (!is_probe(r.kind)) {
+      e.push_back((y - r.xyz).norm());
+      continue;
+    }
+    const StationValue* s = station_of(stations, data, r);
+    double res[3];
+    e.push_back(s ? Eigen::Map<const Eigen::VectorXd>(res, probe_residual(*s, r, y, res)).norm() : std::nan(""));
   }
   return e;
 }

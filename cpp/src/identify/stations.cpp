@@ -3,6 +3,8 @@
 // constraint with its Jacobian, the artifact's known lengths and angles, and the stations' start.
 #include "point_eval.hpp"
 
+#include "kincal/identify/stations.hpp"
+
 #include "kincal/core/rigid.hpp"
 #include "kincal/identify/so3.hpp"
 #include "kincal/kinematics/kinematics.hpp"
@@ -11,6 +13,35 @@
 
 #include <algorithm>
 #include <cmath>
+
+namespace kincal {
+
+int probe_residual(const StationValue& s, const Measurement& m, const Vec3& y, double* r) {
+  switch (m.kind) {
+    case MeasureKind::sphere:
+      for (int k = 0; k < 3; ++k) r[k] = y[k] - s.point[k];
+      return 3;
+    case MeasureKind::plane:
+      r[0] = s.normal.dot(y) - s.offset - m.radius_mm;
+      return 1;
+    case MeasureKind::distance:
+      r[0] = (y - s.point).norm() - m.length_mm;
+      return 1;
+    default:
+      break;
+  }
+  throw std::logic_error("probe_residual: not a probe row");
+}
+
+const StationValue* station_of(const std::vector<StationValue>& values, const MeasurementSet& data,
+                               const Measurement& m) {
+  if (m.station < 0 || m.station >= static_cast<int>(data.station_names.size())) return nullptr;
+  for (const StationValue& v : values)
+    if (v.name == data.station_names[static_cast<size_t>(m.station)] && v.kind == m.kind) return &v;
+  return nullptr;
+}
+
+}  // namespace kincal
 
 namespace kincal::detail {
 
@@ -60,10 +91,21 @@ Eigen::Matrix3Xd station_points(const PointStructure& s, const MeasurementSet& d
 
 void PointStructure::init_stations(const MeasurementSet* data) {
   const size_t n = layout.station_names.size();
-  station_u.assign(n, Vec3::UnitX());
-  station_v.assign(n, Vec3::UnitY());
-  station_normal.assign(n, Vec3::UnitZ());
-  if (!data || n == 0) return;
+  auto directions = [&] {
+    station_normal = layout.station_normals;
+    station_u.clear();
+    station_v.clear();
+    for (const Vec3& nrm : station_normal) station_u.push_back(nrm.unitOrthogonal()), station_v.push_back(nrm.cross(station_u.back()));
+  };
+  if (layout.station_normals.size() == n) return directions();  // given (another fit's layout)
+  layout.station_normals.assign(n, Vec3::UnitZ());
+  if (data && n > 0) compute_normals(*data);
+  directions();
+}
+
+void PointStructure::compute_normals(const MeasurementSet& d) {
+  const MeasurementSet* data = &d;
+  const size_t n = layout.station_names.size();
   const std::vector<Eigen::Isometry3d> place = start_placements(*this, *data);
   for (size_t k = 0; k < n; ++k) {
     if (layout.station_kinds[k] != MeasureKind::plane) continue;
@@ -75,9 +117,7 @@ void PointStructure::init_stations(const MeasurementSet* data) {
     Vec3 nrm = svd.matrixU().col(2);
     // towards the flange: the ball centres lie on the plane's side where the flange is
     if ((flanges.colwise() - y.rowwise().mean()).rowwise().mean().dot(nrm) < 0) nrm = -nrm;
-    station_normal[k] = nrm;
-    station_u[k] = nrm.unitOrthogonal();
-    station_v[k] = nrm.cross(station_u[k]);
+    layout.station_normals[k] = nrm;
   }
 }
 
@@ -87,16 +127,19 @@ void PointEval::init_stations() {
   for (size_t k = 0; k < station_.size(); ++k) {
     StationState& st = station_[k];
     const double* p = &x_[L.stations + 3 * k];
+    st.v.name = L.station_names[k];
+    st.v.kind = L.station_kinds[k];
     if (L.station_kinds[k] != MeasureKind::plane) {
-      st.c = Vec3(p[0], p[1], p[2]);
+      st.v.point = Vec3(p[0], p[1], p[2]);
       continue;
     }
     const Vec3 w = s_->station_normal[k] + p[0] * s_->station_u[k] + p[1] * s_->station_v[k];
     const double nw = w.norm();
-    st.n = w / nw;
-    st.dn[0] = (s_->station_u[k] - st.n * st.n.dot(s_->station_u[k])) / nw;
-    st.dn[1] = (s_->station_v[k] - st.n * st.n.dot(s_->station_v[k])) / nw;
-    st.d = p[2];
+    const Vec3 n = w / nw;
+    st.v.normal = n;
+    st.dn[0] = (s_->station_u[k] - n * n.dot(s_->station_u[k])) / nw;
+    st.dn[1] = (s_->station_v[k] - n * n.dot(s_->station_v[k])) / nw;
+    st.v.offset = p[2];
   }
 }
 
@@ -109,34 +152,31 @@ int PointEval::probe_residuals(const Measurement& m, int size, double* r, double
   const StationState& st = station_[static_cast<size_t>(m.station)];
   const Vec3 y = predict(m, J, nullptr, nullptr);
   std::fill_n(r, size, 0.0);
-  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> JJ(J, J ? size : 0, P);
-  if (J && size > 3) JJ.bottomRows(size - 3).setZero();
+  const int used = probe_residual(st.v, m, y, r);
+  if (!J) return used;
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> JJ(J, size, P);
+  if (size > 3) JJ.bottomRows(size - 3).setZero();
   switch (m.kind) {
     case MeasureKind::sphere:
-      for (int k = 0; k < 3; ++k) r[k] = y[k] - st.c[k];
-      if (J) JJ.block(0, off, 3, 3) -= Mat3::Identity();
-      return 3;
+      JJ.block(0, off, 3, 3) -= Mat3::Identity();
+      return used;
     case MeasureKind::plane:
-      r[0] = st.n.dot(y) - st.d - m.radius_mm;
-      if (J) {
-        JJ.row(0) = st.n.transpose() * JJ.topRows(3);
+      {
+        JJ.row(0) = st.v.normal.transpose() * JJ.topRows(3);
         JJ(0, off) += st.dn[0].dot(y);
         JJ(0, off + 1) += st.dn[1].dot(y);
         JJ(0, off + 2) -= 1.0;
         JJ.middleRows(1, 2).setZero();
       }
-      return 1;
+      return used;
     case MeasureKind::distance: {
-      const Vec3 v = y - st.c;
+      const Vec3 v = y - st.v.point;
       const double len = v.norm();
       const Vec3 e = len > 0 ? Vec3(v / len) : Vec3::UnitX();
-      r[0] = len - m.length_mm;
-      if (J) {
-        JJ.row(0) = e.transpose() * JJ.topRows(3);
-        for (int k = 0; k < 3; ++k) JJ(0, off + k) -= e[k];
-        JJ.middleRows(1, 2).setZero();
-      }
-      return 1;
+      JJ.row(0) = e.transpose() * JJ.topRows(3);
+      for (int k = 0; k < 3; ++k) JJ(0, off + k) -= e[k];
+      JJ.middleRows(1, 2).setZero();
+      return used;
     }
     default:
       break;
@@ -151,25 +191,31 @@ double PointEval::artifact_residual(const ArtifactTerm& a, double* J) const {
   if (J) std::fill_n(J, P, 0.0);
   const bool planes = L.station_kinds[static_cast<size_t>(a.a)] == MeasureKind::plane;
   if (!std::isnan(a.angle_deg)) {  // the unsigned angle between the planes, on a 1 m lever (mm)
-    const double c = sa.n.dot(sb.n), sign = c < 0 ? -1.0 : 1.0;
+    const double c = sa.v.normal.dot(sb.v.normal), sign = c < 0 ? -1.0 : 1.0;
     const double ac = std::min(1.0, std::abs(c)), ang = std::acos(ac);
     if (J) {
       const double d = -kArtifactLever / std::max(std::sqrt(1 - ac * ac), 1e-9) * sign;  // d(angle)/dc
-      for (int k = 0; k < 2; ++k) J[oa + k] = d * sb.n.dot(sa.dn[k]), J[ob + k] = d * sa.n.dot(sb.dn[k]);
+      for (int k = 0; k < 2; ++k) J[oa + k] = d * sb.v.normal.dot(sa.dn[k]), J[ob + k] = d * sa.v.normal.dot(sb.dn[k]);
     }
     return kArtifactLever * (ang - a.angle_deg * kDeg);
   }
   if (planes) {  // the faces n_a y = d_a and (nearly) parallel n_b y = d_b: |d_a - s d_b|, s = sign(n_a n_b)
-    const double s = sa.n.dot(sb.n) < 0 ? -1.0 : 1.0, gap = sa.d - s * sb.d, sg = gap < 0 ? -1.0 : 1.0;
+    const double s = sa.v.normal.dot(sb.v.normal) < 0 ? -1.0 : 1.0, gap = sa.v.offset - s * sb.v.offset, sg = gap < 0 ? -1.0 : 1.0;
     if (J) J[oa + 2] = sg, J[ob + 2] = -s * sg;
     return std::abs(gap) - a.distance_mm;
   }
-  const Vec3 v = sa.c - sb.c;
+  const Vec3 v = sa.v.point - sb.v.point;
   const double len = v.norm();
   const Vec3 e = len > 0 ? Vec3(v / len) : Vec3::UnitX();
   if (J)
     for (int k = 0; k < 3; ++k) J[oa + k] = e[k], J[ob + k] = -e[k];
   return len - a.distance_mm;
+}
+
+std::vector<StationValue> PointEval::stations() const {
+  std::vector<StationValue> out;
+  for (const StationState& st : station_) out.push_back(st.v);
+  return out;
 }
 
 void start_stations(const PointStructure& s, const MeasurementSet& data, const std::vector<Eigen::Isometry3d>& place,

@@ -111,7 +111,8 @@ def evaluate(res: _core.IdentifyResult, data: dict[str, Any], extra: Sequence[_c
     parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
     parameter index of each of them that is the fit's, by index)."""
     layout = res.layout
-    pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True)
+    pm = _core.PointModel(res.robot, len(res.targets), list(layout.effect_list) + list(extra), res.t_ref, True,
+                          stations_of=layout)
     new = pm.layout.parameters
     old = {_key(p): p.index for p in layout.parameters}
     # the fit's parameters by name, not by place: the calibrated model may carry one the fit's did not

@@ -139,8 +139,9 @@ def orientation_errors_deg(robot: Robot, data: dict[str, Any]) -> FloatArray:
 
 
 def point_errors(res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
-    """3-D distance (mm) between each measured point and the fitted model's prediction."""
-    return np.asarray(_core.point_errors(res.robot, res.targets, data))
+    """3-D distance (mm) between each measured point and the fitted model's prediction (a probe row's
+    error along its constraint, against the fit's station)."""
+    return np.asarray(_core.point_errors(res.robot, res.targets, data, res.stations))
 
 
 def masses(robot: Robot) -> bool:

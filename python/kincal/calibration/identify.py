@@ -100,9 +100,11 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     return out
 
 
-def read_measurements(path: str, robot: Robot) -> dict[str, Any]:
-    """The measurement CSV of the contract (errors name file:line and cause)."""
-    return _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
+def read_measurements(path: str, robot: Robot, artifact: str | None = None) -> dict[str, Any]:
+    """The measurement CSV of the contract (errors name file:line and cause), with the known distances
+    and angles between its probe stations from an artifact file."""
+    data = _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
+    return _core.read_artifact(str(artifact), data, robot.dof) if artifact else data
 
 
 def measurements_csv(data: dict[str, Any], dof: int) -> str:
@@ -263,8 +265,8 @@ def check_effects(effects: Union[str, Iterable[Union[str, Candidate]]], robot: R
 def _errors(r: _core.IdentifyResult, h: dict[str, Any]) -> dict[str, FloatArray]:
     """Position (and, with measured orientations, orientation) errors of the rows h: before (the
     nominal geometry, frames fitted) and after (the identified model r)."""
-    out = {"ea": _core.point_errors(r.robot, r.targets, h), "eb": _core.point_errors(r.nominal_fitted,
-                                                                                     r.nominal_targets, h)}
+    out = {"ea": _core.point_errors(r.robot, r.targets, h, r.stations),
+           "eb": _core.point_errors(r.nominal_fitted, r.nominal_targets, h, r.nominal_stations)}
     if "abc" in h:  # the 6-D rows only (a mixed file's reflector rows have none)
         oa = orientation_errors_deg(r.robot, h)
         if len(oa):

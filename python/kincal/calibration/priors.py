@@ -133,7 +133,7 @@ class Fitter:
             try:
                 for held in masks:
                     r = self._once(_subset(data, ~held), o)
-                    e = np.asarray(_core.point_errors(r.robot, r.targets, _subset(data, held)))
+                    e = np.asarray(_core.point_errors(r.robot, r.targets, _subset(data, held), r.stations))
                     ss, n = ss + float(np.sum(e ** 2)), n + len(e)
             except ValueError:  # a fold these priors cannot fit (too narrow data for a wide prior)
                 continue
@@ -162,7 +162,7 @@ def down_weighted(fit: _core.IdentifyResult, data: dict[str, Any], n: int = 5) -
     scale = fit.loss_scale_mm
     if not scale or not len(data["pose"]):
         return []
-    e = np.asarray(_core.point_errors(fit.robot, fit.targets, data))
+    e = np.asarray(_core.point_errors(fit.robot, fit.targets, data, fit.stations))
     w = np.minimum(1.0, scale / np.maximum(e, 1e-12))
     order = [i for i in np.argsort(w) if w[i] < 1.0][:n]
     return [(int(data["pose"][i]), int(data["target"][i]), float(e[i]), float(w[i])) for i in order]

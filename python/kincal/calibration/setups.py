@@ -163,8 +163,8 @@ def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", l
         return _core.identify(robot, data, opts, None, calibrated)
 
     cal, nom = frames_only(True), frames_only(False)
-    ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data))
-    eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data))
+    ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data, cal.stations))
+    eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data, nom.stations))
     oa = ob = None
     if "abc" in data:
         oa, ob = orientation_errors_deg(cal.robot, data), orientation_errors_deg(nom.robot, data)

@@ -60,6 +60,30 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
                           0.0 if duration_h is None else 3600.0 * float(duration_h))
 
 
+def simulate_probe(truth: Robot, kind: str, *, stations: int = 3, touches: int = 25, cone_deg: float = 35.0,
+                   probe: Sequence[float] = (0.0, 0.0, 150.0), radius_mm: float = 3.0, length_mm: float = 150.0,
+                   block_mm: float = 400.0, noise_mm: float = 0.005, seed: int = 1,
+                   artifact: bool = True) -> dict[str, Any]:
+    """A probe campaign (no tracker) on the truth's calibrated model: ``kind`` 'sphere' (the ball in
+    ``stations`` fixed nests placed in reach), 'plane' (the faces of one block of ``block_mm``: top,
+    the face towards the robot, the sideways ones, the far one) or 'distance' (a ballbar of
+    ``length_mm`` at ``stations`` pivots); ``touches`` rows per station, the probe's axis within
+    ``cone_deg`` of its station's mean direction, the ball centre at ``probe`` in the tool frame,
+    ``noise_mm`` along each constraint. With ``artifact`` the data carry the known distances (from
+    the first station) or the block's angles and edge under 'artifact'."""
+    if stations < 1 or touches < 1:
+        raise ValueError(f"--stations and --touches must be positive, not {stations} and {touches}")
+    if noise_mm < 0 or not math.isfinite(noise_mm):
+        raise ValueError(f"the noise must be a finite non-negative number, not {noise_mm}")
+    o = _core.ProbeSimulationOptions()
+    o.kind = kind
+    o.stations, o.touches, o.cone_deg = int(stations), int(touches), float(cone_deg)
+    o.probe = np.asarray(probe, dtype=float)
+    o.radius_mm, o.length_mm, o.block_mm, o.noise_mm = float(radius_mm), float(length_mm), float(block_mm), float(noise_mm)
+    o.seed, o.artifact = int(seed), bool(artifact)
+    return _core.simulate_probe(truth, o)
+
+
 def _effect_value(e: HiddenEffect) -> tuple[_core.Effect, list[float]]:
     """(Effect, values) from (Effect, values) or (name, joint from 1 or 0, values)."""
     if len(e) == 2 and isinstance(e[0], _core.Effect):

@@ -15,8 +15,28 @@ from ..calibration import identify as ident
 from ..io import strict_json
 from ..io.urdf import spec_urdf, urdf_left_out
 from .. import report
-from .options import (effect_opts, effects_arg, fit_options, fit_opts, harmonics_option, loss_opts, progress,
+from ..calibration import simulation as sim
+from .options import (artifact_opt, effect_opts, effects_arg, fit_options, fit_opts, harmonics_option, loss_opts, progress,
                       robot_of, robot_opts, say, step_progress, tool_targets)
+
+
+def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.Robot) -> None:
+    """simulate --kind: a probe campaign and its artifact file."""
+    probe = [float(v) for v in args.probe.split(",")]
+    if len(probe) != 3:
+        raise ValueError(f"--probe {args.probe}: expected X,Y,Z (mm, the ball centre in the tool frame)")
+    data = sim.simulate_probe(truth, args.kind, stations=args.stations, touches=args.touches, cone_deg=args.cone,
+                              probe=probe, radius_mm=args.radius, length_mm=args.length, block_mm=args.block,
+                              noise_mm=0.005 if args.noise is None else args.noise, seed=args.seed)
+    data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
+    art = args.artifact_out or str(Path(args.out).with_name(Path(args.out).stem + "-artifact.csv"))
+    text = ident.measurements_csv(data, robot.dof)
+    artifact = _core.format_artifact(data, robot.dof) if "artifact" in data else None
+    _core.write_file_atomic(args.out, text)
+    if artifact:
+        _core.write_file_atomic(art, artifact)
+    print(f"wrote {len(data['pose'])} {args.kind} rows at {len(data['station_names'])} stations to {args.out}"
+          + (f", their known distances and angles to {art}" if artifact else ""), file=sys.stderr)
 
 
 def cmd_simulate(args: argparse.Namespace) -> None:
@@ -27,6 +47,15 @@ def cmd_simulate(args: argparse.Namespace) -> None:
             raise ValueError(f"{args.truth}: {truth.dof} joints but {args.robot} has {robot.dof}")
     else:
         truth = ident.default_truth(robot, seed=args.seed)
+    if args.truth_out and not args.truth and args.kind:
+        _core.write_file_atomic(args.truth_out, truth.to_json())
+    if args.kind:
+        _simulate_probe(args, robot, truth)
+        return
+    if args.poses is None:
+        raise ValueError("--poses: the number of configurations to measure (or --kind for a probe campaign)")
+    if args.noise is None:
+        args.noise = 0.02
     pool = args.poses * (10 if args.select == "observability" else 1)
     hidden = [ident.parse_hidden_effect(h, robot.dof, args.harmonics) for h in args.hide]
     data = ident.simulate(truth, pool, seed=args.seed, noise_mm=args.noise, targets=args.targets,
@@ -46,7 +75,7 @@ def cmd_simulate(args: argparse.Namespace) -> None:
 
 def cmd_identify(args: argparse.Namespace) -> None:
     robot = robot_of(args)
-    data = ident.read_measurements(args.data, robot)
+    data = ident.read_measurements(args.data, robot, args.artifact)
     effects = effects_arg(args, robot, data)
     if args.holdout is not None and args.folds is not None:
         raise ValueError("--holdout and --folds: give one (a split, or cross-validation)")
@@ -75,7 +104,7 @@ def cmd_identify(args: argparse.Namespace) -> None:
 
 def cmd_validate(args: argparse.Namespace) -> None:
     robot = load_robot(args.model)
-    data = ident.read_measurements(args.data, robot)
+    data = ident.read_measurements(args.data, robot, args.artifact)
     v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
     v["model"] = str(args.model)
     _core.write_file_atomic(args.out, strict_json.dumps(v, indent=1, sort_keys=True) + "\n")
@@ -95,7 +124,7 @@ def cmd_diagnose(args: argparse.Namespace) -> None:
         _diagnose_fivebar(args)
         return
     robot = robot_of(args)
-    data = ident.read_measurements(args.data, robot)
+    data = ident.read_measurements(args.data, robot, args.artifact)
     start = effects_arg(args, robot, data)
     if start == "auto":
         raise ValueError("--effects auto: the diagnosis chooses its effects itself; --effects gives the model it "
@@ -116,10 +145,11 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     sp.add_argument("--truth", help="model JSON of the true robot (default: realistic errors drawn with --seed: "
                                     "1 mm, 0.05 deg, joint compliance about 0.003 deg/kNm)")
     sp.add_argument("--truth-out", help="write the drawn true model here (when --truth is not given)")
-    sp.add_argument("--poses", type=int, required=True, help="number of robot configurations")
+    sp.add_argument("--poses", type=int, help="number of robot configurations (a tracker campaign)")
     sp.add_argument("--out", required=True, help="measurement CSV")
     sp.add_argument("--targets", type=int, default=3, help="reflectors on the tool (1..4)")
-    sp.add_argument("--noise", type=float, default=0.02, help="instrument noise per coordinate (mm)")
+    sp.add_argument("--noise", type=float, default=None,
+                    help="instrument noise per coordinate (mm; default 0.02), or along a probe's constraint (0.005)")
     sp.add_argument("--outliers", type=float, default=0.0, help="share of points with a gross error")
     sp.add_argument("--outlier-mm", type=float, default=5.0, help="size of a gross error (mm)")
     sp.add_argument("--orientation-noise", type=float, default=None, metavar="DEG",
@@ -136,6 +166,19 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
                     help="a time_s column: the campaign runs from 0 to HOURS in pose order")
     harmonics_option(sp, "a hidden transmission_error")
     sp.add_argument("--seed", type=int, default=1)
+    probe = sp.add_argument_group("a probe campaign (no tracker)")
+    probe.add_argument("--kind", choices=["sphere", "plane", "distance"],
+                       help="spheres in fixed nests, the faces of a block, or a ballbar at pivots")
+    probe.add_argument("--stations", type=int, default=3, help="spheres or pivots; planes: faces of the block (<= 5)")
+    probe.add_argument("--touches", type=int, default=25, help="rows per station")
+    probe.add_argument("--cone", type=float, default=35.0, metavar="DEG",
+                       help="the probe's axis within this angle of its station's mean direction")
+    probe.add_argument("--probe", default="0,0,150", metavar="X,Y,Z", help="the ball centre in the tool frame (mm)")
+    probe.add_argument("--radius", type=float, default=3.0, help="the ball's radius (mm; planes)")
+    probe.add_argument("--length", type=float, default=150.0, help="the ballbar's length (mm)")
+    probe.add_argument("--block", type=float, default=400.0, help="the block's edge (mm; planes)")
+    probe.add_argument("--artifact-out", metavar="A.csv",
+                       help="the known distances and angles between the stations (default: OUT's name + -artifact.csv)")
     sp.set_defaults(func=cmd_simulate)
 
     sp = sub.add_parser("identify", help="parameter identification from measurements")
@@ -157,6 +200,7 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
                     "placement) whole, its placement and targets refitted, instead of folds")
     sp.add_argument("--seed", type=int, default=0, help="seed of the validation split")
     sp.add_argument("--urdf", help="also write the calibrated geometry as a URDF")
+    artifact_opt(sp)
     sp.set_defaults(func=cmd_identify)
 
     sp = sub.add_parser("validate", help="check a calibration on new measurements (placements and targets refitted)")
@@ -165,6 +209,7 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
                                                   "placement per setup)")
     sp.add_argument("--out", required=True, help="V.json: points, rms_mm, mean_mm, max_mm, before_rms_mm, ...")
     loss_opts(sp)
+    artifact_opt(sp)
     sp.set_defaults(func=cmd_validate)
 
 
@@ -181,4 +226,5 @@ def add_diagnose(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known")
     effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")
     fit_opts(sp)
+    artifact_opt(sp)
     sp.set_defaults(func=cmd_diagnose)

@@ -70,6 +70,13 @@ def loss_opts(sp: argparse.ArgumentParser, scale: Optional[float] = 0.1) -> None
                     + (f"{scale})" if scale else "from the residuals' robust spread)"))
 
 
+def artifact_opt(sp: argparse.ArgumentParser) -> None:
+    """--artifact: the known geometry between a probe campaign's stations."""
+    sp.add_argument("--artifact", metavar="A.csv",
+                    help="known distances and angles between the data's probe stations (columns a, b, distance_mm, "
+                         "angle_deg; one of the last two per row): a length bar, a ball plate, a datum cube")
+
+
 def fit_opts(sp: argparse.ArgumentParser) -> None:
     """The fitting options of identify and diagnose: one group, one default each (kincal.calibration.fitting)."""
     loss_opts(sp, DEFAULT_LOSS_SCALE_MM)

@@ -65,6 +65,7 @@ struct IdentifyResult {
   double nominal_rms_mm = 0, nominal_max_mm = 0;  ///< on the fitted rows, nominal geometry
   ModelSpec nominal_fitted;               ///< nominal geometry, fitted base frame
   std::vector<Vec3> nominal_targets;      ///< targets fitted with the nominal geometry
+  std::vector<StationValue> nominal_stations;  ///< the probe stations fitted with the nominal geometry
   std::vector<bool> fixed;                ///< held at its start value
   /// free, but determined by its prior rather than by the data (these poses leave it redundant or
   /// barely seen where a generic campaign would determine it)
@@ -75,6 +76,7 @@ struct IdentifyResult {
   std::vector<std::string> fixed_reason;  ///< why it is held ("" when free)
   ModelSpec calibrated;
   std::vector<Vec3> targets;
+  std::vector<StationValue> stations;     ///< the probe stations (the campaign's, not the robot's)
   std::vector<EffectValue> effects;       ///< identified values of the extra effects
   double t_ref = 20.0;                    ///< reference temperature of thermal_expansion
   double t_mean_s = 0;                    ///< reference time of the drift (the data's mean time)

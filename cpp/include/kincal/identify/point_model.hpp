@@ -55,6 +55,7 @@
 #pragma once
 
 #include "kincal/identify/fit_modes.hpp"
+#include "kincal/identify/stations.hpp"
 #include "kincal/io/measurements.hpp"
 #include "kincal/model/model.hpp"
 
@@ -92,6 +93,8 @@ struct LayoutOptions {
   bool fit_gravity = false;             ///< the moments of every link from the first loaded joint's on are parameters
   std::vector<std::string> station_names;  ///< the data's probe stations by code (none without probe rows)
   std::vector<MeasureKind> station_kinds;  ///< and their kinds
+  /// the planes' reference normals by station (empty: from the data the PointModel is given, else z)
+  std::vector<Vec3> station_normals;
 };
 
 /// Layout of the identification parameter vector for a model and its options.
@@ -109,6 +112,7 @@ struct ParamLayout {
   std::vector<std::string> setup_names;  ///< by setup code (empty: one setup, no setup column)
   std::vector<std::string> station_names;  ///< by station code; 3 parameters each from `stations` on
   std::vector<MeasureKind> station_kinds;
+  std::vector<Vec3> station_normals;  ///< every station's reference normal (a plane's tilts turn it)
   std::vector<std::string> names;     ///< one per parameter, e.g. "joint3.tilt_u", "base.ry", "base[B].ry"
   std::vector<std::string> units;     ///< "rad", "mm", "deg/kNm", "t m"
   ParamLayout(const Model& nominal, const LayoutOptions& options);
@@ -172,6 +176,8 @@ class PointState {
   /// An artifact term's residual (mm: a length error; an angle error in rad times a 1 m lever) and,
   /// when J is not null, its gradient (layout().size).
   double artifact_residual(const ArtifactTerm& a, double* J) const;
+  /// The probe stations at these parameters (layout order).
+  std::vector<StationValue> stations() const;
 
  private:
   friend class PointModel;

@@ -3,6 +3,7 @@
 // of the truth acts in one place, simulate_point().
 #pragma once
 
+#include "kincal/identify/stations.hpp"
 #include "kincal/io/measurements.hpp"
 #include "kincal/model/model.hpp"
 
@@ -84,6 +85,10 @@ ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& e
 /// each row seen from its setup's placement, the model's drift at the row's time) with the given
 /// targets.
 std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data);
+/// The same with probe rows: their error along the constraint against their station among `stations`
+/// (stations.hpp; NaN for a station not among them).
+std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
+                                 const std::vector<StationValue>& stations);
 /// Orientation errors (deg) of every 6-D row of a set, in order (rows without a measured orientation
 /// are left out): the angle between the measured tool frame and the model's (every effect acting,
 /// seen from the row's placement at its time).

@@ -21,6 +21,7 @@ void define_io(py::module_& m);
 void define_controllers(py::module_& m);
 void define_feed(py::module_& m);
 void define_measurements(py::module_& m);
+void define_measurement_model(py::module_& m);
 void define_identify(py::module_& m);
 void define_fivebar(py::module_& m);
 

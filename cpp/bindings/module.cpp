@@ -13,6 +13,7 @@ PYBIND11_MODULE(_core, m) {
   define_controllers(m);
   define_feed(m);
   define_measurements(m);
+  define_measurement_model(m);  // before identify: its records appear in identify's signatures
   define_identify(m);
   define_fivebar(m);
 }

@@ -248,3 +248,50 @@ TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
   EXPECT_GT(b.nominal, 1.0);
   EXPECT_LT(b.identified, 0.05);  // measured 0.011 mm
 }
+
+// Without a known length the overall scale is not seen: the result says so, and the ball centres the
+// fit predicts on 200 random configurations equal those of the fit with the length after the best
+// similarity transform (rotation, translation and scale: Umeyama) to 0.01 mm. Truth, campaign: the
+// spheres above (6 x 25 touches, 60 deg cone, 0.005 mm noise). A tracker campaign sees the scale.
+TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
+  KINCAL_SEED_TRACE(51, 52, 53);
+  const Model truth(truth_spec(51, 0.003)), nominal(kr500_spec());
+  ProbeSimulationOptions so;
+  so.stations = 6;
+  so.touches = 25;
+  so.cone_deg = 60;
+  so.probe = Vec3(0, 0, 150);
+  so.seed = test::test_seed(52);
+  const MeasurementSet with = simulate_probe(truth, so);
+  MeasurementSet without = with;
+  without.artifact.clear();
+  IdentifyOptions opt;
+  opt.covariance = false;
+  const IdentifyResult a = identify(nominal, with, opt), b = identify(nominal, without, opt);
+  EXPECT_TRUE(a.scale_determined);
+  EXPECT_FALSE(b.scale_determined);
+  const Model ma(a.calibrated), mb(b.calibrated);
+  std::mt19937_64 rng(test::test_seed(53));
+  std::uniform_real_distribution<double> ud(-0.4, 0.4);
+  const int n = 200;
+  Eigen::Matrix3Xd pa(3, n), pb(3, n);
+  for (int k = 0; k < n; ++k) {
+    VecQ q(6);
+    for (int j = 0; j < 6; ++j) {
+      const JointSpec& js = nominal.spec().joints[j];
+      q[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg);
+    }
+    pa.col(k) = ball(ma, q, a.targets[0]);
+    pb.col(k) = ball(mb, q, b.targets[0]);
+  }
+  const Eigen::Matrix4d sim = Eigen::umeyama(pb, pa, true);
+  const Eigen::Matrix3Xd moved = (sim.topLeftCorner<3, 3>() * pb).colwise() + sim.topRightCorner<3, 1>();
+  const double rms = std::sqrt((moved - pa).colwise().squaredNorm().mean());
+  std::printf("without the length: scale %.6f, ball centres after the similarity %.5f mm\n",
+              sim.topLeftCorner<3, 3>().determinant() > 0 ? std::cbrt(sim.topLeftCorner<3, 3>().determinant()) : 0.0, rms);
+  EXPECT_LT(rms, 0.01);
+  SimulationOptions tracker;
+  tracker.poses = 40;
+  tracker.seed = test::test_seed(54);
+  EXPECT_TRUE(identify(nominal, simulate(truth, tracker), opt).scale_determined);
+}

@@ -2,6 +2,8 @@
 // condition number and observability index of the free ones after it.
 #include "kincal/identify/identifiability.hpp"
 
+#include "linearization.hpp"
+
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -16,7 +18,7 @@
 
 namespace kincal {
 
-namespace {
+namespace detail {
 
 /// J^T J with only its lower triangle filled (half the work of the product; what a self-adjoint
 /// solver reads).
@@ -25,6 +27,37 @@ Eigen::MatrixXd normal_matrix_lower(const Eigen::MatrixXd& j) {
   n.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose());
   return n;
 }
+
+/// The Jacobian of every parameter and the residuals of data at x.
+Linearization linearize(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x, double weight) {
+  const PointState at_x = pm.at(x);
+  const int P = pm.layout().size;
+  const size_t n = residual_size(residual_kind(data)) * data.rows.size();
+  std::vector<int> every(P);
+  std::iota(every.begin(), every.end(), 0);
+  RowMatrix J(n, P);
+  Linearization lin;
+  lin.residuals.assign(n, 0.0);
+  all_residuals(at_x, data, weight, every, lin.residuals.data(), J.data());
+  lin.jacobian = J;
+  // the artifact's known lengths and angles follow the rows, one residual each
+  const Eigen::Index rows = static_cast<Eigen::Index>(n);
+  lin.jacobian.conservativeResize(rows + static_cast<Eigen::Index>(data.artifact.size()), P);
+  std::vector<double> grad(static_cast<size_t>(P));
+  for (size_t k = 0; k < data.artifact.size(); ++k) {
+    lin.residuals.push_back(at_x.artifact_residual(data.artifact[k], grad.data()));
+    for (int c = 0; c < P; ++c) lin.jacobian(rows + static_cast<Eigen::Index>(k), c) = grad[static_cast<size_t>(c)];
+  }
+  return lin;
+}
+
+}  // namespace detail
+
+using detail::linearize;
+using detail::normal_matrix_lower;
+
+namespace {
+
 
 /// Which targets the data measure (by target index).
 std::vector<bool> measured_targets(const MeasurementSet& data) {
@@ -187,28 +220,6 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
   return generic;
 }
 
-/// The Jacobian of every parameter and the residuals of data at x.
-Linearization linearize(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x, double weight) {
-  const PointState at_x = pm.at(x);
-  const int P = pm.layout().size;
-  const size_t n = residual_size(residual_kind(data)) * data.rows.size();
-  std::vector<int> every(P);
-  std::iota(every.begin(), every.end(), 0);
-  RowMatrix J(n, P);
-  Linearization lin;
-  lin.residuals.assign(n, 0.0);
-  all_residuals(at_x, data, weight, every, lin.residuals.data(), J.data());
-  lin.jacobian = J;
-  // the artifact's known lengths and angles follow the rows, one residual each
-  const Eigen::Index rows = static_cast<Eigen::Index>(n);
-  lin.jacobian.conservativeResize(rows + static_cast<Eigen::Index>(data.artifact.size()), P);
-  std::vector<double> grad(static_cast<size_t>(P));
-  for (size_t k = 0; k < data.artifact.size(); ++k) {
-    lin.residuals.push_back(at_x.artifact_residual(data.artifact[k], grad.data()));
-    for (int c = 0; c < P; ++c) lin.jacobian(rows + static_cast<Eigen::Index>(k), c) = grad[static_cast<size_t>(c)];
-  }
-  return lin;
-}
 
 /// With priors: what a generic campaign leaves redundant is held as without them; of the rest,
 /// what these data leave redundant or barely seen (the greedy selection on the data, parameters
@@ -458,10 +469,19 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
   lin = start_at(pm, data, opt, res, xp, x, lin);
   std::string missing;
   int n_missing = 0;
+  // a probe campaign without a known length leaves the scale to one held parameter (its generic
+  // campaign, rows scattered away from their stations, sees it): that one is no error
+  bool scale_free = data.has_probe() && !scale_seen(pm, lin.jacobian, x);
   // only what the data make exactly redundant counts (near the weak threshold the two may differ)
   for (int i = 0; i < L.size; ++i)
-    if (res.fixed[i] && !generic.fixed[i] && res.fixed_reason[i].rfind("not identifiable", 0) == 0)
+    if (res.fixed[i] && !generic.fixed[i] && res.fixed_reason[i].rfind("not identifiable", 0) == 0) {
+      if (scale_free) {
+        res.fixed_reason[i] = "held for the overall scale: no known length in these probe data (--artifact)";
+        scale_free = false;
+        continue;
+      }
       missing += (n_missing++ ? ", " : "") + L.names[i];
+    }
   if (n_missing)
     throw InputError(data.source + ": the " + std::to_string(data.rows.size()) + " measured points of " +
                      std::to_string(count_poses(data)) + " poses cannot determine " + missing +
@@ -469,23 +489,5 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
   return lin;
 }
 
-void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
-  const Eigen::MatrixXd J = linearize(pm, data, res.x, opt.orientation_weight).jacobian;
-  std::vector<int> free_idx;
-  for (int i = 0; i < res.layout.size; ++i)  // what the data determine (not the priors)
-    if (!res.fixed[i] && !(i < static_cast<int>(res.at_prior.size()) && res.at_prior[i])) free_idx.push_back(i);
-  Eigen::MatrixXd Jf(J.rows(), free_idx.size());
-  for (size_t k = 0; k < free_idx.size(); ++k) {
-    const double nrm = J.col(free_idx[k]).norm();
-    Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
-  }
-  // singular values from the eigenvalues of the (small) normal matrix
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal_matrix_lower(Jf), Eigen::EigenvaluesOnly);
-  const Eigen::VectorXd s = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
-  res.condition_number = s.maxCoeff() / s.minCoeff();
-  double logsum = 0;
-  for (int k = 0; k < s.size(); ++k) logsum += std::log(s(k));
-  res.observability_index = std::exp(logsum / s.size()) / std::sqrt(static_cast<double>(data.rows.size()));
-}
 
 }  // namespace kincal

@@ -222,6 +222,9 @@ class Identification:
                          ", ".join(f"joint {j} {ranges[j - 1][0]:.0f}..{ranges[j - 1][1]:.0f} deg" for j in periodic))
         lines.append(f"condition number {f.condition_number:.4g}, observability index {f.observability_index:.4g}"
                      " (what the data determine)")
+        if not f.scale_determined:
+            lines.append("scale: not determined by these data (spheres and planes see no length), held at its prior; "
+                         "add a known length with --artifact (a length bar, a ball plate, a block's edge)")
         lines += tcp_summary_line(self.robot)
         if self.fit_info:
             lines += priors.summary_lines(f, self.fit_info, self.worst)

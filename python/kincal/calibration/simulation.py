@@ -4,7 +4,7 @@ its measurements by a simulated laser tracker, and the effects hidden in it (`--
 from __future__ import annotations
 
 import math
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Literal, Optional, Sequence, Union
 
 import numpy as np
 
@@ -60,7 +60,7 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
                           0.0 if duration_h is None else 3600.0 * float(duration_h))
 
 
-def simulate_probe(truth: Robot, kind: str, *, stations: int = 3, touches: int = 25, cone_deg: float = 35.0,
+def simulate_probe(truth: Robot, kind: Literal["sphere", "plane", "distance"], *, stations: int = 3, touches: int = 25, cone_deg: float = 35.0,
                    probe: Sequence[float] = (0.0, 0.0, 150.0), radius_mm: float = 3.0, length_mm: float = 150.0,
                    block_mm: float = 400.0, noise_mm: float = 0.005, seed: int = 1,
                    artifact: bool = True) -> dict[str, Any]:

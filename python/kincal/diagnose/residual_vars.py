@@ -77,13 +77,16 @@ def carriers(res: _core.IdentifyResult, data: dict[str, Any]) -> tuple[FloatArra
 
     dof = res.robot.dof
     extra = [_core.Effect("joint_map", j, order=1) for j in range(1, dof + 1)]
-    r, _, J, new, _ = evaluate(res, data, extra)
+    r, _, J, new, fit_of = evaluate(res, data, extra)
     base = [p.index for p in new if p.kind == "base"]
     n = len(data["pose"])
     dims = len(r) // n
     q = np.radians(np.asarray(data["q_deg"], dtype=float))
     s, c = np.repeat(np.sin(q), dims, axis=0), np.repeat(np.cos(q), dims, axis=0)
-    tail = J[:, J.shape[1] - 2 * dof:]
+    # the appended maps' (sine, cosine) columns, joint by joint (not the fit's own, nor a probe
+    # campaign's stations after them)
+    added = [p.index for p in new if p.kind == "joint_map" and p.index not in fit_of]
+    tail = J[:, added]
     joints = tail[:, 0::2] * s + tail[:, 1::2] * c  # J_j = sin q_j d/d(s_1) + cos q_j d/d(c_1)
     return r, np.c_[J[:, base], joints]
 

@@ -53,6 +53,11 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
 
 /// The condition number and the observability index of the free parameters (the unit-scaled
 /// Jacobian at res.x), into res.
+/// Whether the rows (their Jacobian J at x, the artifact's terms included) see a uniform scaling of
+/// every length: what is left of it in the rows against what its parts alone would show (a probe
+/// campaign without a known length leaves almost nothing: only the gravity torques' centres of
+/// mass, given in mm, see it at all).
+bool scale_seen(const PointModel& pm, const Eigen::MatrixXd& J, const std::vector<double>& x);
 void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res);
 
 }  // namespace kincal

@@ -84,6 +84,9 @@ struct IdentifyResult {
   double initial_cost = 0, final_cost = 0;
   double rms_mm = 0, max_mm = 0;          ///< on the fitted rows
   double condition_number = 0, observability_index = 0;
+  /// whether the data see the overall scale of the arm (not without a known length in a probe
+  /// campaign: then the priors, or a held parameter, fix it)
+  bool scale_determined = true;
   struct Correlation {
     std::string a, b;
     double r;

@@ -1,0 +1,124 @@
+// kincal: Python bindings of the identification's measurement model (PointModel: its residuals and
+// Jacobian for a parameter vector), the probe stations a fit identifies and the probe campaigns'
+// simulation (measurements without a tracker).
+#include "common.hpp"
+
+#include <numeric>
+#include <optional>
+
+#include "kincal/identify/point_model.hpp"
+#include "kincal/identify/simulate.hpp"
+#include "kincal/identify/stations.hpp"
+
+using namespace kincal;
+
+namespace {
+
+/// The setup names of a PointModel: those given, else the model's own setups (a calibrated model
+/// identified on several setups predicts them with their frames).
+std::vector<std::string> setup_names_or_model(const std::optional<std::vector<std::string>>& given, const Model& m) {
+  if (given) return *given;
+  std::vector<std::string> names;
+  for (const SetupFrame& f : m.spec().setups) names.push_back(f.name);
+  return names;
+}
+
+}  // namespace
+
+void define_measurement_model(py::module_& m) {
+  py::class_<StationValue>(m, "StationValue", "A probe station as identified (instrument frame of its rows' setup)")
+      .def_readonly("name", &StationValue::name)
+      .def_property_readonly("kind", [](const StationValue& v) { return to_string(v.kind); },
+                             "'sphere', 'plane' or 'distance' (a ballbar's pivot)")
+      .def_readonly("point", &StationValue::point, "a sphere's centre or a pivot (mm)")
+      .def_readonly("normal", &StationValue::normal, "a plane's unit normal, towards the flange")
+      .def_readonly("offset", &StationValue::offset, "a plane's offset: normal . y = offset (mm)")
+      .def("__repr__", [](const StationValue& v) { return "<StationValue " + v.name + " " + to_string(v.kind) + ">"; });
+  py::class_<ProbeSimulationOptions>(m, "ProbeSimulationOptions", "A probe campaign to simulate (simulate_probe)")
+      .def(py::init<>())
+      .def_property(
+          "kind", [](const ProbeSimulationOptions& o) { return to_string(o.kind); },
+          [](ProbeSimulationOptions& o, const std::string& k) {
+            for (MeasureKind c : {MeasureKind::sphere, MeasureKind::plane, MeasureKind::distance})
+              if (k == to_string(c)) return void(o.kind = c);
+            throw InputError("simulate: --kind " + k + ": expected sphere, plane or distance");
+          },
+          "'sphere', 'plane' or 'distance'")
+      .def_readwrite("stations", &ProbeSimulationOptions::stations,
+                     "spheres or pivots placed in reach; planes: faces of one block (at most 5)")
+      .def_readwrite("touches", &ProbeSimulationOptions::touches, "rows per station")
+      .def_readwrite("cone_deg", &ProbeSimulationOptions::cone_deg, "the probe's axis within this angle of its mean")
+      .def_readwrite("probe", &ProbeSimulationOptions::probe, "the ball centre in the tool frame (mm)")
+      .def_readwrite("radius_mm", &ProbeSimulationOptions::radius_mm, "plane: the ball's radius")
+      .def_readwrite("length_mm", &ProbeSimulationOptions::length_mm, "distance: the ballbar's length")
+      .def_readwrite("block_mm", &ProbeSimulationOptions::block_mm, "plane: the block's edge")
+      .def_readwrite("noise_mm", &ProbeSimulationOptions::noise_mm, "along the constraint (mm)")
+      .def_readwrite("limit_margin", &ProbeSimulationOptions::limit_margin)
+      .def_readwrite("seed", &ProbeSimulationOptions::seed)
+      .def_readwrite("artifact", &ProbeSimulationOptions::artifact, "write the known distances and angles");
+  m.def(
+      "simulate_probe",
+      [](const Robot& truth, const ProbeSimulationOptions& o) {
+        return measurements_to_dict(simulate_probe(*truth.calibrated, o), truth.calibrated->dof());
+      },
+      py::arg("truth"), py::arg("options"),
+      "A probe campaign on the calibrated (true) model of a robot: every row's ball centre on its\n"
+      "constraint, the noise along it; the artifact's terms under 'artifact'");
+  // Python's PointModel: the robot's model (kept alive), the layout's options and the measurement
+  // model built from them; residuals() builds one for the data's payloads
+  struct PyPointModel {
+    std::shared_ptr<const Model> model;
+    LayoutOptions options;
+    PointModel pm;
+  };
+  py::class_<PyPointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
+      .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
+                       bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
+                       std::optional<double> t_mean_s, bool fit_gravity, const ParamLayout* stations_of) {
+             std::shared_ptr<const Model> m = from_calibrated ? r.calibrated : r.nominal;
+             LayoutOptions o{n_targets, effects, t_ref, setup_names_or_model(setups, *m),
+                             t_mean_s ? *t_mean_s : m->spec().t_mean_s, fit_gravity};
+             if (stations_of) {
+               o.station_names = stations_of->station_names;
+               o.station_kinds = stations_of->station_kinds;
+               o.station_normals = stations_of->station_normals;
+             }
+             PointModel pm(*m, o);
+             return new PyPointModel{std::move(m), std::move(o), std::move(pm)};
+           }),
+           py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
+           py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
+           py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false, py::arg("stations_of") = nullptr,
+           "setups: the data's setup names (default: the model's setups); stations_of: a layout whose probe\n"
+           "stations (names, kinds, reference normals) this one has too; t_mean_s: the drift's reference\n"
+           "time (default: the model's); fit_gravity: the compliances' torques from fitted mass moments\n"
+           "(parameters of kind 'gravity_moment', 2 per link) instead of the model's masses")
+      .def_property_readonly("layout", [](const PyPointModel& p) -> const ParamLayout& { return p.pm.layout(); },
+                             py::return_value_policy::reference_internal)
+      .def_property_readonly("names", [](const PyPointModel& p) { return p.pm.layout().names; })
+      .def("start", [](const PyPointModel& p, const py::dict& d) {
+             return p.pm.start(measurements_from_dict(d, p.pm.layout().dof));
+           }, py::arg("data"))
+      .def(
+          "residuals",
+          [](const PyPointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
+            const ParamLayout& L = p.pm.layout();
+            const MeasurementSet data = measurements_from_dict(d, L.dof);
+            if (static_cast<int>(x.size()) != L.size) throw InputError("PointModel: wrong parameter count");
+            if (!L.setup_names.empty() && data.setup_names != L.setup_names)
+              throw InputError(data.source + ": the data's setups are not the layout's (" +
+                               std::to_string(L.n_setups) + " setups in that order)");
+            const PointState at = PointModel(*p.model, p.options, &data).at(x);
+            const size_t n = residual_size(residual_kind(data)) * data.rows.size();
+            std::vector<int> every(L.size);
+            std::iota(every.begin(), every.end(), 0);
+            Eigen::VectorXd r(n);
+            RowMatrix J(jac ? n : 0, L.size);
+            {
+              py::gil_scoped_release free;  // the rows run on the core's threads
+              all_residuals(at, data, weight, every, r.data(), jac ? J.data() : nullptr);
+            }
+            return py::make_tuple(r, J);
+          },
+          py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0);
+}

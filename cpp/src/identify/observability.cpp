@@ -1,0 +1,89 @@
+// kincal: what the identified parameters' Jacobian says of the data (identifiability.hpp): the
+// conditioning of what they determine, and whether they see the arm's overall scale.
+#include "kincal/identify/identifiability.hpp"
+
+#include "kincal/identify/point_model.hpp"
+
+#include "linearization.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+
+namespace kincal {
+
+using detail::linearize;
+using detail::normal_matrix_lower;
+
+namespace {
+
+/// The parameters' rates under a uniform scaling of every length about the first setup's base
+/// origin (per unit of the scale's change): the joint lines' points, the tool's and the targets'
+/// offsets, the other placements, the stations; the compliances the inverse (the torques scale with
+/// the arms, the deflection angles stay).
+Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>& x) {
+  const ParamLayout& L = pm.layout();
+  const PointState at = pm.at(x);
+  const ModelSpec& s = at.spec();
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(L.size);
+  const Vec3 o = pose_to_iso(s.base_in_instrument).translation();
+  for (int j = 0; j < L.dof; ++j) {
+    const Vec3 w = s.joints[j].axis, p = s.joints[j].point;
+    const Vec3 u = w.unitOrthogonal(), vv = w.cross(u);  // (the layout's own directions are its nominal's; a
+    v[4 * j + 2] = p.dot(u);                              // small tilt changes them little)
+    v[4 * j + 3] = p.dot(vv);
+  }
+  for (size_t i = 0; i < L.loaded.size(); ++i) v[L.compliance + static_cast<int>(i)] = -x[L.compliance + i];
+  for (int i = L.moments; i < L.tool; ++i) v[i] = x[i];
+  const Vec3 t = pose_to_iso(s.tool).translation();
+  for (int k = 0; k < 3; ++k) v[L.tool + k] = t[k];
+  for (int i = L.targets; i < L.effects; ++i) v[i] = x[i];
+  for (int st = 1; st < L.n_setups; ++st) {
+    const Vec3 ts = pose_to_iso(s.setups[static_cast<size_t>(st)].base_in_instrument).translation() - o;
+    for (int k = 0; k < 3; ++k) v[L.base + 6 * st + k] = ts[k];
+  }
+  const std::vector<StationValue> sv = at.stations();
+  for (size_t k = 0; k < sv.size(); ++k) {
+    const int c = L.stations + 3 * static_cast<int>(k);
+    if (sv[k].kind == MeasureKind::plane) {
+      v[c + 2] = sv[k].offset - sv[k].normal.dot(o);
+    } else {
+      for (int i = 0; i < 3; ++i) v[c + i] = sv[k].point[i] - o[i];
+    }
+  }
+  return v;
+}
+
+}  // namespace
+
+bool scale_seen(const PointModel& pm, const Eigen::MatrixXd& J, const std::vector<double>& x) {
+  const Eigen::VectorXd v = scale_direction(pm, x);
+  double parts = 0;
+  for (Eigen::Index i = 0; i < v.size(); ++i) parts += J.col(i).squaredNorm() * v[i] * v[i];
+  return (J * v).norm() > 1e-3 * std::sqrt(parts);
+}
+
+void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
+  const Eigen::MatrixXd J = linearize(pm, data, res.x, opt.orientation_weight).jacobian;
+  // the overall scale: what the rows see of a uniform scaling of every length, against what a point
+  // measured at the robot's reach would see (a probe campaign without a known length sees nothing)
+  res.scale_determined = scale_seen(pm, J, res.x);
+  std::vector<int> free_idx;
+  for (int i = 0; i < res.layout.size; ++i)  // what the data determine (not the priors)
+    if (!res.fixed[i] && !(i < static_cast<int>(res.at_prior.size()) && res.at_prior[i])) free_idx.push_back(i);
+  Eigen::MatrixXd Jf(J.rows(), free_idx.size());
+  for (size_t k = 0; k < free_idx.size(); ++k) {
+    const double nrm = J.col(free_idx[k]).norm();
+    Jf.col(k) = J.col(free_idx[k]) / (nrm > 0 ? nrm : 1.0);
+  }
+  // singular values from the eigenvalues of the (small) normal matrix
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal_matrix_lower(Jf), Eigen::EigenvaluesOnly);
+  const Eigen::VectorXd s = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  res.condition_number = s.maxCoeff() / s.minCoeff();
+  double logsum = 0;
+  for (int k = 0; k < s.size(); ++k) logsum += std::log(s(k));
+  res.observability_index = std::exp(logsum / s.size()) / std::sqrt(static_cast<double>(data.rows.size()));
+}
+
+}  // namespace kincal

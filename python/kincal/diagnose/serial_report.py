@@ -172,6 +172,38 @@ def _variables_figure(plt: ModuleType, scores: list[dict[str, Any]], path: Path)
     plt.close(fig)
 
 
+def _residual_figure(plt: ModuleType, data: dict[str, Any], e0: FloatArray, e1: FloatArray, path: Path) -> None:
+    """The rows' errors with the starting model (e0) and the final one (e1): a map of the measured
+    points in the instrument frame; for a campaign with probe rows each row's error along its
+    constraint against the configurations, one colour per station (tracker points as one more)."""
+    station = np.asarray(data.get("station", np.full(len(data["pose"]), -1)))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    if np.any(station >= 0):
+        names = list(data["station_names"])
+        groups = [(k, names[k]) for k in range(len(names))] + ([(-1, "tracker points")] if np.any(station < 0) else [])
+        row = np.arange(len(station))
+        for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
+            for k, name in groups:
+                m = station == k
+                ax.scatter(row[m], np.maximum(e[m], 1e-6) * 1000, s=8, label=name)
+            ax.set_yscale("log")
+            ax.set_title(f"{lab}: RMS {np.sqrt(np.mean(e ** 2)) * 1000:.1f} um (fitted rows)", fontsize=10)
+            ax.set_xlabel("configuration (row of the campaign)")
+        axes[0].set_ylabel("error along the constraint (um, log scale)")
+        axes[1].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False, title="station")
+    else:
+        norm = report.error_norm(np.concatenate([e0, e1]) * 1000)
+        for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
+            sc = ax.scatter(data["xyz"][:, 0], data["xyz"][:, 1], c=e * 1000, s=8, cmap="viridis", norm=norm)
+            ax.set_title(f"{lab}: RMS {np.sqrt(np.mean(e ** 2)) * 1000:.1f} um (fitted points)", fontsize=10)
+            ax.set_xlabel("x (mm, instrument)")
+            ax.set_aspect("equal")
+        axes[0].set_ylabel("y (mm, instrument)")
+        fig.colorbar(sc, ax=list(axes), label="point error (um, log scale)")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
 def write_report(robot: Robot, data: dict[str, Any], diag: dict[str, Any], out_dir: Union[str, Path],
                  title: str = "kincal diagnose", model_file: Optional[str] = None) -> list[str]:
     """Figures and report.html of a diagnosis in out_dir; returns the files written. ``model_file``:
@@ -202,21 +234,11 @@ def write_report(robot: Robot, data: dict[str, Any], diag: dict[str, Any], out_d
     fig.savefig(out / "gap.png", dpi=100)
     plt.close(fig)
     files.append("gap.png")
-    # 2. residual maps before (geometry only) and after (final model), in the instrument frame
+    # 2. residuals before (geometry only) and after (final model): where the points are, or per station
     start: Spec = diag["_start"]
     e0 = start.errors(start.fit(data), data)
     e1 = diag["_spec"].errors(diag["_final_fit"], data)
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
-    norm = report.error_norm(np.concatenate([e0, e1]) * 1000)
-    for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
-        sc = ax.scatter(data["xyz"][:, 0], data["xyz"][:, 1], c=e * 1000, s=8, cmap="viridis", norm=norm)
-        ax.set_title(f"{lab}: RMS {np.sqrt(np.mean(e ** 2)) * 1000:.1f} um (fitted points)", fontsize=10)
-        ax.set_xlabel("x (mm, instrument)")
-        ax.set_aspect("equal")
-    axes[0].set_ylabel("y (mm, instrument)")
-    fig.colorbar(sc, ax=list(axes), label="point error (um, log scale)")
-    fig.savefig(out / "residual_map.png", dpi=100)
-    plt.close(fig)
+    _residual_figure(plt, data, e0, e1, out / "residual_map.png")
     files.append("residual_map.png")
     # 3. residuals against each named effect's variable, before and after it was added
     spec = start

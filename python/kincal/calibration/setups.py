@@ -214,7 +214,9 @@ def validate(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale
     ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm)
     v = validation_figures(ea, eb, oa, ob, data)
     v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
-             refitted="the instrument placement of every setup and the target offsets; the model's geometry and "
-                      "effects held (its drift left out)", placements=setup_frames(cal.setups),
+             refitted="the instrument placement of every setup and the target offsets"
+                      + (", the probe stations" if data.get("station_names") else "")
+                      + "; the model's geometry and effects held (its drift left out)",
+             placements=setup_frames(cal.setups),
              extrapolated=extrapolated(robot, data["q_deg"]))
     return v

@@ -295,3 +295,36 @@ TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
   tracker.seed = test::test_seed(54);
   EXPECT_TRUE(identify(nominal, simulate(truth, tracker), opt).scale_determined);
 }
+
+// A tracker campaign plus one sphere station, fitted together: the probe's rows share the fit's
+// robot, the tracker's rows place the instrument; the joint fit is not worse than the tracker alone
+// by more than 5% (it should be better). Truth as above; tracker: 60 poses, one reflector at the
+// ball's offset, 0.02 mm noise per coordinate; the sphere: 25 touches in a 60 deg cone, 0.005 mm.
+// Accuracy: the ball centre on 200 random configurations after the best rigid transform.
+TEST(Stations, ATrackerCampaignWithASphereStation) {
+  KINCAL_SEED_TRACE(71, 72, 73, 74);
+  const Model truth(truth_spec(71, 0.003)), nominal(kr500_spec());
+  const Vec3 probe(0, 0, 150);
+  SimulationOptions tr;
+  tr.poses = 60;
+  tr.targets = {probe};
+  tr.seed = test::test_seed(72);
+  const MeasurementSet tracker = simulate(truth, tr);
+  ProbeSimulationOptions so;
+  so.stations = 1;
+  so.touches = 25;
+  so.cone_deg = 60;
+  so.probe = probe;
+  so.seed = test::test_seed(73);
+  const MeasurementSet sphere = simulate_probe(truth, so);
+  MeasurementSet both = tracker;
+  both.station_names = sphere.station_names;
+  both.station_kinds = sphere.station_kinds;
+  for (Measurement r : sphere.rows) {
+    r.pose += static_cast<int>(tracker.rows.size());
+    both.rows.push_back(r);
+  }
+  const Accuracy alone = probe_accuracy(truth, tracker, probe, test::test_seed(74), "tracker alone");
+  const Accuracy joint = probe_accuracy(truth, both, probe, test::test_seed(74), "tracker + a sphere");
+  EXPECT_LT(joint.identified, 1.05 * alone.identified);
+}

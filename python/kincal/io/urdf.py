@@ -66,9 +66,10 @@ def _link_of(joint: ET.Element, tag: str, path: str) -> str:
     return name
 
 
-def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None) -> dict[str, Any]:
-    """The kincal geometry (model JSON "nominal" section) of a URDF serial chain."""
-    path = str(path)
+def _chain(path: str, base: str | None, tip: str | None
+           ) -> tuple[ET.Element, dict[str, ET.Element], list[ET.Element], str, str]:
+    """The URDF's root element, its links by name, the joints from ``base`` to ``tip`` and those two
+    links' names (the only root and the only leaf below it when not named)."""
     try:
         root = ET.parse(path).getroot()
     except FileNotFoundError:
@@ -79,10 +80,9 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
     if root.tag != "robot":
         raise ValueError(f"{path}: the root element is <{root.tag}>, not <robot>")
     links = {str(l.get("name")): l for l in root.findall("link")}
-    joints = root.findall("joint")
     by_child: dict[str, ET.Element] = {}
     children: dict[str, list[ET.Element]] = {}
-    for j in joints:
+    for j in root.findall("joint"):
         by_child[_link_of(j, "child", path)] = j
         children.setdefault(_link_of(j, "parent", path), []).append(j)
     roots = [n for n in links if n not in by_child]
@@ -115,7 +115,26 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
         chain.append(up)
         n = _link_of(up, "parent", path)
     chain.reverse()
+    return root, links, chain, base, tip
 
+
+def _limits(j: ET.Element, where: str) -> tuple[float, float, float]:
+    """A revolute or continuous joint's (lower, upper, velocity) in degrees (and per second)."""
+    lim = j.find("limit")
+    lo, hi, vel = -180.0, 180.0, 0.0
+    if lim is not None:
+        if j.get("type") == "revolute":
+            lo, hi = math.degrees(float(lim.get("lower", "0"))), math.degrees(float(lim.get("upper", "0")))
+        vel = math.degrees(float(lim.get("velocity", "0")))
+    if not lo < hi:
+        raise ValueError(f"{where}: lower limit {lo:g} deg is not below upper limit {hi:g} deg")
+    return lo, hi, vel
+
+
+def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None) -> dict[str, Any]:
+    """The kincal geometry (model JSON "nominal" section) of a URDF serial chain."""
+    path = str(path)
+    root, links, chain, base, tip = _chain(path, base, tip)
     t = np.eye(4)
     out_joints: list[dict[str, Any]] = []
 
@@ -146,29 +165,11 @@ def urdf_spec(path: str | Path, base: str | None = None, tip: str | None = None)
             raise ValueError(f"{where}: type '{typ}' is not supported (a serial revolute chain is needed)")
         axis_el = j.find("axis")
         axis = _floats(axis_el.get("xyz") if axis_el is not None else "1 0 0", 3, where + " axis")
-        lim = j.find("limit")
-        lo, hi, vel = -180.0, 180.0, 0.0
-        if lim is not None:
-            if typ == "revolute":
-                lo, hi = math.degrees(float(lim.get("lower", "0"))), math.degrees(float(lim.get("upper", "0")))
-            vel = math.degrees(float(lim.get("velocity", "0")))
-        if not lo < hi:
-            raise ValueError(f"{where}: lower limit {lo:g} deg is not below upper limit {hi:g} deg")
+        lo, hi, vel = _limits(j, where)
         m, c = inertial(child, t)
-        out_joints.append(
-            {
-                "name": name,
-                "point_mm": list(t[:3, 3] * 1000.0),
-                "axis": list(t[:3, :3] @ axis),
-                "limits_deg": [lo, hi],
-                "max_velocity_deg_s": vel,
-                "max_acceleration_deg_s2": 0.0,
-                "max_jerk_deg_s3": 0.0,
-                "mass_kg": m,
-                "com_mm": list(c),
-                "compliance_deg_per_knm": 0.0,
-            }
-        )
+        out_joints.append({"name": name, "point_mm": list(t[:3, 3] * 1000.0), "axis": list(t[:3, :3] @ axis),
+                           "limits_deg": [lo, hi], "max_velocity_deg_s": vel, "max_acceleration_deg_s2": 0.0,
+                           "max_jerk_deg_s3": 0.0, "mass_kg": m, "com_mm": list(c), "compliance_deg_per_knm": 0.0})
     if not out_joints:
         raise ValueError(f"{path}: no revolute joint between '{base}' and '{tip}'")
     return {

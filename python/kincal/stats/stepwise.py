@@ -228,6 +228,59 @@ class Search(Generic[E]):
     linearised: Optional[Linearisation[E]] = None
 
 
+def _score_round(problem: Problem[E], regressors: Linearisation[E], effects: list[E], candidates: Sequence[E],
+                 row_folds: list[BoolArray]) -> tuple[list[dict[str, Any]], Optional[float]]:
+    """One round of the search: every candidate not yet in the model (and that the data can fit)
+    scored against the current linearisation (its variant chosen first when it has several), with
+    the residual's RMS. Each score carries its candidate (``_cand``) and columns (``_cols``)."""
+    variants = getattr(problem, "variants", None)
+    covered = getattr(problem, "covered", None)
+    score_folds = getattr(problem, "score_folds", None)
+    admits = getattr(problem, "admits", None)
+    chosen = getattr(problem, "chosen", None)
+    scored: list[dict[str, Any]] = []
+    r_rms = None
+    basis: Optional[tuple[FloatArray, FloatArray]] = None  # the current model's columns and their orthonormal basis
+    for c in candidates:
+        if any(e.name == c.name and e.joint == c.joint for e in effects):
+            continue
+        if admits and not admits(effects, c):  # more parameters than the data can fit
+            continue
+        r, Jc, R = regressors(c)
+        if r_rms is None:
+            r_rms = float(np.sqrt(np.mean(np.asarray(r) ** 2))) if len(r) else 0.0
+        if basis is None or basis[0] is not Jc:
+            basis = (Jc, _basis(Jc))
+        order: dict[str, Any] = {}
+        ridge = None
+        nested = variants(c, R) if variants else None
+        if nested:
+            sel = getattr(problem, "variant_folds", None)
+            sel_folds = [np.repeat(f, problem.dims) for f in sel(c)] if sel else row_folds
+            i, gains = choose_variant(r, R, [(m, w) for _, m, w in nested], sel_folds, basis[1])
+            c, m, ridge = nested[i]
+            R = R[:, :m]
+            if covered and covered(c, candidates):
+                continue
+            if chosen:
+                chosen(c, ridge)
+            order = {"variant_cv_gain": [round(x, 6) for x in gains], "variant": i}
+        s = score(r, Jc, R, row_folds, basis[1], ridge)
+        own = score_folds(c) if score_folds else None  # e.g. a periodic effect: ranges of its angle
+        if own and not s.get("absorbed") and not s.get("untestable"):  # it must also predict those
+            s["extrapolation_cv_gain"] = score(r, Jc, R, [np.repeat(f, problem.dims) for f in own], basis[1],
+                                               ridge)["cv_gain"]
+        if "cv_ss_after" in s:  # the linearised cross-validated RMS per point, with the candidate
+            s["cv_rms_linear_mm"] = math.sqrt(problem.dims * s.pop("cv_ss_after") / len(r))
+            s.pop("cv_ss_before")
+        s.update(problem.describe(c))
+        s.update(order)
+        s["_cand"] = c
+        s["_cols"] = (r, Jc, R)
+        scored.append(s)
+    return scored, r_rms
+
+
 def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, alpha: float = 1e-6,
            min_gain: float = 0.03, max_steps: int = 6, say: Callable[[str], None] = lambda s: None,
            confirm: bool = True, cur: Optional[float] = None, listed: int = LISTED,
@@ -250,55 +303,11 @@ def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, 
     regressors = None
     steps: list[dict[str, Any]] = []
     scored: list[dict[str, Any]] = []
-    variants = getattr(problem, "variants", None)
-    covered = getattr(problem, "covered", None)
-    score_folds = getattr(problem, "score_folds", None)
     r_floor = getattr(problem, "resolution", None)  # a residual below it (per coordinate) explains nothing
-    admits = getattr(problem, "admits", None)
-    chosen = getattr(problem, "chosen", None)
     for _ in range(max_steps):
         if regressors is None:
             regressors = problem.linearise(effects)
-        scored = []
-        r_rms = None
-        basis: Optional[tuple[FloatArray, FloatArray]] = None  # the current model's columns and their orthonormal basis
-        for c in candidates:
-            if any(e.name == c.name and e.joint == c.joint for e in effects):
-                continue
-            if admits and not admits(effects, c):  # more parameters than the data can fit
-                continue
-            r, Jc, R = regressors(c)
-            if r_rms is None:
-                r_rms = float(np.sqrt(np.mean(np.asarray(r) ** 2))) if len(r) else 0.0
-            if basis is None or basis[0] is not Jc:
-                basis = (Jc, _basis(Jc))
-            order: dict[str, Any] = {}
-            ridge = None
-            nested = variants(c, R) if variants else None
-            if nested:
-                sel = getattr(problem, "variant_folds", None)
-                sel_folds = [np.repeat(f, problem.dims) for f in sel(c)] if sel else row_folds
-                i, gains = choose_variant(r, R, [(m, w) for _, m, w in nested], sel_folds, basis[1])
-                c, m, ridge = nested[i]
-                R = R[:, :m]
-                if covered and covered(c, candidates):
-                    continue
-                if chosen:
-                    chosen(c, ridge)
-                order = {"variant_cv_gain": [round(x, 6) for x in gains], "variant": i}
-            s = score(r, Jc, R, row_folds, basis[1], ridge)
-            own = score_folds(c) if score_folds else None  # e.g. a periodic effect: ranges of its angle
-            if own and not s.get("absorbed") and not s.get("untestable"):  # it must also predict those
-                s["extrapolation_cv_gain"] = score(r, Jc, R, [np.repeat(f, problem.dims) for f in own], basis[1],
-                                                   ridge)["cv_gain"]
-            if "cv_ss_after" in s:  # the linearised cross-validated RMS per point, with the candidate
-                s["cv_rms_linear_mm"] = math.sqrt(problem.dims * s.pop("cv_ss_after") / len(r))
-                s.pop("cv_ss_before")
-            s.update(problem.describe(c))
-            s.update(order)
-            s["_cand"] = c
-            s["_cols"] = (r, Jc, R)
-            scored.append(s)
+        scored, r_rms = _score_round(problem, regressors, effects, candidates, row_folds)
         scored.sort(key=lambda s: -_credited(s))
         history[-1]["candidates"] = [{k: v for k, v in s.items() if not k.startswith(("_", "variant"))}
                                      for s in scored[:listed]]

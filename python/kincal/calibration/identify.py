@@ -334,6 +334,39 @@ def _fit_options(fit: Optional[FitOptions], **kw: Any) -> FitOptions:
     return FitOptions(**kw)
 
 
+def _validation_scheme(data: dict[str, Any], fit: FitOptions, *, hold_out_setups: bool, holdout: Optional[float],
+                       k_folds: int, seed: int
+                       ) -> tuple[BoolArray, list[BoolArray], dict[str, Any], Optional[SetupRefit]]:
+    """How identify() validates: the rows its model is fitted on, the held-out masks (each setup
+    whole, a split of the configurations, or k folds of them; none), the validation's description
+    and, for whole setups, the refit of a held setup's placement and targets."""
+    every_row = np.ones(len(data["pose"]), dtype=bool)
+    refit: Optional[SetupRefit] = None
+    val: dict[str, Any]
+    if hold_out_setups:
+        codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
+        if len(np.unique(codes)) < 2:
+            raise ValueError("holding out whole setups needs a setup column with at least two setups")
+        fit_mask, masks = every_row, [codes == c for c in np.unique(codes)]
+        val = {"scheme": f"each of the {len(masks)} setups held out whole (its placement and targets refitted)",
+               "grouping": "setup column", "configurations": int(grouping.configurations(data).count),
+               "held_rows": int(len(codes)), "model_rows": "every row (validated by holding out setups)"}
+        refit = _setup_refit(fit.loss, fit.loss_scale_mm or 0.0)
+    elif holdout is not None:
+        fit_mask, held = split_poses(data, holdout, seed)
+        val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()),
+                   model_rows="the fitted rows only: the model excludes the held-out rows")
+        masks = [held]
+    elif k_folds > 1:
+        fit_mask, masks = every_row, folds(data, k_folds, seed)
+        val = dict(grouping.describe(data, f"{k_folds}-fold"),
+                   held_rows=int(len(data["pose"])), model_rows="every row (validated by cross-validation)")
+    else:
+        fit_mask, masks = every_row, []
+        val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
+    return fit_mask, masks, val, refit
+
+
 def identify(robot: Robot, data: dict[str, Any], *, effects: Union[str, Sequence[Union[str, Candidate]]] = "auto",
              fit: Optional[FitOptions] = None, loss: str = "huber",
              loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM, prior_sd: Optional[dict[str, float]] = None,
@@ -392,30 +425,8 @@ def identify(robot: Robot, data: dict[str, Any], *, effects: Union[str, Sequence
             return ch.fit, ch
         return fit.fit(robot, train, core_effects, penalties=penalties, gravity=gravity_of, seed=seed), None
 
-    every_row = np.ones(len(data["pose"]), dtype=bool)
-    refit: Optional[SetupRefit] = None
-    val: dict[str, Any]
-    if hold_out_setups:
-        codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
-        if len(np.unique(codes)) < 2:
-            raise ValueError("holding out whole setups needs a setup column with at least two setups")
-        fit_mask, masks = every_row, [codes == c for c in np.unique(codes)]
-        val = {"scheme": f"each of the {len(masks)} setups held out whole (its placement and targets refitted)",
-               "grouping": "setup column", "configurations": int(grouping.configurations(data).count),
-               "held_rows": int(len(codes)), "model_rows": "every row (validated by holding out setups)"}
-        refit = _setup_refit(fit.loss, fit.loss_scale_mm or 0.0)
-    elif holdout is not None:
-        fit_mask, held = split_poses(data, holdout, seed)
-        val = dict(grouping.describe(data, f"{holdout:.0%} held out"), held_rows=int(held.sum()),
-                   model_rows="the fitted rows only: the model excludes the held-out rows")
-        masks = [held]
-    elif k_folds > 1:
-        fit_mask, masks = every_row, folds(data, k_folds, seed)
-        val = dict(grouping.describe(data, f"{k_folds}-fold"),
-                   held_rows=int(len(data["pose"])), model_rows="every row (validated by cross-validation)")
-    else:
-        fit_mask, masks = every_row, []
-        val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
+    fit_mask, masks, val, refit = _validation_scheme(data, fit, hold_out_setups=hold_out_setups, holdout=holdout,
+                                                     k_folds=k_folds, seed=seed)
     # folds: each predicted by a model fitted (its effects chosen) without it; a split: by the delivered model
     e: dict[str, FloatArray] = {}
     fold_choices: list[Optional[effect_choice.Choice]] = []

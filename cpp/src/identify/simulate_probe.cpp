@@ -27,6 +27,23 @@ struct Placer {
   const Model& truth;
   const ProbeSimulationOptions& opt;
   std::mt19937_64& rng;
+  /// Joint angles drawn in opt.limit_margin of every joint's range.
+  VecQ random_q() const {
+    std::uniform_real_distribution<double> ud(-0.5, 0.5);
+    VecQ q(truth.dof());
+    for (int j = 0; j < truth.dof(); ++j) {
+      const JointSpec& js = truth.spec().joints[j];
+      q[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg) * opt.limit_margin;
+    }
+    return q;
+  }
+  /// Directions of the last motion drawn for every joint.
+  VecQ random_dir() const {
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    VecQ d(truth.dof());
+    for (int j = 0; j < truth.dof(); ++j) d[j] = u01(rng) < 0.5 ? -1.0 : 1.0;
+    return d;
+  }
   /// Commanded angles that put the truth's ball centre at c with the tool turned to r (base frame),
   /// near ref; false when out of reach.
   bool reach(const Vec3& c, const Mat3& r, const VecQ& ref, const VecQ& dir, Measurement& row, int starts = 8) const {
@@ -45,6 +62,79 @@ struct Placer {
   }
 };
 
+/// The block whose faces a plane campaign probes: in front of the robot, its top face's centre at
+/// `top`, the probe pointing down in `frame` (a pose of the truth with joint angles q0); faces in the
+/// order top, the one towards the robot, the two sideways ones, the far one (hardest to reach).
+struct Block {
+  explicit Block(double edge) : edge_mm(edge) { frame.linear() << 1, 0, 0, 0, -1, 0, 0, 0, -1; }
+  double edge_mm;
+  VecQ q0;
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+  Vec3 top = Vec3::Zero();
+  static Vec3 normal(int s) {
+    const Vec3 n[] = {Vec3::UnitZ(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitX()};
+    return n[s];
+  }
+  Vec3 centre(int s) const { return top - Vec3::UnitZ() * (0.5 * edge_mm) + normal(s) * (0.5 * edge_mm); }
+  /// The probe turned from `frame` to point into face s.
+  Mat3 turn(int s) const {
+    return Eigen::Quaterniond::FromTwoVectors(frame.linear().col(2), -normal(s)).toRotationMatrix() * frame.linear();
+  }
+};
+
+/// Where every probed face's centre is in reach with the probe pointing into it: the first of a few
+/// places at fractions of the reach and heights about the shoulder. InputError when none is.
+Block place_block(const Placer& place) {
+  const Model& truth = place.truth;
+  const ProbeSimulationOptions& opt = place.opt;
+  const int n = truth.dof();
+  Block b(opt.block_mm);
+  VecQ mid(n);
+  for (int j = 0; j < n; ++j) mid[j] = 0.5 * (truth.spec().joints[j].lower_deg + truth.spec().joints[j].upper_deg);
+  const double reach = (fk_compliant(truth, VecQ::Zero(n)) * opt.probe).head<2>().norm();
+  const double shoulder = truth.point(1).z();
+  for (double fr : {0.55, 0.45, 0.65, 0.35})
+    for (double fz : {-0.3, 0.0, -0.5, 0.2})
+      for (double az : {0.0, 30.0, -30.0}) {
+        b.top = Vec3(fr * reach * std::cos(az * kDeg), fr * reach * std::sin(az * kDeg), shoulder + fz * reach);
+        Measurement row;
+        if (!place.reach(b.centre(0) + Block::normal(0) * opt.radius_mm, b.turn(0), mid, place.random_dir(), row, 48))
+          continue;
+        b.q0 = row.q_deg;
+        bool all = true;
+        for (int s = 1; s < opt.stations && all; ++s)
+          all = place.reach(b.centre(s) + Block::normal(s) * opt.radius_mm, b.turn(s), b.q0, place.random_dir(), row, 48);
+        if (all) return b;
+      }
+  throw InputError("simulate: no place for a block of " + std::to_string(opt.block_mm) + " mm with " +
+                   std::to_string(opt.stations) + " faces in the robot's reach");
+}
+
+/// The artifact of a campaign: spheres and pivots, the distance of every station from the first
+/// (points: their places, base frame); planes, the 90 deg angles between the top face and the
+/// others and the block's edge between opposite faces.
+std::vector<ArtifactTerm> known_geometry(const ProbeSimulationOptions& opt, const std::vector<Vec3>& points) {
+  std::vector<ArtifactTerm> out;
+  for (int s = 1; s < opt.stations; ++s) {
+    ArtifactTerm a;
+    a.a = 0;
+    a.b = s;
+    if (opt.kind == MeasureKind::plane) a.angle_deg = 90;
+    else a.distance_mm = (points[static_cast<size_t>(s)] - points[0]).norm();
+    out.push_back(a);
+  }
+  if (opt.kind == MeasureKind::plane)
+    for (const auto& [fa, fb] : {std::pair<int, int>{2, 3}, {1, 4}}) {  // y+ with y-, x- with x+
+      if (fb >= opt.stations) continue;
+      ArtifactTerm a;
+      a.a = fa;
+      a.b = fb;
+      a.distance_mm = opt.block_mm;
+      out.push_back(a);
+    }
+  return out;
+}
+
 }  // namespace
 
 MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& opt) {
@@ -53,67 +143,21 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
   if (opt.kind == MeasureKind::plane && opt.stations > 5) throw InputError("simulate: a block has 5 faces to probe");
   if (truth.dof() != 6) throw InputError("simulate: probe campaigns need a 6-joint robot");
   std::mt19937_64 rng(opt.seed);
-  std::uniform_real_distribution<double> ud(-0.5, 0.5), u01(0.0, 1.0);
+  std::uniform_real_distribution<double> ud(-0.5, 0.5);
   std::normal_distribution<double> nd(0.0, 1.0);
-  const int n = truth.dof();
   const Placer place{truth, opt, rng};
   const double cone = opt.cone_deg * kDeg;
   MeasurementSet m;
   m.source = "simulated";
-  auto random_q = [&] {
-    VecQ q(n);
-    for (int j = 0; j < n; ++j) {
-      const JointSpec& js = truth.spec().joints[j];
-      q[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg) * opt.limit_margin;
-    }
-    return q;
-  };
-  auto random_dir = [&] {
-    VecQ d(n);
-    for (int j = 0; j < n; ++j) d[j] = u01(rng) < 0.5 ? -1.0 : 1.0;
-    return d;
-  };
+  auto random_dir = [&] { return place.random_dir(); };
   // a seed pose with the probe's ball well in reach: its tool frame (base frame)
   auto seed_pose = [&](VecQ& q) {
-    q = random_q();
+    q = place.random_q();
     return fk_model(truth, q * kDeg, EffectContext{random_dir(), std::nan("")});
   };
   std::vector<Vec3> points;  // every sphere's centre or pivot (base frame)
-  // the top, the face towards the robot, the two sideways and the far one (hardest to reach)
-  const char* faces[] = {"top", "x-", "y+", "y-", "x+"};
-  const Vec3 face_normal[] = {Vec3::UnitZ(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitX()};
-  // the block: in front of the robot, where every probed face's centre is in reach with the probe
-  // pointing into it (the first of a few places at fractions of the reach and heights about the
-  // shoulder); its top face's centre `top`
-  VecQ q0 = VecQ::Zero(n);
-  Eigen::Isometry3d block = Eigen::Isometry3d::Identity();
-  block.linear() << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // the probe pointing down
-  Vec3 top = Vec3::Zero();
-  auto face_centre = [&](int s) -> Vec3 { return top - Vec3::UnitZ() * (0.5 * opt.block_mm) + face_normal[s] * (0.5 * opt.block_mm); };
-  auto face_turn = [&](int s) -> Mat3 {  // the probe turned to point into face s
-    return Eigen::Quaterniond::FromTwoVectors(block.linear().col(2), -face_normal[s]).toRotationMatrix() * block.linear();
-  };
-  if (opt.kind == MeasureKind::plane) {
-    VecQ mid(n);
-    for (int j = 0; j < n; ++j) mid[j] = 0.5 * (truth.spec().joints[j].lower_deg + truth.spec().joints[j].upper_deg);
-    const double reach = (fk_compliant(truth, VecQ::Zero(n)) * opt.probe).head<2>().norm();
-    const double shoulder = truth.point(1).z();
-    bool found = false;
-    for (double fr : {0.55, 0.45, 0.65, 0.35})
-      for (double fz : {-0.3, 0.0, -0.5, 0.2})
-        for (double az : {0.0, 30.0, -30.0}) {
-          if (found) break;
-          top = Vec3(fr * reach * std::cos(az * kDeg), fr * reach * std::sin(az * kDeg), shoulder + fz * reach);
-          Measurement probe_row;
-          found = place.reach(face_centre(0) + face_normal[0] * opt.radius_mm, face_turn(0), mid, random_dir(), probe_row, 48);
-          if (!found) continue;
-          q0 = probe_row.q_deg;
-          for (int s = 1; s < opt.stations && found; ++s)
-            found = place.reach(face_centre(s) + face_normal[s] * opt.radius_mm, face_turn(s), q0, random_dir(), probe_row, 48);
-        }
-    if (!found) throw InputError("simulate: no place for a block of " + std::to_string(opt.block_mm) + " mm with " +
-                                 std::to_string(opt.stations) + " faces in the robot's reach");
-  }
+  const char* faces[] = {"top", "x-", "y+", "y-", "x+"};  // Block's order
+  const Block block = opt.kind == MeasureKind::plane ? place_block(place) : Block(opt.block_mm);
   for (int s = 0; s < opt.stations; ++s) {
     const std::string name = opt.kind == MeasureKind::plane ? faces[s] : "S" + std::to_string(s + 1);
     m.station_names.push_back(name);
@@ -123,10 +167,10 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
     VecQ ref;
     Eigen::Isometry3d seed;
     if (opt.kind == MeasureKind::plane) {
-      ref = q0;
-      seed = block;
-      normal = face_normal[s];
-      centre = face_centre(s);
+      ref = block.q0;
+      seed = block.frame;
+      normal = Block::normal(s);
+      centre = block.centre(s);
       axis = -normal;  // the probe points into the face
     } else {
       seed = seed_pose(ref);
@@ -151,7 +195,7 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
         const Vec3 a = normal.unitOrthogonal(), b = normal.cross(a);
         const Vec3 on = centre + 0.7 * opt.block_mm * (ud(rng) * a + ud(rng) * b);
         c = on + normal * (opt.radius_mm + opt.noise_mm * nd(rng));
-        r = tilt(rng, axis, cone) * face_turn(s);
+        r = tilt(rng, axis, cone) * block.turn(s);
         row.radius_mm = opt.radius_mm;
       } else if (opt.kind == MeasureKind::sphere) {
         c = centre + Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
@@ -170,33 +214,7 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
     }
   }
   // (the stations are in the base frame, the artifact's lengths and angles in any)
-  if (opt.artifact) {
-    if (opt.kind != MeasureKind::plane) {
-      for (int s = 1; s < opt.stations; ++s) {
-        ArtifactTerm a;
-        a.a = 0;
-        a.b = s;
-        a.distance_mm = (points[static_cast<size_t>(s)] - points[0]).norm();
-        m.artifact.push_back(a);
-      }
-    } else {
-      for (int s = 1; s < opt.stations; ++s) {
-        ArtifactTerm a;
-        a.a = 0;
-        a.b = s;
-        a.angle_deg = 90;
-        m.artifact.push_back(a);
-      }
-      for (const auto& [fa, fb] : {std::pair<int, int>{2, 3}, {1, 4}}) {  // y+ with y-, x- with x+
-        if (fb >= opt.stations) continue;
-        ArtifactTerm a;
-        a.a = fa;
-        a.b = fb;
-        a.distance_mm = opt.block_mm;
-        m.artifact.push_back(a);
-      }
-    }
-  }
+  if (opt.artifact) m.artifact = known_geometry(opt, points);
   return m;
 }
 

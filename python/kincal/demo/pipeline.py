@@ -35,6 +35,7 @@ from ..io import strict_json
 from ..io.csv_text import format_rows
 
 if TYPE_CHECKING:
+    from .._core import Robot
     from ..typing_ import FloatArray
 
 SEED = 7
@@ -58,6 +59,72 @@ def _table1() -> Optional[Path]:
             if path.exists():
                 return path
     return None
+
+
+def _line(out: Path, b_fit: Robot, identified: Robot, diagnosed: Robot, truth: Robot) -> tuple[Any, ...]:
+    """The demo's line program (taught where the nominal robot with the measured tracker frame puts
+    it), uncompensated and compensated on the identified and the diagnosed models, and what the true
+    robot does with each: the poses, the uncompensated and compensated joints, the compensation's
+    result and the (position, orientation) errors of the three programs on the truth."""
+    w = _core.write_file_atomic
+    base_line = line_program()
+    # the line is taught in the tracker (user) frame: where the nominal robot would put it
+    poses = fk(b_fit, compensate(b_fit, base_line, compensate=False)["q_deg"], frame="instrument")
+    w(str(out / "line.csv"), format_rows(["x", "y", "z", "a", "b", "c"], poses))
+    w(str(out / "line.gcode"), _gcode(poses))
+    unc = _core.compensate_program(b_fit, str(out / "line.gcode"), str(out / "uncompensated.gcode"), compensate=False,
+                                   instrument=True)
+    com = _core.compensate_program(identified, str(out / "line.gcode"), str(out / "compensated.gcode"), instrument=True)
+    _core.compensate_program(identified, str(out / "line.csv"), str(out / "compensated.csv"), instrument=True)
+    com_d = _core.compensate_program(diagnosed, str(out / "line.gcode"), str(out / "compensated_diagnosed.gcode"),
+                                     instrument=True)
+    q_unc, q_com, q_dia = np.asarray(unc["q_deg"]), np.asarray(com["q_deg"]), np.asarray(com_d["q_deg"])
+    # what the true robot does with each program: geometry, compliance and the backlash of joint 2,
+    # which acts with the direction each axis arrives from (the sign of its commanded motion)
+    def on_truth(q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        att = run_program(truth, q, frame="instrument")
+        return (np.linalg.norm(att[:, :3] - poses[:, :3], axis=1),
+                accuracy_demo.orientation_errors_deg(poses[:, 3:], att[:, 3:]))
+    return poses, q_unc, q_com, com, on_truth(q_unc), on_truth(q_com), on_truth(q_dia)
+
+
+def _fivebar(out: Path) -> tuple[dict[str, dict[str, Any]], list[float], dict[Any, Any]]:
+    """The demo's five-bar step: the Kiper paper's Table I fitted three ways (when ../shared has it),
+    the simulated 6-bar's minimax fit and error matrix with their error maps, and the axes' VDI/DGQ
+    3441 figures. Returns the Table I fits, the largest error of the nominal, fitted and corrected
+    mechanism (mm) and the axes' reports."""
+    w = _core.write_file_atomic
+    hdir = out / "fivebar"
+    hdir.mkdir(exist_ok=True)
+    table_fits: dict[str, dict[str, Any]] = {}
+    table = _table1()
+    if table is not None:
+        t1_pts = fb.read_table(str(table))
+        for m, sc in (("polynomial", "desired"), ("lsq", "desired"), ("minimax", "measured")):
+            f = table_fits[f"{m} ({sc} score)"] = fb.fit(t1_pts, m, sc)
+            model = fb.FiveBar(f["a"], f["b"], f["c"], f["d"])  # each fit under both scores, for the table
+            f["largest_mm"] = {sc_: fb.largest_error(model, t1_pts, sc_ == "desired") for sc_ in ("desired", "measured")}
+    sixbar = _core.paper_sixbar(1)
+    tab_xy = np.array([(212.132, 0), (212.132, 75), (262.132, 75), (262.132, 0), (262.132, -75), (212.132, -75),
+                       (162.132, -75), (162.132, 0), (162.132, 75)])
+    rng = np.random.default_rng(SEED)
+    val = np.c_[rng.uniform(163, 261, 400), rng.uniform(-74, 74, 400)]
+    meas9 = _core.sixbar_campaign(sixbar, fb.FiveBar(), None, tab_xy, 0.020, 1)
+    fit = fb.fit(meas9, "minimax")
+    w(str(hdir / "fit.json"), strict_json.dumps(fit, indent=1) + "\n")
+    model = fb.model_of(fit)
+    grid = _core.sixbar_campaign(sixbar, model, None, fb.grid_targets(), 0.001, 2)
+    matrix = _core.ErrorMatrix.from_points(grid, "grid")
+    w(str(hdir / "matrix.json"), matrix.to_json())
+    v0 = _core.sixbar_campaign(sixbar, fb.FiveBar(), None, val, 0.001, 3)
+    v1 = _core.sixbar_campaign(sixbar, model, None, val, 0.001, 4)
+    v2 = _core.sixbar_campaign(sixbar, model, matrix, val, 0.001, 5)
+    fb.error_map_figure([("nominal lengths", v0), ("after the fit", v1), ("after fit + matrix", v2)],
+                        str(hdir / "error_maps.png"))
+    hb = [float(fb.position_errors(v).max()) for v in (v0, v1, v2)]
+    axes = accuracy_demo.fivebar_axes(sixbar, model, matrix, out, SEED)
+
+    return table_fits, hb, axes
 
 
 def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
@@ -92,26 +159,9 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
     w(str(ddir / "model.json"), diagnosed.model_json())
 
     say(4, n_steps, "the paper's line: nominal IK (uncompensated) and Newton compensation on the identified model")
-    base_line = line_program()
     b_fit = res.fit["nominal_fitted"]  # nominal geometry with the measured tracker frame
-    # the line is taught in the tracker (user) frame: where the nominal robot would put it
-    poses = fk(b_fit, compensate(b_fit, base_line, compensate=False)["q_deg"], frame="instrument")
-    w(str(out / "line.csv"), format_rows(["x", "y", "z", "a", "b", "c"], poses))
-    w(str(out / "line.gcode"), _gcode(poses))
-    unc = _core.compensate_program(b_fit, str(out / "line.gcode"), str(out / "uncompensated.gcode"), compensate=False,
-                                   instrument=True)
-    com = _core.compensate_program(res.robot, str(out / "line.gcode"), str(out / "compensated.gcode"), instrument=True)
-    _core.compensate_program(res.robot, str(out / "line.csv"), str(out / "compensated.csv"), instrument=True)
-    com_d = _core.compensate_program(diagnosed.robot, str(out / "line.gcode"), str(out / "compensated_diagnosed.gcode"),
-                                     instrument=True)
-    q_unc, q_com, q_dia = np.asarray(unc["q_deg"]), np.asarray(com["q_deg"]), np.asarray(com_d["q_deg"])
-    # what the true robot does with each program: geometry, compliance and the backlash of joint 2,
-    # which acts with the direction each axis arrives from (the sign of its commanded motion)
-    def on_truth(q: FloatArray) -> tuple[FloatArray, FloatArray]:
-        att = run_program(truth, q, frame="instrument")
-        return (np.linalg.norm(att[:, :3] - poses[:, :3], axis=1),
-                accuracy_demo.orientation_errors_deg(poses[:, 3:], att[:, 3:]))
-    (err_unc, ori_unc), (err_com, ori_com), (err_dia, ori_dia) = on_truth(q_unc), on_truth(q_com), on_truth(q_dia)
+    poses, q_unc, q_com, com, (err_unc, ori_unc), (err_com, ori_com), (err_dia, ori_dia) = _line(
+        out, b_fit, res.robot, diagnosed.robot, truth)
 
     say(5, n_steps, "ISO 9283 on the true robot: the largest cube's test poses, 30 cycles, three programs")
     iso = accuracy_demo.iso9283_runs(robot, b_fit, {
@@ -130,35 +180,7 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
                                            "programs": {k: feedmod.json_ready(v) for k, v in fres.items()}}) + "\n")
 
     say(7, n_steps, "five-bar: the Kiper paper's Table I, fit and error matrix on the simulated 6-bar, VDI/DGQ 3441")
-    hdir = out / "fivebar"
-    hdir.mkdir(exist_ok=True)
-    table_fits: dict[str, dict[str, Any]] = {}
-    table = _table1()
-    if table is not None:
-        t1_pts = fb.read_table(str(table))
-        for m, sc in (("polynomial", "desired"), ("lsq", "desired"), ("minimax", "measured")):
-            f = table_fits[f"{m} ({sc} score)"] = fb.fit(t1_pts, m, sc)
-            model = fb.FiveBar(f["a"], f["b"], f["c"], f["d"])  # each fit under both scores, for the table
-            f["largest_mm"] = {sc_: fb.largest_error(model, t1_pts, sc_ == "desired") for sc_ in ("desired", "measured")}
-    sixbar = _core.paper_sixbar(1)
-    tab_xy = np.array([(212.132, 0), (212.132, 75), (262.132, 75), (262.132, 0), (262.132, -75), (212.132, -75),
-                       (162.132, -75), (162.132, 0), (162.132, 75)])
-    rng = np.random.default_rng(SEED)
-    val = np.c_[rng.uniform(163, 261, 400), rng.uniform(-74, 74, 400)]
-    meas9 = _core.sixbar_campaign(sixbar, fb.FiveBar(), None, tab_xy, 0.020, 1)
-    fit = fb.fit(meas9, "minimax")
-    w(str(hdir / "fit.json"), strict_json.dumps(fit, indent=1) + "\n")
-    model = fb.model_of(fit)
-    grid = _core.sixbar_campaign(sixbar, model, None, fb.grid_targets(), 0.001, 2)
-    matrix = _core.ErrorMatrix.from_points(grid, "grid")
-    w(str(hdir / "matrix.json"), matrix.to_json())
-    v0 = _core.sixbar_campaign(sixbar, fb.FiveBar(), None, val, 0.001, 3)
-    v1 = _core.sixbar_campaign(sixbar, model, None, val, 0.001, 4)
-    v2 = _core.sixbar_campaign(sixbar, model, matrix, val, 0.001, 5)
-    fb.error_map_figure([("nominal lengths", v0), ("after the fit", v1), ("after fit + matrix", v2)],
-                        str(hdir / "error_maps.png"))
-    hb = [float(fb.position_errors(v).max()) for v in (v0, v1, v2)]
-    axes = accuracy_demo.fivebar_axes(sixbar, model, matrix, out, SEED)
+    table_fits, hb, axes = _fivebar(out)
 
     say(8, n_steps, "report")
     summary = {
@@ -203,13 +225,9 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
     return summary
 
 
-def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary: dict[str, Any], err_unc: FloatArray,
-            err_com: FloatArray, err_dia: FloatArray, fres: dict[str, dict[str, Any]],
-            table_fits: dict[str, dict[str, Any]], sections: dict[str, str]) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def _line_figure(plt: Any, path: Path, err_unc: FloatArray, err_com: FloatArray, err_dia: FloatArray) -> None:
+    """The line's errors on the true robot along it: uncompensated, compensated on the identified
+    and on the diagnosed model."""
     fig, ax = plt.subplots(figsize=(10, 3.4), constrained_layout=True)
     s_mm = np.arange(len(err_unc)) * 5.0
     ax.plot(s_mm, err_unc, label="uncompensated (nominal IK)")
@@ -219,8 +237,18 @@ def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary:
     ax.set_ylabel("error on the true robot (mm)")
     ax.set_yscale("log")
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside the curves, never on them
-    fig.savefig(out / "line_errors.png", dpi=100)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary: dict[str, Any], err_unc: FloatArray,
+            err_com: FloatArray, err_dia: FloatArray, fres: dict[str, dict[str, Any]],
+            table_fits: dict[str, dict[str, Any]], sections: dict[str, str]) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    _line_figure(plt, out / "line_errors.png", err_unc, err_com, err_dia)
 
     v = res.validation
     ident_rows = [["fitted poses", f"{res.fit['nominal_rms_mm']:.3f}", f"{res.fit['rms_mm']:.3f}",

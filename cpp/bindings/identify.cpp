@@ -193,6 +193,14 @@ void define_identify(py::module_& m) {
       "each row seen from its setup's placement, the model's drift at the row's time); a probe row's error\n"
       "along its constraint against its station among `stations` (NaN when not among them)");
   m.def(
+      "check_effect_columns",
+      [](const Robot& r, const py::dict& d, const std::vector<Effect>& effects) {
+        check_effect_columns(*r.nominal, measurements_from_dict(d, r.nominal->dof()), effects);
+      },
+      py::arg("robot"), py::arg("data"), py::arg("effects"),
+      "ValueError (file:line of the first row without it) unless the data carry every column the effects\n"
+      "read (the registry's needs: temperature_c, time_s, dir1..dirN)");
+  m.def(
       "orientation_errors",
       [](const Robot& r, const py::dict& d) {
         const auto e = orientation_errors(*r.calibrated, measurements_from_dict(d, r.calibrated->dof()));

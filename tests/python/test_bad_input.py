@@ -69,6 +69,13 @@ def _cases():
          ["identify", "--robot", "kr500", "--data", "{d}/m.csv", "--out", "OUT"], "m.csv"),
         ("identify-unknown-effect", {"m.csv": MEAS_HEAD + "0,0,-90,90,0,5,0,1,2,3\n"},
          ["identify", "--robot", "kr500", "--data", "{d}/m.csv", "--out", "OUT", "--effects", "magic"], "magic"),
+        # an effect whose column the data lack: the core's check names the first row without it
+        ("identify-effect-column", {"m.csv": MEAS_HEAD + "".join(f"{i},{i},-90,90,0,{5 + i},0,1,2,3\n" for i in range(30))},
+         ["identify", "--robot", "kr500", "--data", "{d}/m.csv", "--out", "OUT", "--effects", "backlash:2"],
+         "m.csv:2: backlash needs the dir1..dir6 columns (the sign of each joint's last motion into the pose)"),
+        ("identify-time-column", {"m.csv": MEAS_HEAD + "".join(f"{i},{i},-90,90,0,{5 + i},0,1,2,3\n" for i in range(30))},
+         ["identify", "--robot", "kr500", "--data", "{d}/m.csv", "--out", "OUT", "--effects", "drift"],
+         "m.csv:2: drift needs the time_s column (when each point was measured, s)"),
         ("identify-dir-value", {"m.csv": "pose,q1,q2,q3,q4,q5,q6,x,y,z,dir1,dir2,dir3,dir4,dir5,dir6\n"
                                 "0,0,-90,90,0,5,0,1,2,3,1,1,2,1,1,1\n"},
          ["identify", "--robot", "kr500", "--data", "{d}/m.csv", "--out", "OUT"], "m.csv:2"),

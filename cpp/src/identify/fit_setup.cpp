@@ -85,23 +85,6 @@ std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOpti
   return effects;
 }
 
-/// InputError unless the effects are valid for the robot and the data carry the columns they read
-/// (the registry's needs: temperature_c, time_s, dir1..dirN).
-void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
-  for (const Effect& e : effects) check_effect(e, nominal.dof(), "");
-  for (const Effect& e : effects) {  // the column each effect reads (the registry's "needs")
-    const std::string& column = e.kind().needs;
-    for (const auto& r : data.rows) {
-      if (column == "temperature_c" && std::isnan(r.temperature_c))
-        throw InputError(where(data, r) + ": " + e.name + " needs the temperature_c column");
-      if (column == "time_s" && std::isnan(r.time_s))
-        throw InputError(where(data, r) + ": " + e.name + " needs the time_s column");
-      if (column == "dir" && r.dir.size() != nominal.dof())
-        throw InputError(where(data, r) + ": " + e.name + " needs the dir1..dir" + std::to_string(nominal.dof()) +
-                         " columns");
-    }
-  }
-}
 
 /// The reference temperature of thermal_expansion: the starting model's, or the mean of the data's
 /// when the effect is new to the model.
@@ -158,3 +141,25 @@ std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResul
 }
 
 }  // namespace kincal::fit_setup
+
+namespace kincal {
+
+/// InputError unless the effects are valid for the robot and the data carry the columns they read
+/// (identify.hpp).
+void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects) {
+  for (const Effect& e : effects) check_effect(e, nominal.dof(), "");
+  for (const Effect& e : effects) {  // the column each effect reads (the registry's "needs")
+    const std::string& column = e.kind().needs;
+    for (const auto& r : data.rows) {
+      if (column == "temperature_c" && std::isnan(r.temperature_c))
+        throw InputError(fit_setup::where(data, r) + ": " + e.name + " needs the temperature_c column");
+      if (column == "time_s" && std::isnan(r.time_s))
+        throw InputError(fit_setup::where(data, r) + ": " + e.name + " needs the time_s column (when each point was measured, s)");
+      if (column == "dir" && r.dir.size() != nominal.dof())
+        throw InputError(fit_setup::where(data, r) + ": " + e.name + " needs the dir1..dir" + std::to_string(nominal.dof()) +
+                         " columns (the sign of each joint's last motion into the pose)");
+    }
+  }
+}
+
+}  // namespace kincal

@@ -20,9 +20,6 @@ const MeasurementSet& measured_artifact(const MeasurementSet& data, MeasurementS
 /// The extra effects: those asked for, then those the starting model carries (held at their values),
 /// but its drift: a property of the campaign it was measured on, not of the robot.
 std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt);
-/// InputError unless the effects are valid for the robot and the data carry the columns they read
-/// (the registry's needs: temperature_c, time_s, dir1..dirN).
-void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects);
 /// The reference temperature of thermal expansion: the starting model's, or the mean of the data's
 /// when the effect is new to the model.
 double reference_temperature(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects);

@@ -123,13 +123,5 @@ def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effec
 def check_data(effects: Sequence[Candidate], data: dict[str, Any], robot: Robot) -> None:
     """The data columns the effects read (the registry's ``needs``) are present: a clear error names
     the file and the column otherwise."""
-    src = data.get("source", "<data>")
-    for e in effects:
-        need = _core.effect_kind(e.name).needs
-        if need == "dir" and "dir" not in data:
-            raise ValueError(f"{src}: {e.label} needs the dir1..dir{robot.dof} columns (the sign of each joint's "
-                             "last motion into the pose)")
-        if need == "temperature_c" and "temperature_c" not in data:
-            raise ValueError(f"{src}: {e.label} needs the temperature_c column")
-        if need == "time_s" and "time_s" not in data:
-            raise ValueError(f"{src}: {e.label} needs the time_s column (when each point was measured, s)")
+    # the core's check (JointCompliance reads no column of its own)
+    _core.check_effect_columns(robot, data, [e for e in effects if isinstance(e, _core.Effect)])

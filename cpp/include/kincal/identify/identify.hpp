@@ -111,4 +111,9 @@ struct IdentifyResult {
 /// are too few for the free parameters.
 IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt);
 
+/// InputError unless the effects are valid for the robot and the data carry the columns they read
+/// (the registry's needs: temperature_c, time_s, dir1..dirN), naming the file and line of the first
+/// row without it: the one check identify() and Python's effect choice make.
+void check_effect_columns(const Model& nominal, const MeasurementSet& data, const std::vector<Effect>& effects);
+
 }  // namespace kincal

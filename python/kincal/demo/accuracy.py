@@ -45,7 +45,7 @@ AXIS_TARGETS = 11
 RUNS_HEAD = ["point", "cycle", "xc", "yc", "zc", "ac", "bc", "cc", "x", "y", "z", "a", "b", "c"]
 
 
-def orientation_errors_deg(a: FloatArray, b: FloatArray) -> FloatArray:
+def angles_between_deg(a: FloatArray, b: FloatArray) -> FloatArray:
     """Angle (deg) of the rotation between the orientations (KUKA ABC, deg) of the rows of a and b."""
     out = np.empty(len(a))
     for i, (u, v) in enumerate(zip(a, b)):

@@ -84,7 +84,7 @@ def _line(out: Path, b_fit: Robot, identified: Robot, diagnosed: Robot, truth: R
     def on_truth(q: FloatArray) -> tuple[FloatArray, FloatArray]:
         att = run_program(truth, q, frame="instrument")
         return (np.linalg.norm(att[:, :3] - poses[:, :3], axis=1),
-                accuracy_demo.orientation_errors_deg(poses[:, 3:], att[:, 3:]))
+                accuracy_demo.angles_between_deg(poses[:, 3:], att[:, 3:]))
     return poses, q_unc, q_com, com, on_truth(q_unc), on_truth(q_com), on_truth(q_dia)
 
 

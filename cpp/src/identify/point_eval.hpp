@@ -136,6 +136,12 @@ class PointEval {
   /// The joint frames G_0..G_n of row m with compliance and effects acting, and the thermal scale.
   void row_frames(const Model& model, const Measurement& m, GravityState& gs, std::array<Mat3, kMaxJoints + 1>& gr,
                   std::array<Vec3, kMaxJoints + 1>& gt, double& scale) const;
+  /// The extra effects' columns of a row (jac_rot: their angular velocities, or null): a joint-angle
+  /// effect's through its joint's rates jp, jw (scaled with the robot's point), thermal expansion's
+  /// through the unscaled point xr; rb: the row's instrument placement (rotation).
+  void effect_columns(const Measurement& m, const VecQ& q, const Mat3& rb, const Vec3& xr,
+                      const std::array<Vec3, kMaxJoints>& jp, const std::array<Vec3, kMaxJoints>& jw, double scale,
+                      double* jac, double* jac_rot) const;
   /// rb: the row's instrument placement (rotation).
   void add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
                         const std::array<Vec3, kMaxJoints>& jw, const Mat3& rb, double* jac,

@@ -381,30 +381,33 @@ Vec3 PointEval::predict(const Measurement& m, double* jac, Mat3* rot, double* ja
   for (int j = 0; j < n; ++j) jw[j] = gr[j] * w_[j];
   if (!layout_.loaded.empty() && model.has_compliance())
     add_torque_terms(model, gs, jp, jw, rb, J.data(), ang ? W.data() : nullptr);
+  if (!layout_.effect_list.empty()) effect_columns(m, q, rb, xr, jp, jw, scale, jac, ang ? jac_rot : nullptr);
+  if (scale != 1.0) J.leftCols(layout_.base) *= scale;  // every column through the robot's point scales with it
+  return y;
+}
+
+void PointEval::effect_columns(const Measurement& m, const VecQ& q, const Mat3& rb, const Vec3& xr,
+                               const std::array<Vec3, kMaxJoints>& jp, const std::array<Vec3, kMaxJoints>& jw,
+                               double scale, double* jac, double* jac_rot) const {
+  const int P = layout_.size;
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(jac, 3, P);
+  double dummy[3];
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> W(jac_rot ? jac_rot : dummy, 3, jac_rot ? P : 1);
   for (size_t e = 0; e < layout_.effect_list.size(); ++e) {
     const Effect& ef = layout_.effect_list[e];
     const int c = layout_.effect_offset[e];
     const EffectKind& kind = ef.kind();
-    if (kind.of_instrument()) continue;  // the instrument's, above
-    if (!kind.scales_lengths()) {  // joint-angle effects: dq_j = p . basis
+    if (kind.of_instrument()) continue;  // the instrument's: predict()'s drift columns
+    if (!kind.scales_lengths()) {  // joint-angle effects: dq_j = p . basis, scaled with the robot's point
       double b[128];
       joint_basis(ef, q[ef.joint], kind.reads_dir() ? m.dir[ef.joint] : 0.0, b);
-      for (int k = 0; k < ef.size(); ++k) J.col(c + k) = rb * jp[ef.joint] * b[k];
-      if (ang)
+      for (int k = 0; k < ef.size(); ++k) J.col(c + k) = scale * (rb * jp[ef.joint] * b[k]);
+      if (jac_rot)
         for (int k = 0; k < ef.size(); ++k) W.col(c + k) = rb * jw[ef.joint] * b[k];
-    } else {
+    } else {  // thermal's own column: not scaled
       J.col(c) = rb * xr * (m.temperature_c - layout_.t_ref);
     }
   }
-  if (scale != 1.0) {
-    // every column through the robot's point scales with it (not the bases', not thermal's own, not
-    // the drift's)
-    J.leftCols(layout_.base) *= scale;
-    for (size_t e = 0; e < layout_.effect_list.size(); ++e)
-      if (!layout_.effect_list[e].kind().scales_lengths() && !layout_.effect_list[e].kind().of_instrument())
-        J.middleCols(layout_.effect_offset[e], layout_.effect_list[e].size()) *= scale;
-  }
-  return y;
 }
 
 }  // namespace detail

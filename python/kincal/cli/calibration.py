@@ -16,8 +16,8 @@ from ..io import strict_json
 from ..io.urdf import spec_urdf, urdf_left_out
 from .. import report
 from ..calibration import simulation as sim
-from .options import (artifact_opt, effect_opts, effects_arg, fit_options, fit_opts, harmonics_option, loss_opts, progress,
-                      robot_of, robot_opts, say, step_progress, tool_targets)
+from .options import (artifact_opt, effect_opts, effects_arg, fit_options, fit_opts, harmonics_option, loss_opts,
+                      progress, robot_of, robot_opts, say, step_progress, tool_targets)
 
 
 def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.Robot) -> None:
@@ -35,6 +35,8 @@ def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.R
     _core.write_file_atomic(args.out, text)
     if artifact:
         _core.write_file_atomic(art, artifact)
+    if args.truth_out and not args.truth:  # the truth drawn, once the campaign on it was made
+        _core.write_file_atomic(args.truth_out, truth.to_json())
     print(f"wrote {len(data['pose'])} {args.kind} rows at {len(data['station_names'])} stations to {args.out}"
           + (f", their known distances and angles to {art}" if artifact else ""), file=sys.stderr)
 
@@ -47,8 +49,6 @@ def cmd_simulate(args: argparse.Namespace) -> None:
             raise ValueError(f"{args.truth}: {truth.dof} joints but {args.robot} has {robot.dof}")
     else:
         truth = ident.default_truth(robot, seed=args.seed)
-    if args.truth_out and not args.truth and args.kind:
-        _core.write_file_atomic(args.truth_out, truth.to_json())
     if args.kind:
         _simulate_probe(args, robot, truth)
         return

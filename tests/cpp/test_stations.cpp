@@ -31,6 +31,34 @@ const char* kMixed =
 /// The ball centre (tool frame offset `probe`) of a model at q, base frame.
 Vec3 ball(const Model& m, const VecQ& q_deg, const Vec3& probe) { return fk_compliant(m, q_deg * kDeg) * probe; }
 
+/// The 200 random configurations (10 deg inside the kr500's limits) the accuracy is scored on.
+std::vector<Vec6> scoring_configurations(unsigned seed) {
+  const Model nominal(kr500_spec());
+  std::mt19937_64 rng(seed);
+  std::vector<Vec6> qs;
+  for (int k = 0; k < 200; ++k) qs.push_back(test::random_q(nominal, rng, 10.0));
+  return qs;
+}
+
+/// The ball centres of a model at every configuration.
+Eigen::Matrix3Xd balls(const Model& m, const std::vector<Vec6>& qs, const Vec3& probe) {
+  Eigen::Matrix3Xd out(3, static_cast<Eigen::Index>(qs.size()));
+  for (size_t k = 0; k < qs.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = ball(m, qs[k], probe);
+  return out;
+}
+
+/// A probe campaign's options: the ball 150 mm out on the tool, the simulator's noise (0.005 mm).
+ProbeSimulationOptions probe_options(MeasureKind kind, int stations, int touches, double cone_deg, unsigned seed) {
+  ProbeSimulationOptions so;
+  so.kind = kind;
+  so.stations = stations;
+  so.touches = touches;
+  so.cone_deg = cone_deg;
+  so.probe = Vec3(0, 0, 150);
+  so.seed = seed;
+  return so;
+}
+
 }  // namespace
 
 TEST(Stations, CsvRowsAndRoundTrip) {
@@ -93,12 +121,9 @@ TEST(Stations, JacobiansMatchFiniteDifferences) {
   const Model truth(truth_spec(41, 0.003)), nominal(kr500_spec());
   for (MeasureKind kind : {MeasureKind::sphere, MeasureKind::plane, MeasureKind::distance}) {
     SCOPED_TRACE(to_string(kind));
-    ProbeSimulationOptions so;
-    so.kind = kind;
-    so.stations = kind == MeasureKind::plane ? 3 : 2;
-    so.touches = 5;
+    // the simulator's default cone (35 deg); the ball off the tool's axis, so that every target column acts
+    ProbeSimulationOptions so = probe_options(kind, kind == MeasureKind::plane ? 3 : 2, 5, 35, test::test_seed(42));
     so.probe = Vec3(10, -20, 150);
-    so.seed = test::test_seed(42);
     const MeasurementSet d = simulate_probe(truth, so);
     LayoutOptions lo(1);
     lo.station_names = d.station_names;
@@ -172,20 +197,8 @@ Accuracy probe_accuracy(const Model& truth, const MeasurementSet& d, const Vec3&
   opt.prior_scale = prior_scale;
   const IdentifyResult res = identify(nominal, d, opt);
   const Model cal(res.calibrated);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> ud(-0.4, 0.4);
-  const int n = 200;
-  Eigen::Matrix3Xd t(3, n), c(3, n), z(3, n);
-  for (int k = 0; k < n; ++k) {
-    VecQ q(6);
-    for (int j = 0; j < 6; ++j) {
-      const JointSpec& js = nominal.spec().joints[j];
-      q[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg);
-    }
-    t.col(k) = ball(truth, q, probe);
-    c.col(k) = ball(cal, q, res.targets[0]);
-    z.col(k) = ball(nominal, q, probe);
-  }
+  const std::vector<Vec6> qs = scoring_configurations(seed);
+  const Eigen::Matrix3Xd t = balls(truth, qs, probe), c = balls(cal, qs, res.targets[0]), z = balls(nominal, qs, probe);
   auto rms_after_fit = [&](const Eigen::Matrix3Xd& a) {
     const Eigen::Isometry3d f = rigid_fit(a, t);
     return std::sqrt(((f * a) - t).colwise().squaredNorm().mean());
@@ -199,21 +212,16 @@ Accuracy probe_accuracy(const Model& truth, const MeasurementSet& d, const Vec3&
 // Identification from spheres with a length bar. Truth: the kr500 with 1 mm / 0.05 deg geometric
 // errors and joint compliance; 6 spheres x 25 touches in a 60 deg cone, the probe's ball 150 mm out
 // on the tool, 0.005 mm noise, the distances of the stations from the first known (the artifact).
-// Accuracy: RMS of the ball centre on 200 random configurations against the noise-free truth after
+// Accuracy: RMS of the ball centre on 200 random configurations (10 deg inside the limits) against the
+// noise-free truth after
 // the best rigid transform (the base frame is free in these data).
 TEST(Stations, SpheresWithALengthBarRecoverTheRobot) {
   KINCAL_SEED_TRACE(51, 52, 53);
   const Model truth(truth_spec(51, 0.003));
-  ProbeSimulationOptions so;
-  so.kind = MeasureKind::sphere;
-  so.stations = 6;
-  so.touches = 25;
-  so.cone_deg = 60;
-  so.probe = Vec3(0, 0, 150);
-  so.seed = test::test_seed(52);
+  const ProbeSimulationOptions so = probe_options(MeasureKind::sphere, 6, 25, 60, test::test_seed(52));
   const Accuracy a = probe_accuracy(truth, simulate_probe(truth, so), so.probe, test::test_seed(53), "spheres");
   EXPECT_GT(a.nominal, 1.0);
-  EXPECT_LT(a.identified, 0.05);  // measured 0.007 mm
+  EXPECT_LT(a.identified, 0.05);  // measured 0.0075 mm
   EXPECT_LT(a.fit_rms, 0.02);  // the fit reaches the noise (0.005 mm per axis)
 }
 
@@ -224,26 +232,14 @@ TEST(Stations, SpheresWithALengthBarRecoverTheRobot) {
 TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
   KINCAL_SEED_TRACE(61, 62, 63, 64);
   const Model truth(truth_spec(61, 0.003));
-  ProbeSimulationOptions planes;
-  planes.kind = MeasureKind::plane;
-  planes.stations = 4;
-  planes.touches = 40;
+  ProbeSimulationOptions planes = probe_options(MeasureKind::plane, 4, 40, 60, test::test_seed(62));
   planes.block_mm = 400;
-  planes.cone_deg = 60;
-  planes.probe = Vec3(0, 0, 150);
-  planes.seed = test::test_seed(62);
   const MeasurementSet faces = simulate_probe(truth, planes);
   ASSERT_EQ(faces.artifact.size(), 4u);  // 3 angles, 1 edge
   const Accuracy a = probe_accuracy(truth, faces, planes.probe, test::test_seed(63), "block faces");
-  EXPECT_LT(a.identified, 0.1);  // measured 0.037 mm (a 120 mm block in a 35 deg cone: 3 mm, nothing determined)
-  ProbeSimulationOptions bar;
-  bar.kind = MeasureKind::distance;
-  bar.stations = 4;
-  bar.touches = 40;
-  bar.cone_deg = 60;
+  EXPECT_LT(a.identified, 0.1);  // measured 0.038 mm (a 120 mm block in a 35 deg cone: 3 mm, nothing determined)
+  ProbeSimulationOptions bar = probe_options(MeasureKind::distance, 4, 40, 60, test::test_seed(64));
   bar.noise_mm = 0.002;
-  bar.probe = Vec3(0, 0, 150);
-  bar.seed = test::test_seed(64);
   const Accuracy b = probe_accuracy(truth, simulate_probe(truth, bar), bar.probe, test::test_seed(63), "ballbar");
   EXPECT_GT(b.nominal, 1.0);
   EXPECT_LT(b.identified, 0.05);  // measured 0.011 mm
@@ -256,13 +252,7 @@ TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
 TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
   KINCAL_SEED_TRACE(51, 52, 53);
   const Model truth(truth_spec(51, 0.003)), nominal(kr500_spec());
-  ProbeSimulationOptions so;
-  so.stations = 6;
-  so.touches = 25;
-  so.cone_deg = 60;
-  so.probe = Vec3(0, 0, 150);
-  so.seed = test::test_seed(52);
-  const MeasurementSet with = simulate_probe(truth, so);
+  const MeasurementSet with = simulate_probe(truth, probe_options(MeasureKind::sphere, 6, 25, 60, test::test_seed(52)));
   MeasurementSet without = with;
   without.artifact.clear();
   IdentifyOptions opt;
@@ -270,20 +260,8 @@ TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
   const IdentifyResult a = identify(nominal, with, opt), b = identify(nominal, without, opt);
   EXPECT_TRUE(a.scale_determined);
   EXPECT_FALSE(b.scale_determined);
-  const Model ma(a.calibrated), mb(b.calibrated);
-  std::mt19937_64 rng(test::test_seed(53));
-  std::uniform_real_distribution<double> ud(-0.4, 0.4);
-  const int n = 200;
-  Eigen::Matrix3Xd pa(3, n), pb(3, n);
-  for (int k = 0; k < n; ++k) {
-    VecQ q(6);
-    for (int j = 0; j < 6; ++j) {
-      const JointSpec& js = nominal.spec().joints[j];
-      q[j] = 0.5 * (js.lower_deg + js.upper_deg) + ud(rng) * (js.upper_deg - js.lower_deg);
-    }
-    pa.col(k) = ball(ma, q, a.targets[0]);
-    pb.col(k) = ball(mb, q, b.targets[0]);
-  }
+  const std::vector<Vec6> qs = scoring_configurations(test::test_seed(53));
+  const Eigen::Matrix3Xd pa = balls(Model(a.calibrated), qs, a.targets[0]), pb = balls(Model(b.calibrated), qs, b.targets[0]);
   const Eigen::Matrix4d sim = Eigen::umeyama(pb, pa, true);
   const Eigen::Matrix3Xd moved = (sim.topLeftCorner<3, 3>() * pb).colwise() + sim.topRightCorner<3, 1>();
   const double rms = std::sqrt((moved - pa).colwise().squaredNorm().mean());
@@ -310,13 +288,7 @@ TEST(Stations, ATrackerCampaignWithASphereStation) {
   tr.targets = {probe};
   tr.seed = test::test_seed(72);
   const MeasurementSet tracker = simulate(truth, tr);
-  ProbeSimulationOptions so;
-  so.stations = 1;
-  so.touches = 25;
-  so.cone_deg = 60;
-  so.probe = probe;
-  so.seed = test::test_seed(73);
-  const MeasurementSet sphere = simulate_probe(truth, so);
+  const MeasurementSet sphere = simulate_probe(truth, probe_options(MeasureKind::sphere, 1, 25, 60, test::test_seed(73)));
   MeasurementSet both = tracker;
   both.station_names = sphere.station_names;
   both.station_kinds = sphere.station_kinds;

@@ -19,12 +19,9 @@ from conftest import run
 
 
 def _rigid_rms(a: np.ndarray, b: np.ndarray) -> float:
-    """RMS distance between the points a and b after the best rigid transform of a onto b."""
-    ca, cb = a.mean(0), b.mean(0)
-    u, _, vt = np.linalg.svd((a - ca).T @ (b - cb))
-    d = np.sign(np.linalg.det(vt.T @ u.T))
-    r = vt.T @ np.diag([1, 1, d]) @ u.T
-    return float(np.sqrt(np.mean(np.sum(((a - ca) @ r.T + cb - b) ** 2, axis=1))))
+    """RMS distance between the points a and b after the best rigid transform of a onto b (the core's fit)."""
+    m = _core.rigid_fit(a, b)
+    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
 
 
 def _balls(robot: kincal.Robot, q: np.ndarray, offset: np.ndarray) -> np.ndarray:

@@ -131,8 +131,8 @@ def test_reflectors_only_record_a_nominal_tcp(reflector_model):
     doc = json.loads((d / "m.json").read_text())
     assert doc["tcp"] == "nominal"
     tcp_lines = [ln for ln in stdout.splitlines() if ln.startswith("TCP:")]
-    assert tcp_lines == ["TCP: nominal (reflectors only place themselves, not the tool frame; --tool-targets or a "
-                         "6-D row measures it)"]
+    assert tcp_lines == ["TCP: nominal (reflectors, or a probe's ball, place only themselves, not the tool frame; "
+                         "--tool-targets or a 6-D row measures it)"]
 
 
 def test_tool_targets_record_where_the_tcp_comes_from(reflector_model, tmp_path):

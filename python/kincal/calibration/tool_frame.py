@@ -52,8 +52,8 @@ def _abc_of(r: FloatArray) -> list[float]:
 _TCP_LINES = {
     "measured": "TCP: measured (the frame the 6-D rows measure is the tool frame, identified with the rest)",
     "tool-targets": "TCP: placed by --tool-targets (the targets' known offsets in the tool frame)",
-    "nominal": "TCP: nominal (reflectors only place themselves, not the tool frame; --tool-targets or a 6-D row "
-               "measures it)",
+    "nominal": "TCP: nominal (reflectors, or a probe's ball, place only themselves, not the tool frame; "
+               "--tool-targets or a 6-D row measures it)",
 }
 
 

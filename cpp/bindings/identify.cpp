@@ -335,6 +335,9 @@ void define_identify(py::module_& m) {
                      "the compliance of their joints on")
       .def_readwrite("orientation_weight", &IdentifyOptions::orientation_weight,
                      "mm per rad: how orientation residuals weigh against positions")
+      .def_readwrite("target_start", &IdentifyOptions::target_start,
+                     "where each target's offset on the tool starts (mm, tool frame; empty: the origin), e.g. a\n"
+                     "probe's nominal ball offset")
       .def_readwrite("penalties", &IdentifyOptions::penalties,
                      "ridge penalties (parameter name, weight in mm per unit of the parameter), e.g. a joint_map's\n"
                      "smoothness penalty (assign a whole list)");

@@ -101,7 +101,8 @@ void define_measurement_model(py::module_& m) {
            }, py::arg("data"))
       .def(
           "residuals",
-          [](const PyPointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight) {
+          [](const PyPointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight,
+             bool artifact) {
             const ParamLayout& L = p.pm.layout();
             const MeasurementSet data = measurements_from_dict(d, L.dof);
             if (static_cast<int>(x.size()) != L.size) throw InputError("PointModel: wrong parameter count");
@@ -110,15 +111,22 @@ void define_measurement_model(py::module_& m) {
                                std::to_string(L.n_setups) + " setups in that order)");
             const PointState at = PointModel(*p.model, p.options, &data).at(x);
             const size_t n = residual_size(residual_kind(data)) * data.rows.size();
+            const size_t na = artifact ? data.artifact.size() : 0;
             std::vector<int> every(L.size);
             std::iota(every.begin(), every.end(), 0);
-            Eigen::VectorXd r(n);
-            RowMatrix J(jac ? n : 0, L.size);
+            Eigen::VectorXd r(n + na);
+            RowMatrix J(jac ? n + na : 0, L.size);
             {
               py::gil_scoped_release free;  // the rows run on the core's threads
               all_residuals(at, data, weight, every, r.data(), jac ? J.data() : nullptr);
+              for (size_t k = 0; k < na; ++k)
+                r[static_cast<Eigen::Index>(n + k)] =
+                    at.artifact_residual(data.artifact[k], jac ? J.row(static_cast<Eigen::Index>(n + k)).data() : nullptr);
             }
             return py::make_tuple(r, J);
           },
-          py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0);
+          py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0,
+          py::arg("artifact") = false,
+          "The rows' residuals (residual_size per row, unused equations 0) and with `artifact` the\n"
+          "artifact's terms after them (mm: a length's error, an angle's on a 1 m lever)");
 }

@@ -315,6 +315,7 @@ class IdentifyOptions:
     effects: list[Effect]
     orientation_weight: float
     penalties: list[tuple[str, float]]
+    target_start: list[np.ndarray]
     prior_sd: list[tuple[str, float]]
     prior_scale: float
     def __init__(self, compliance: bool = ..., loss: str = ..., loss_scale_mm: float = ..., max_iterations: int = ...,
@@ -415,7 +416,7 @@ class PointModel:
     def names(self) -> list[str]: ...
     def start(self, data: dict[str, Any]) -> list[float]: ...
     def residuals(self, x: Sequence[float], data: dict[str, Any], jacobian: bool = ...,
-                  orientation_weight: float = ...) -> tuple[np.ndarray, np.ndarray]: ...
+                  orientation_weight: float = ..., artifact: bool = ...) -> tuple[np.ndarray, np.ndarray]: ...
 
 # five-bar hidden robot (a point set is a dict: id, theta1_deg, theta2_deg, desired, measured, line)
 class FiveBar:

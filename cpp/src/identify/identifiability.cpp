@@ -221,14 +221,20 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
 }
 
 
-/// With priors: what a generic campaign leaves redundant is held as without them; of the rest,
-/// what these data leave redundant or barely seen (the greedy selection on the data, parameters
-/// without a prior kept first so that the ones the prior determines are those left) stays free,
-/// determined by its prior (res.at_prior), or is held when it has no prior.
+/// With priors: what these data leave redundant or barely seen (the greedy selection on the data,
+/// parameters without a prior kept first so that the ones the prior determines are those left)
+/// stays free, determined by its prior (res.at_prior), or is held when it has no prior. What a
+/// generic campaign leaves redundant is held as without priors, except on probe data (`probe`) when
+/// it has a prior: the generic campaign is a tracker's, its base frame free, while the stations
+/// absorb the base frame otherwise, and a maximum a posteriori fit that holds a parameter at its
+/// prior's centre forces the others to carry its share at their own prior's cost (four probed
+/// faces: 0.17 mm held, 0.058 mm free, tests/python/test_probe_map.py). On a tracker's data those
+/// are exact redundancies (the tool frame beside the targets): held, the model does not drift along
+/// directions only a prior sees.
 void at_prior(const Linearization& lin, const IdentifyResult& generic, const std::vector<int>& order,
-              const IdentifyOptions& opt, const std::vector<double>& prior_sd, IdentifyResult& res) {
+              const IdentifyOptions& opt, const std::vector<double>& prior_sd, bool probe, IdentifyResult& res) {
   for (int i = 0; i < res.layout.size; ++i)
-    if (generic.fixed[i] && !res.fixed[i]) res.fix(i, generic.fixed_reason[i]);
+    if (generic.fixed[i] && !res.fixed[i] && !(probe && std::isfinite(prior_sd[i]))) res.fix(i, generic.fixed_reason[i]);
   std::vector<int> data_order;
   for (int pass = 0; pass < 2; ++pass)
     for (int i : order)
@@ -462,7 +468,7 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
   Linearization lin = linearize(pm, data, xp, opt.orientation_weight);
   res.at_prior.assign(L.size, false);
   if (std::any_of(prior_sd.begin(), prior_sd.end(), [](double s) { return std::isfinite(s); })) {
-    at_prior(lin, generic, order, opt, prior_sd, res);
+    at_prior(lin, generic, order, opt, prior_sd, data.has_probe(), res);
     return start_at(pm, data, opt, res, xp, x, lin);
   }
   select_independent(lin.jacobian, order, opt, res);

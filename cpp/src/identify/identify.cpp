@@ -422,9 +422,10 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   LayoutOptions lo(data.n_targets, effects, t_ref, data.setup_names, t_mean, fit_gravity);
   lo.station_names = data.station_names;
   lo.station_kinds = data.station_kinds;
+  lo.target_start = opt.target_start;
   const PointModel pm(nominal, lo, &data);
   IdentifyResult res(pm.layout());
-  res.start = pm.start(data);
+  res.start = pm.start(data, opt.target_start);
   res.fixed.assign(res.layout.size, false);
   res.fixed_reason.assign(res.layout.size, "");
   start_carried_effects(nominal, opt, res);

@@ -30,6 +30,7 @@ struct PointStructure {
   /// every station's reference normal (planes: towards the flange; stations.cpp) and two unit
   /// directions normal to it, along which its tilt parameters turn it
   std::vector<Vec3> station_normal, station_u, station_v;
+  std::vector<Vec3> target_start;  ///< the targets' start (LayoutOptions::target_start)
   /// The reference normals: the layout's when it has them, else from the data (the plane through
   /// each plane station's nominal ball centres, towards the flange), else z; stored in the layout.
   void init_stations(const MeasurementSet* data);

@@ -131,6 +131,7 @@ PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, c
       if (!std::isnan(r.payload_kg) && r.payload_kg != nominal.spec().payload_kg) pays.insert(r.payload_kg);
     payloads.assign(pays.begin(), pays.end());
   }
+  target_start = options.target_start;
   init_stations(data);
 }
 
@@ -415,9 +416,14 @@ void PointEval::effect_columns(const Measurement& m, const VecQ& q, const Mat3& 
 PointModel::PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data)
     : s_(std::make_shared<const detail::PointStructure>(nominal, options, data)) {}
 
-std::vector<double> PointModel::start(const MeasurementSet& data) const {
+std::vector<double> PointModel::start(const MeasurementSet& data, const std::vector<Vec3>& targets) const {
   const ParamLayout& L = s_->layout;
   std::vector<double> x(L.size, 0.0);
+  if (!targets.empty() && static_cast<int>(targets.size()) != L.n_targets)
+    throw InputError("identify: " + std::to_string(targets.size()) + " target start(s) for the data's " +
+                     std::to_string(L.n_targets) + " target(s)");
+  for (size_t t = 0; t < targets.size(); ++t)
+    for (int k = 0; k < 3; ++k) x[static_cast<size_t>(L.targets) + 3 * t + static_cast<size_t>(k)] = targets[t][k];
   for (size_t i = 0; i < L.loaded.size(); ++i)
     x[L.compliance + i] = s_->nominal.spec().joints[L.loaded[i]].compliance_deg_per_knm;
   // each setup's frame from the nominal prediction of the tool point matched to its points (Horn)

@@ -176,7 +176,8 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
       seed = seed_pose(ref);
       centre = seed * opt.probe;
       axis = seed.linear().col(2);
-      if (opt.kind == MeasureKind::distance) centre -= Vec3::UnitZ() * opt.length_mm;  // the pivot below
+      // the pivot on the probe's axis beyond the ball (the bar cannot pass through the tool)
+      if (opt.kind == MeasureKind::distance) centre += axis * opt.length_mm;
       points.push_back(centre);
     }
     int made = 0, tries = 0;
@@ -201,8 +202,9 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
         c = centre + Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
         r = tilt(rng, axis, cone) * seed.linear();
       } else {
-        // the bar's direction within the cone about the vertical, the tool turned within half of it
-        const Vec3 d = tilt(rng, Vec3::UnitZ(), cone) * Vec3::UnitZ();
+        // the bar's direction (pivot to ball) within the cone about the probe's axis reversed, the
+        // tool turned within half of it
+        const Vec3 d = tilt(rng, -axis, cone) * -axis;
         c = centre + d * opt.length_mm;
         r = tilt(rng, axis, 0.5 * cone) * seed.linear();
         row.length_mm = opt.length_mm + opt.noise_mm * nd(rng);

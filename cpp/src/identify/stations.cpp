@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace kincal {
 
@@ -69,9 +70,11 @@ std::vector<Eigen::Isometry3d> start_placements(const PointStructure& s, const M
 
 namespace {
 
-/// The nominal tool points of a station's rows, each seen from its setup's placement.
+/// The nominal points of a station's rows (the tool frame's origin moved by the row's target offset
+/// in x, when given), each seen from its setup's placement.
 Eigen::Matrix3Xd station_points(const PointStructure& s, const MeasurementSet& data,
-                                const std::vector<Eigen::Isometry3d>& place, int station, Eigen::Matrix3Xd* flanges) {
+                                const std::vector<Eigen::Isometry3d>& place, int station, Eigen::Matrix3Xd* flanges,
+                                const std::vector<double>* x = nullptr) {
   std::vector<const Measurement*> rows;
   for (const Measurement& r : data.rows)
     if (r.station == station) rows.push_back(&r);
@@ -81,10 +84,76 @@ Eigen::Matrix3Xd station_points(const PointStructure& s, const MeasurementSet& d
   for (size_t j = 0; j < rows.size(); ++j) {
     const Eigen::Isometry3d& b = place[static_cast<size_t>(rows[j]->setup)];
     const Eigen::Isometry3d t = fk_compliant(s.nominal, rows[j]->q_deg * kDeg);
-    y.col(static_cast<Eigen::Index>(j)) = b * t.translation();
+    Vec3 offset = Vec3::Zero();
+    if (x && rows[j]->target >= 0)
+      offset = Eigen::Map<const Vec3>(x->data() + s.layout.targets + 3 * rows[j]->target);
+    y.col(static_cast<Eigen::Index>(j)) = b * (t * offset);
     if (flanges) flanges->col(static_cast<Eigen::Index>(j)) = b * (t * tool_inv).translation();
   }
   return y;
+}
+
+/// Sum of (|y_j - p| - l_j)^2 after a few Gauss-Newton steps on the pivot p from `p` (updated).
+double refine_pivot(const Eigen::Matrix3Xd& y, const std::vector<double>& len, Vec3& p) {
+  double cost = 0;
+  for (int it = 0; it < 20; ++it) {
+    Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+    Vec3 Jtr = Vec3::Zero();
+    cost = 0;
+    for (Eigen::Index j = 0; j < y.cols(); ++j) {
+      const Vec3 d = p - y.col(j);
+      const double n = d.norm(), r = n - len[static_cast<size_t>(j)];
+      const Vec3 g = n > 0 ? Vec3(d / n) : Vec3::UnitX();
+      JtJ += g * g.transpose();
+      Jtr += g * r;
+      cost += r * r;
+    }
+    const Vec3 step = JtJ.ldlt().solve(Jtr);
+    if (!step.allFinite()) break;
+    p -= step;
+    if (step.norm() < 1e-9) break;
+  }
+  return cost;
+}
+
+/// A ballbar's pivot from the ball centres y and the measured lengths. The linear sphere fit
+/// (radius free) fails where the bar's directions lie near one cone (the centres near a circle:
+/// along its axis the fit is undetermined), so the pivot is refined with the lengths from it and from
+/// the two points on the circle's axis at the bar's length; of near-equal costs (the mirror images of
+/// a circle) the one on the far side of the ball from the flange is taken.
+Vec3 start_pivot(const Eigen::Matrix3Xd& y, const Eigen::Matrix3Xd& flanges, const std::vector<double>& len) {
+  const Eigen::Index n = y.cols();
+  const Vec3 c = y.rowwise().mean();
+  // |y - p|^2 = l^2: 2 y.p - |p|^2 = |y|^2 - l^2, linear in p and |p|^2 (about the mean, for conditioning)
+  Eigen::MatrixXd A(n, 4);
+  Eigen::VectorXd b(n);
+  double mean_len = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const Vec3 yj = y.col(j) - c;
+    A.row(j) << 2 * yj.transpose(), -1.0;
+    b[j] = yj.squaredNorm() - len[static_cast<size_t>(j)] * len[static_cast<size_t>(j)];
+    mean_len += len[static_cast<size_t>(j)] / static_cast<double>(n);
+  }
+  std::vector<Vec3> starts;
+  const Eigen::VectorXd sol = A.colPivHouseholderQr().solve(b);
+  if (sol.allFinite()) starts.push_back(c + sol.head<3>());
+  const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(y.colwise() - c, Eigen::ComputeFullU);
+  const Vec3 axis = svd.matrixU().col(2);
+  const double rho2 = (y.colwise() - c).colwise().squaredNorm().mean();
+  const double h = std::sqrt(std::max(0.0, mean_len * mean_len - rho2));
+  starts.push_back(c + axis * h);
+  starts.push_back(c - axis * h);
+  Vec3 best = c;
+  double best_cost = std::numeric_limits<double>::infinity(), best_side = 0;
+  for (Vec3 p : starts) {
+    const double cost = refine_pivot(y, len, p);
+    if (!p.allFinite()) continue;
+    // > 0 when the pivot lies beyond the ball, away from the flange
+    const double side = ((y.colwise() - flanges.rowwise().mean()).rowwise().mean()).dot(p - c);
+    const bool mirror = std::abs(cost - best_cost) <= 1e-6 * static_cast<double>(n) + 1e-3 * std::min(cost, best_cost);
+    if (mirror ? side > best_side : cost < best_cost) best = p, best_cost = cost, best_side = side;
+  }
+  return best;
 }
 
 }  // namespace
@@ -107,10 +176,13 @@ void PointStructure::compute_normals(const MeasurementSet& d) {
   const MeasurementSet* data = &d;
   const size_t n = layout.station_names.size();
   const std::vector<Eigen::Isometry3d> place = start_placements(*this, *data);
+  std::vector<double> x(static_cast<size_t>(layout.size), 0.0);  // the targets at their start
+  for (size_t t = 0; t < target_start.size() && static_cast<int>(t) < layout.n_targets; ++t)
+    for (int c = 0; c < 3; ++c) x[static_cast<size_t>(layout.targets) + 3 * t + static_cast<size_t>(c)] = target_start[t][c];
   for (size_t k = 0; k < n; ++k) {
     if (layout.station_kinds[k] != MeasureKind::plane) continue;
     Eigen::Matrix3Xd flanges;
-    const Eigen::Matrix3Xd y = station_points(*this, *data, place, static_cast<int>(k), &flanges);
+    const Eigen::Matrix3Xd y = station_points(*this, *data, place, static_cast<int>(k), &flanges, &x);
     if (y.cols() < 3) continue;
     const Vec3 c = y.rowwise().mean();
     const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(y.colwise() - c, Eigen::ComputeFullU);
@@ -222,7 +294,7 @@ void start_stations(const PointStructure& s, const MeasurementSet& data, const s
                     std::vector<double>& x) {
   const ParamLayout& L = s.layout;
   for (size_t k = 0; k < L.station_names.size(); ++k) {
-    const Eigen::Matrix3Xd y = station_points(s, data, place, static_cast<int>(k), nullptr);
+    const Eigen::Matrix3Xd y = station_points(s, data, place, static_cast<int>(k), nullptr, &x);
     if (y.cols() == 0) continue;
     double* p = &x[L.stations + 3 * k];
     const Vec3 c = y.rowwise().mean();
@@ -237,19 +309,12 @@ void start_stations(const PointStructure& s, const MeasurementSet& data, const s
     }
     Vec3 start = c;
     if (L.station_kinds[k] == MeasureKind::distance && y.cols() >= 4) {
-      // |y - p|^2 = l^2: 2 y.p - |p|^2 = |y|^2 - l^2, linear in p and |p|^2 (about the mean, for conditioning)
-      Eigen::MatrixXd A(y.cols(), 4);
-      Eigen::VectorXd b(y.cols());
-      int j = 0;
-      for (const Measurement& r : data.rows) {
-        if (r.station != static_cast<int>(k)) continue;
-        const Vec3 yj = y.col(j) - c;
-        A.row(j) << 2 * yj.transpose(), -1.0;
-        b[j] = yj.squaredNorm() - r.length_mm * r.length_mm;
-        ++j;
-      }
-      const Eigen::VectorXd sol = A.colPivHouseholderQr().solve(b);
-      if (sol.allFinite()) start = c + sol.head<3>();
+      Eigen::Matrix3Xd flanges;
+      station_points(s, data, place, static_cast<int>(k), &flanges, &x);
+      std::vector<double> len;
+      for (const Measurement& r : data.rows)
+        if (r.station == static_cast<int>(k)) len.push_back(r.length_mm);
+      start = start_pivot(y, flanges, len);
     }
     for (int i = 0; i < 3; ++i) p[i] = start[i];
   }

@@ -53,6 +53,7 @@ class FitOptions:
     gravity: str = "auto"
     orientation_weight: float = 100.0
     max_iterations: int = 100
+    target_start: Optional[Sequence[Sequence[float]]] = None  #: each target's start on the tool (mm; a probe's ball)
 
     def __post_init__(self) -> None:
         if self.loss not in LOSSES:
@@ -79,7 +80,7 @@ class FitOptions:
                        orientation_weight=self.orientation_weight, max_iterations=self.max_iterations,
                        penalties=penalties, prior_sd=self.prior_sd,
                        prior_scale=1.0 if self.prior_scale is None else float(self.prior_scale),
-                       gravity=gravity or self.gravity)
+                       gravity=gravity or self.gravity, target_start=self.target_start)
 
     def fitter(self, robot: Robot, seed: int = 0) -> priors.Fitter:
         """The fit of a data set from the starting model (priors centred there; their width chosen per
@@ -98,12 +99,13 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
             covariance: bool = True, orientation_weight: float = 100.0, max_iterations: int = 100,
             fix: Sequence[str] = (), penalties: Sequence[tuple[str, float]] = (),
             prior_sd: Optional[dict[str, float]] = None, prior_scale: float = 0.0,
-            gravity: str = "auto") -> _core.IdentifyOptions:
+            gravity: str = "auto", target_start: Optional[Sequence[Sequence[float]]] = None) -> _core.IdentifyOptions:
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
     joint_map smoothness penalty. ``prior_sd`` (kinds in file units, priors.DEFAULT_PRIOR_SD) times
-    ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals."""
+    ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals; ``target_start``: each
+    target's start on the tool (mm), e.g. a probe's nominal ball offset."""
     effects = list(effects)
     o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss, gravity=gravity,
                               loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
@@ -111,6 +113,8 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
     o.penalties = [(str(n), float(w)) for n, w in penalties]
     o.prior_sd = priors.core_prior_sd(priors.DEFAULT_PRIOR_SD if prior_sd is None else prior_sd)
     o.prior_scale = float(prior_scale) if prior_sd is None or prior_sd else 0.0
+    if target_start is not None:
+        o.target_start = [np.asarray(t, dtype=float) for t in target_start]
     return o
 
 

@@ -148,7 +148,8 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
     return v
 
 
-def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1) -> tuple[
+def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1,
+                      target_start: Optional[Sequence[Sequence[float]]] = None) -> tuple[
         FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
     targets, on the calibrated model (after) and the nominal one (before); orientation errors (or
@@ -160,6 +161,8 @@ def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", l
         held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
         opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
                                      covariance=False)
+        if target_start is not None:
+            opts.target_start = [np.asarray(t, dtype=float) for t in target_start]
         return _core.identify(robot, data, opts, None, calibrated)
 
     cal, nom = frames_only(True), frames_only(False)
@@ -197,7 +200,8 @@ def inside_and_outside(robot: Robot, data: dict[str, Any], loss: str = "huber",
     return {"inside": part(~out), "outside": part(out)}
 
 
-def validate(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1) -> dict[str, Any]:
+def validate(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1,
+             target_start: Optional[Sequence[Sequence[float]]] = None) -> dict[str, Any]:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
     differently: only the placements and the target offsets are refitted, on the calibrated
@@ -211,7 +215,7 @@ def validate(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale
     "effects", "fitted_deg", "rows_outside", "share_outside", "message"}``."""
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
-    ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm)
+    ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm, target_start)
     v = validation_figures(ea, eb, oa, ob, data)
     v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
              refitted="the instrument placement of every setup and the target offsets"

@@ -16,20 +16,19 @@ from ..io import strict_json
 from ..io.urdf import spec_urdf, urdf_left_out
 from .. import report
 from ..calibration import simulation as sim
-from .options import (artifact_opt, effect_opts, effects_arg, fit_options, fit_opts, harmonics_option, loss_opts,
-                      progress, robot_of, robot_opts, say, step_progress, tool_targets)
+from .options import (artifact_opt, artifact_out, effect_opts, effects_arg, fit_options, fit_opts, harmonics_option,
+                      loss_opts, probe_offset, probe_opts, probe_start, progress, robot_of, robot_opts, say, step_progress,
+                      tool_targets)
 
 
 def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.Robot) -> None:
     """simulate --kind: a probe campaign and its artifact file."""
-    probe = [float(v) for v in args.probe.split(",")]
-    if len(probe) != 3:
-        raise ValueError(f"--probe {args.probe}: expected X,Y,Z (mm, the ball centre in the tool frame)")
+    probe = probe_offset(args)
     data = sim.simulate_probe(truth, args.kind, stations=args.stations, touches=args.touches, cone_deg=args.cone,
                               probe=probe, radius_mm=args.radius, length_mm=args.length, block_mm=args.block,
                               noise_mm=0.005 if args.noise is None else args.noise, seed=args.seed)
     data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
-    art = args.artifact_out or str(Path(args.out).with_name(Path(args.out).stem + "-artifact.csv"))
+    art = artifact_out(args)
     text = ident.measurements_csv(data, robot.dof)
     artifact = _core.format_artifact(data, robot.dof) if "artifact" in data else None
     _core.write_file_atomic(args.out, text)
@@ -105,7 +104,7 @@ def cmd_identify(args: argparse.Namespace) -> None:
 def cmd_validate(args: argparse.Namespace) -> None:
     robot = load_robot(args.model)
     data = ident.read_measurements(args.data, robot, args.artifact)
-    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale)
+    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale, target_start=probe_start(args))
     v["model"] = str(args.model)
     _core.write_file_atomic(args.out, strict_json.dumps(v, indent=1, sort_keys=True) + "\n")
     print(ident.validation_summary(v))
@@ -166,19 +165,7 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
                     help="a time_s column: the campaign runs from 0 to HOURS in pose order")
     harmonics_option(sp, "a hidden transmission_error")
     sp.add_argument("--seed", type=int, default=1)
-    probe = sp.add_argument_group("a probe campaign (no tracker)")
-    probe.add_argument("--kind", choices=["sphere", "plane", "distance"],
-                       help="spheres in fixed nests, the faces of a block, or a ballbar at pivots")
-    probe.add_argument("--stations", type=int, default=3, help="spheres or pivots; planes: faces of the block (<= 5)")
-    probe.add_argument("--touches", type=int, default=25, help="rows per station")
-    probe.add_argument("--cone", type=float, default=35.0, metavar="DEG",
-                       help="the probe's axis within this angle of its station's mean direction")
-    probe.add_argument("--probe", default="0,0,150", metavar="X,Y,Z", help="the ball centre in the tool frame (mm)")
-    probe.add_argument("--radius", type=float, default=3.0, help="the ball's radius (mm; planes)")
-    probe.add_argument("--length", type=float, default=150.0, help="the ballbar's length (mm)")
-    probe.add_argument("--block", type=float, default=400.0, help="the block's edge (mm; planes)")
-    probe.add_argument("--artifact-out", metavar="A.csv",
-                       help="the known distances and angles between the stations (default: OUT's name + -artifact.csv)")
+    probe_opts(sp, "a probe campaign (no tracker)")
     sp.set_defaults(func=cmd_simulate)
 
     sp = sub.add_parser("identify", help="parameter identification from measurements")

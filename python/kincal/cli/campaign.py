@@ -11,7 +11,7 @@ import sys
 from .. import _core
 from ..calibration import identify as ident
 from ..io.csv_text import format_rows
-from .options import effect_opts, robot_of, robot_opts, step_progress
+from .options import artifact_out, effect_opts, probe_offset, probe_opts, robot_of, robot_opts, step_progress
 
 
 def _numbers(text: str, n: int, option: str) -> list[float]:
@@ -25,10 +25,43 @@ def _numbers(text: str, n: int, option: str) -> list[float]:
     return v
 
 
+def _plan_probe(args: argparse.Namespace, robot: _core.Robot) -> None:
+    """plan --kind: the touches at each station, and the artifact of the stations as placed."""
+    from ..calibration import probe_plan
+
+    conf = None
+    if args.from_:
+        conf = _core.read_csv_columns(args.from_, [f"q{j + 1}" for j in range(robot.dof)])
+        conf = _core.joints_from_controller(robot, conf)
+    noise = 0.005 if args.noise is None else args.noise
+    res = probe_plan.plan_probe(robot, args.kind, stations=args.stations, touches=args.touches, cone_deg=args.cone,
+                                probe=probe_offset(args), radius_mm=args.radius, length_mm=args.length,
+                                block_mm=args.block, effects=ident.parse_effects(args.effects, robot, args.harmonics),
+                                noise_mm=noise, candidates=args.candidates or 300, configurations=conf,
+                                seed=args.seed, progress=step_progress("plan"))
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    data = dict(res.data, q_deg=_core.joints_to_controller(robot, res.data["q_deg"]))
+    art = artifact_out(args)
+    _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
+    _core.write_file_atomic(art, _core.format_artifact(data, robot.dof))
+    print(res.summary(noise))
+    print(f"wrote {len(data['pose'])} touches (the commanded angles on the nominal model: replace each row's angles "
+          f"with the controller's reading at the touch) to {args.out}, the stations' distances and angles as "
+          f"placed to {art}")
+
+
 def cmd_plan(args: argparse.Namespace) -> None:
     from ..calibration import plan
 
     robot = robot_of(args)
+    if args.kind:
+        _plan_probe(args, robot)
+        return
+    if args.poses is None:
+        raise ValueError("--poses: the number of configurations to measure (or --kind for a probe campaign)")
+    if args.noise is None:
+        args.noise = 0.02
     if args.targets.strip().isdigit():
         count = int(args.targets)
         if not 1 <= count <= len(ident.DEFAULT_TARGETS):
@@ -46,7 +79,7 @@ def cmd_plan(args: argparse.Namespace) -> None:
                          max_range=args.range, max_incidence_deg=args.max_incidence)
     res = plan.plan(robot, args.poses, targets=targets, effects=ident.parse_effects(args.effects, robot, args.harmonics),
                     candidates=cand,
-                    n_candidates=args.candidates, rules=rules, noise_mm=args.noise, seed=args.seed,
+                    n_candidates=args.candidates or 5000, rules=rules, noise_mm=args.noise, seed=args.seed,
                     progress=step_progress("plan"))
     if sys.stderr.isatty():
         print(file=sys.stderr)
@@ -81,16 +114,19 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     """The plan and accuracy subcommands on the command line's subparsers ``sub``."""
     sp = sub.add_parser("plan", help="the configurations to measure that determine the model best (D-optimal)")
     robot_opts(sp)
-    sp.add_argument("--poses", type=int, required=True, help="number of configurations K")
-    sp.add_argument("--out", required=True, help="CSV q1..qN, in a short path order")
+    sp.add_argument("--poses", type=int, help="number of configurations K (a tracker campaign)")
+    sp.add_argument("--out", required=True, help="CSV q1..qN, in a short path order (with --kind: the touches, "
+                    "a measurement CSV to fill with the controller's readings)")
     sp.add_argument("--targets", default="1", help="the reflectors: a CSV of offsets x,y,z on the tool (mm), or "
                     "their count (kincal simulate's offsets; default 1)")
     sp.add_argument("--from", dest="from_", metavar="CANDIDATES.csv", help="candidate configurations (q1..qN); "
-                    "default: random ones inside the joint limits")
-    sp.add_argument("--candidates", type=int, default=5000, help="number of random candidates (default 5000)")
+                    "default: random ones inside the joint limits. With --kind: the configurations over which "
+                    "the TCP uncertainty is predicted (default: 200 random ones 10%% inside the limits)")
+    sp.add_argument("--candidates", type=int, default=None, help="number of random candidates (default 5000; with "
+                    "--kind: candidate touches per station, default 300)")
     effect_opts(sp, "joint_compliance", "effects the campaign must identify")
-    sp.add_argument("--noise", type=float, default=0.02, help="the instrument's noise per coordinate (mm) for "
-                    "the predicted uncertainties")
+    sp.add_argument("--noise", type=float, default=None, help="the instrument's noise per coordinate (mm; default "
+                    "0.02), or the probe's along its constraint (default 0.005), for the predicted uncertainties")
     sp.add_argument("--min-sigma", type=float, default=0.0, help="keep out of singularities: the tool Jacobian's "
                     "smallest singular value at least this share of its largest (angular rows times the reach)")
     sp.add_argument("--box", metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX", help="the TCP stays in this box (mm, base)")
@@ -99,6 +135,7 @@ def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     sp.add_argument("--max-incidence", type=float, default=180.0, help="with --instrument: the largest angle "
                     "(deg) between a reflector's normal (the tool's z axis) and the line to the instrument")
     sp.add_argument("--seed", type=int, default=0)
+    probe_opts(sp, "a probe campaign (no tracker): the orientations at each station")
     sp.set_defaults(func=cmd_plan)
 
     acc = sub.add_parser("accuracy", help="standard accuracy reports: ISO 9283, ISO 230-2, VDI/DGQ 3441")

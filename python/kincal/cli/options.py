@@ -4,7 +4,9 @@ parsers, and the progress lines on stderr. Parsing only; the commands are in the
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 import numpy as np
@@ -71,10 +73,18 @@ def loss_opts(sp: argparse.ArgumentParser, scale: Optional[float] = 0.1) -> None
 
 
 def artifact_opt(sp: argparse.ArgumentParser) -> None:
-    """--artifact: the known geometry between a probe campaign's stations."""
+    """--artifact: the known geometry between a probe campaign's stations; --probe: the ball's start."""
     sp.add_argument("--artifact", metavar="A.csv",
                     help="known distances and angles between the data's probe stations (columns a, b, distance_mm, "
                          "angle_deg; one of the last two per row): a length bar, a ball plate, a datum cube")
+    sp.add_argument("--probe", metavar="X,Y,Z", help="the probe ball's nominal centre in the tool frame (mm): where "
+                    "the fit of its offset starts (default: the tool frame's origin; a ballbar's pivots may start "
+                    "on the wrong side of the ball without it)")
+
+
+def probe_start(args: argparse.Namespace) -> Optional[list[list[float]]]:
+    """--probe as the targets' start (one target), or None."""
+    return [probe_offset(args)] if getattr(args, "probe", None) else None
 
 
 def fit_opts(sp: argparse.ArgumentParser) -> None:
@@ -111,7 +121,8 @@ def fit_options(args: argparse.Namespace, robot: _core.Robot) -> FitOptions:
     return FitOptions(loss=args.loss, loss_scale_mm=args.loss_scale or None,
                       prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
                       prior_scale=priors.parse_prior_scale(args.prior_scale), gravity=args.gravity,
-                      orientation_weight=args.orientation_weight, max_iterations=args.max_iterations)
+                      orientation_weight=args.orientation_weight, max_iterations=args.max_iterations,
+                      target_start=probe_start(args))
 
 
 def effects_arg(args: argparse.Namespace, robot: _core.Robot, data: dict[str, Any]) -> Union[str, list[_core.Effect]]:
@@ -158,3 +169,36 @@ def step_progress(label: str) -> Optional[Callable[[int, int], None]]:
 
 def say(text: str) -> None:
     print(text, file=sys.stderr, flush=True)
+
+
+def probe_opts(sp: argparse.ArgumentParser, title: str) -> None:
+    """A probe campaign's options (simulate --kind, plan --kind)."""
+    probe = sp.add_argument_group(title)
+    probe.add_argument("--kind", choices=["sphere", "plane", "distance"],
+                       help="spheres in fixed nests, the faces of a block, or a ballbar at pivots")
+    probe.add_argument("--stations", type=int, default=3, help="spheres or pivots; planes: faces of the block (<= 5)")
+    probe.add_argument("--touches", type=int, default=25, help="rows per station")
+    probe.add_argument("--cone", type=float, default=35.0, metavar="DEG",
+                       help="the probe's axis within this angle of its station's mean direction")
+    probe.add_argument("--probe", default="0,0,150", metavar="X,Y,Z", help="the ball centre in the tool frame (mm)")
+    probe.add_argument("--radius", type=float, default=3.0, help="the ball's radius (mm; planes)")
+    probe.add_argument("--length", type=float, default=150.0, help="the ballbar's length (mm)")
+    probe.add_argument("--block", type=float, default=400.0, help="the block's edge (mm; planes)")
+    probe.add_argument("--artifact-out", metavar="A.csv",
+                       help="the known distances and angles between the stations (default: OUT's name + -artifact.csv)")
+
+
+def probe_offset(args: argparse.Namespace) -> list[float]:
+    """--probe X,Y,Z (mm)."""
+    try:
+        probe = [float(v) for v in args.probe.split(",")]
+    except ValueError:
+        probe = []
+    if len(probe) != 3 or not all(math.isfinite(v) for v in probe):
+        raise ValueError(f"--probe {args.probe}: expected X,Y,Z (mm, the ball centre in the tool frame)")
+    return probe
+
+
+def artifact_out(args: argparse.Namespace) -> str:
+    """--artifact-out, or OUT's name + -artifact.csv beside it."""
+    return str(args.artifact_out or Path(args.out).with_name(Path(args.out).stem + "-artifact.csv"))

@@ -53,6 +53,10 @@ struct IdentifyOptions {
   /// weighted k, so that a map the data see only over part of a turn stays smooth); the
   /// identifiability analysis leaves penalised parameters out (free, the ridge determines them)
   std::vector<std::pair<std::string, double>> penalties;
+  /// where each target's offset on the tool starts (mm, tool frame; empty: at the tool frame's
+  /// origin, then fitted to the data on the nominal geometry): a probe's nominal ball offset, without
+  /// which a ballbar's pivots may start on the wrong side of their balls
+  std::vector<Vec3> target_start;
   std::function<void(int iteration, double cost)> progress;
   double orientation_weight = 100.0;  ///< mm per rad: how orientation residuals weigh against positions
 };

@@ -95,6 +95,9 @@ struct LayoutOptions {
   std::vector<MeasureKind> station_kinds;  ///< and their kinds
   /// the planes' reference normals by station (empty: from the data the PointModel is given, else z)
   std::vector<Vec3> station_normals;
+  /// where the targets start (mm, tool frame; empty: the origin): the balls the reference normals
+  /// are fitted through (IdentifyOptions::target_start)
+  std::vector<Vec3> target_start;
 };
 
 /// Layout of the identification parameter vector for a model and its options.
@@ -143,10 +146,11 @@ class PointModel {
   /// only (the others left zero). Reuse it only while the robot's own parameters stay at x's.
   PointState at_frames_only(const std::vector<double>& x, const MeasurementSet& data) const;
   /// Starting parameters: nominal geometry, each setup's base frame from the best rigid fit (Horn)
-  /// of the nominal prediction of the tool point to that setup's points, targets at the tool point,
-  /// the stations through the nominal tool points of their rows.
+  /// of the nominal prediction of the tool point to that setup's points, targets at the tool point
+  /// (or at `targets`, mm in the tool frame: a probe's nominal ball), the stations through the
+  /// nominal points of their rows (each row's target at its start).
   /// With the gravity fitted: every moment zero (no link torque), compliances nominal.
-  std::vector<double> start(const MeasurementSet& data) const;
+  std::vector<double> start(const MeasurementSet& data, const std::vector<Vec3>& targets = {}) const;
   /// With the gravity fitted: generic non-zero moments (and free zero compliances at the held one's
   /// value) in place of x's, for judging what the data determine: at zero moments a compliance has
   /// no effect, whatever the data (the bilinear form's saddle).

@@ -139,6 +139,44 @@ def evaluate(res: _core.IdentifyResult, data: dict[str, Any], extra: Sequence[_c
     return np.asarray(r), cur, J, new, fit_of
 
 
+def equations(data: dict[str, Any]) -> Optional[BoolArray]:
+    """Per row and position coordinate, whether it carries an equation (a plane's or a ballbar's row
+    has one: its first); None when every row has three."""
+    station = np.asarray(data.get("station", np.full(len(data["pose"]), -1)))
+    kinds = data.get("station_kinds", [])
+    one = np.array([s >= 0 and kinds[s] in ("plane", "distance") for s in station], dtype=bool)
+    if not one.any():
+        return None
+    used = np.ones((len(station), 3), dtype=bool)
+    used[one, 1:] = False
+    return used
+
+
+def _prior_rows(res: _core.IdentifyResult, data: dict[str, Any], fit_of: dict[int, int]
+                ) -> Optional[tuple[FloatArray, FloatArray]]:
+    """On probe data, the fit's priors as pseudo-rows of the linearisation: for each of its free
+    columns with a prior, noise / sd times the parameter's distance from the prior's centre, and
+    noise / sd in its column (the fit's own weighting: priors.cpp's prior_terms). The fit of probe
+    data is a maximum a posteriori one: without its priors the free geometry with the stations'
+    unknowns (no prior) spans nearly every candidate's columns (a sphere campaign's compliance down to
+    2.6e-5 mm), and a candidate the priors leave room for scores nothing. Tracker data keep the plain
+    linearisation (their geometry is the data's; with these rows the UR10 series took transmission
+    errors their folds do not support). None: no pseudo-rows."""
+    if not np.any(np.asarray(data.get("station", [-1])) >= 0):
+        return None
+    fixed, sd = np.asarray(res.fixed), np.asarray(res.prior_sd, dtype=float)
+    x, x0 = np.asarray(res.x, dtype=float), np.asarray(res.start, dtype=float)
+    cols = [k for k in fit_of.values() if not fixed[k]]  # the current columns' parameters, in order
+    rows = [c for c, k in enumerate(cols) if np.isfinite(sd[k])]
+    P = np.zeros((len(rows), len(cols)))
+    rp = np.zeros(len(rows))
+    for i, c in enumerate(rows):
+        w = res.noise_mm / sd[cols[c]]
+        P[i, c] = w
+        rp[i] = w * (x[cols[c]] - x0[cols[c]])
+    return P, rp
+
+
 def fitted_compliance_columns(res: _core.IdentifyResult, data: dict[str, Any], spec: Spec) -> FloatArray:
     """The columns of JointCompliance("fit") for a model fitted without compliance (``res``, the model
     ``spec``): the model with it is fitted (its torques' mass moments with it), and its compliance
@@ -175,11 +213,13 @@ class _Linearised:
         self.scale: Optional[float] = None  # where the candidates' scores bend (from the residual's spread)
         self.w: Optional[FloatArray] = None
         self._stacked: Optional[tuple[FloatArray, FloatArray]] = None  # (the fit's columns, them with the added ones)
+        self.prior: Optional[tuple[FloatArray, FloatArray]] = None  # the priors' pseudo-rows (probe data)
 
     def raw(self, cand: Candidate) -> tuple[FloatArray, FloatArray, FloatArray]:
         """The unweighted residual, current columns and candidate columns at the fit."""
         if self.cols is None:
             self.r, self.cur, self.J, self.new, self.fit_of = evaluate(self.res, self.data, self.extra)
+            self.prior = _prior_rows(self.res, self.data, self.fit_of)
             self.cols = {}
         key = (cand.name, cand.joint, tuple(cand.harmonics), getattr(cand, "gravity", ""))
         if key not in self.cols:
@@ -208,14 +248,23 @@ class _Linearised:
             cur = self._stacked[1]
         if self.w is None:
             self.w = self._weights(r, cur.shape[1])
-        return r * self.w, cur, R
+        return self._with_prior(r * self.w, cur, R)
+
+    def _with_prior(self, r: FloatArray, cur: FloatArray, R: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """r, the current columns and R with the priors' pseudo-rows after the data's (none unless
+        _prior_rows gives them): the candidates scored on the fit's own maximum a posteriori problem."""
+        if self.prior is None:
+            return r, cur, R
+        P, rp = self.prior
+        Pc = np.hstack([P, np.zeros((len(P), cur.shape[1] - P.shape[1]))])  # the steps' added columns: no prior
+        return np.concatenate([r, rp]), np.vstack([cur, Pc]), np.vstack([R, np.zeros((len(P), R.shape[1]))])
 
     def _weights(self, r: FloatArray, p: int) -> FloatArray:
         """The pseudo-residuals' weights of the residual r (p parameters fitted): the fit's loss, bending
         where the residual's own robust spread puts it (4.03 x; the fit's own bend, e.g. a fixed
         0.1 mm, would clip the very structure a candidate is to explain when the model lacks it)."""
         if self.scale is None:
-            self.scale = loss_threshold(robust_noise(r, self.dims, p), self.dims)
+            self.scale = loss_threshold(robust_noise(r, self.dims, p, equations(self.data)), self.dims)
         return robust_weights(r, self.dims, self.fit.loss, self.scale)
 
     def step(self, cand: Candidate) -> _Linearised:
@@ -228,12 +277,16 @@ class _Linearised:
         A = np.hstack([cur] + self.added + [R])
         w = self.w if self.w is not None else self._weights(r, cur.shape[1] + sum(a.shape[1] for a in self.added))
         sw = np.sqrt(w)  # iteratively reweighted least squares: the robust cost's Gauss-Newton step
-        delta, *_ = np.linalg.lstsq(A * sw[:, None], r * sw, rcond=None)
+        rw, Aw, _ = self._with_prior(r * sw, A * sw[:, None], R[:, :0])
+        delta, *_ = np.linalg.lstsq(Aw, rw, rcond=None)
         out = _Linearised.__new__(_Linearised)
         out.__dict__.update(self.__dict__)
         out.added = self.added + [R]
         out._stacked = None
         out.r_now = r - A @ delta
+        if self.prior is not None:  # the priors' pseudo-residuals after the step
+            P, rp = self.prior
+            out.prior = (P, rp - P @ delta[:P.shape[1]])
         out.scale = None  # from the new residual's spread, as the refit's would be
         out.w = None
         return out

@@ -5,12 +5,12 @@ it (the core's robust_noise and loss_threshold, priors.cpp, as Python sees them)
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..typing_ import FloatArray
+    from ..typing_ import BoolArray, FloatArray
 
 
 def robust_weights(r: FloatArray, dims: int, loss: str, scale_mm: float) -> FloatArray:
@@ -29,10 +29,13 @@ def robust_weights(r: FloatArray, dims: int, loss: str, scale_mm: float) -> Floa
     return np.repeat(w, dims)
 
 
-def robust_noise(r: FloatArray, dims: int, p: int) -> float:
+def robust_noise(r: FloatArray, dims: int, p: int, used: Optional[BoolArray] = None) -> float:
     """The residuals' robust spread per coordinate (the core's robust_noise: 1.4826 x the median
-    absolute deviation of the position coordinates, for p parameters)."""
-    v = np.asarray(r).reshape(-1, dims)[:, :3].ravel()
+    absolute deviation of the position coordinates, for p parameters). ``used``: per row and
+    position coordinate, whether it carries an equation (a plane's or a ballbar's row has one, its
+    other two are zero: counted, they would put the median at zero)."""
+    v = np.asarray(r).reshape(-1, dims)[:, :3]
+    v = v[np.asarray(used).reshape(v.shape)] if used is not None else v.ravel()
     if not len(v):
         return 1e-4
     mad = float(np.median(np.abs(v - np.median(v))))

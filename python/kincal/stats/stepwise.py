@@ -127,6 +127,12 @@ def _basis(Jc: FloatArray) -> FloatArray:
     return Q
 
 
+def _padded(row_folds: Sequence[BoolArray], n: int) -> list[BoolArray]:
+    """The held-out masks over n residual rows: rows past the masks' (a prior's pseudo-rows, after the
+    data's) are never held out."""
+    return [np.concatenate([h, np.zeros(n - len(h), dtype=bool)]) if len(h) < n else h for h in row_folds]
+
+
 def _projected(Q: FloatArray, R: FloatArray) -> tuple[FloatArray, BoolArray]:
     """R projected off the span of Q, and which columns survive (those the span does not absorb)."""
     Rp = R - Q @ (Q.T @ R)
@@ -158,7 +164,7 @@ def score(r: FloatArray, Jc: FloatArray, R: FloatArray, row_folds: Sequence[Bool
     F = ((rss0 - rss1) / k) / (rss1 / dof) if rss1 > 0 else math.inf
     p = f_survival(k, dof, F) if math.isfinite(F) else 0.0
     before = after = 0.0
-    for h in row_folds:
+    for h in _padded(row_folds, len(r)):
         if ridge is None:
             b, *_ = np.linalg.lstsq(Rp[~h], r[~h], rcond=None)
         else:
@@ -190,7 +196,7 @@ def choose_variant(r: FloatArray, R: FloatArray, variants: Sequence[tuple[int, F
         solved.append((idx, cols, w2[:, :, None] * np.eye(len(cols))[None, :, :]))
     before = 0.0
     after = np.zeros(len(variants))
-    for h in row_folds:
+    for h in _padded(row_folds, len(r)):
         Rh, rh = Rp[h], r[h]
         Gh, gh, ss = Rh.T @ Rh, Rh.T @ rh, float(rh @ rh)
         before += ss
@@ -247,8 +253,9 @@ def _score_round(problem: Problem[E], regressors: Linearisation[E], effects: lis
         if admits and not admits(effects, c):  # more parameters than the data can fit
             continue
         r, Jc, R = regressors(c)
+        n_data = len(row_folds[0]) if row_folds else len(r)  # the data's rows (a prior's pseudo-rows follow)
         if r_rms is None:
-            r_rms = float(np.sqrt(np.mean(np.asarray(r) ** 2))) if len(r) else 0.0
+            r_rms = float(np.sqrt(np.mean(np.asarray(r[:n_data]) ** 2))) if n_data else 0.0
         if basis is None or basis[0] is not Jc:
             basis = (Jc, _basis(Jc))
         order: dict[str, Any] = {}
@@ -271,7 +278,7 @@ def _score_round(problem: Problem[E], regressors: Linearisation[E], effects: lis
             s["extrapolation_cv_gain"] = score(r, Jc, R, [np.repeat(f, problem.dims) for f in own], basis[1],
                                                ridge)["cv_gain"]
         if "cv_ss_after" in s:  # the linearised cross-validated RMS per point, with the candidate
-            s["cv_rms_linear_mm"] = math.sqrt(problem.dims * s.pop("cv_ss_after") / len(r))
+            s["cv_rms_linear_mm"] = math.sqrt(problem.dims * s.pop("cv_ss_after") / n_data)
             s.pop("cv_ss_before")
         s.update(problem.describe(c))
         s.update(order)

@@ -317,6 +317,7 @@ def measure(truth: Robot, plan: dict[str, Any], probe: Sequence[float] = (0.0, 0
     nominal = _tool_frames(truth, q)
     out = dict(plan)
     kinds = [plan["station_kinds"][s] for s in plan["station"]]
+    dirs = np.asarray(plan["dir"], dtype=float) if "dir" in plan else None  # the last motion's, when recorded
     length = np.asarray(plan["length_mm"], dtype=float).copy()
     for i in range(len(q)):
         target = nominal[i].copy()
@@ -326,7 +327,7 @@ def measure(truth: Robot, plan: dict[str, Any], probe: Sequence[float] = (0.0, 0
             target[:3, 3] += _plane_normal(nominal, plan, i) * rng.normal(0.0, noise_mm)
         else:
             length[i] += rng.normal(0.0, noise_mm)
-        q[i] = _reach(truth, q[i], target, probe_v)
+        q[i] = _reach(truth, q[i], target, probe_v, None if dirs is None else dirs[i])
     out["q_deg"] = q
     out["length_mm"] = length
     return out
@@ -341,17 +342,29 @@ def _plane_normal(frames: FloatArray, plan: dict[str, Any], i: int) -> FloatArra
     return out
 
 
-def _reach(truth: Robot, q0: FloatArray, target: FloatArray, probe: FloatArray, iterations: int = 100) -> FloatArray:
+def _frame(truth: Robot, q: FloatArray, direction: Optional[FloatArray]) -> FloatArray:
+    """The truth's calibrated tool frame (4 x 4, mm) at q (deg), its effects acting with the last
+    motion's direction when given."""
+    p = np.asarray(_core.fk(truth, q[None, :], True, False, None if direction is None else direction[None, :]))[0]
+    f = np.eye(4)
+    f[:3, :3] = _core.abc_to_rotation(p[3:])
+    f[:3, 3] = p[:3]
+    return f
+
+
+def _reach(truth: Robot, q0: FloatArray, target: FloatArray, probe: FloatArray, direction: Optional[FloatArray] = None,
+           iterations: int = 100) -> FloatArray:
     """Joint angles (deg) near q0 where the truth's calibrated model puts the ball centre at target's
-    ball centre with target's orientation (damped Newton steps); ValueError when it cannot."""
+    ball centre with target's orientation (damped Newton steps; its effects acting with the last
+    motion's ``direction`` when given); ValueError when it cannot."""
     want = target[:3, :3] @ probe + target[:3, 3]
     q = q0.copy()
     for _ in range(iterations):
-        f = np.asarray(_core.fk_matrix(truth, q, True))
+        f = _frame(truth, q, direction)
         e = np.concatenate([want - (f[:3, :3] @ probe + f[:3, 3]), _rotvec(target[:3, :3] @ f[:3, :3].T) * 1000.0])
         if np.linalg.norm(e) < 1e-9:
             return q
-        Jt = np.asarray(_core.jacobian(truth, q, True))          # the tool frame: linear rows, then angular
+        Jt = np.asarray(_core.jacobian(truth, q, True, direction))  # the tool frame: linear rows, then angular
         J = np.vstack([Jt[:3] - _skew(f[:3, :3] @ probe) @ Jt[3:], Jt[3:] * 1000.0])  # the ball; rad on a 1 m lever
         q = q + np.degrees(J.T @ np.linalg.solve(J @ J.T + 1e-6 * np.eye(6), e))
     raise ValueError(f"the truth cannot reach a planned touch near {np.round(q0, 3).tolist()} deg "

@@ -30,7 +30,7 @@ from kincal.calibration.fitting import FitOptions
 
 PROBE = np.array([0.0, 0.0, 150.0])
 #: kind -> (stations, touches per station, cone deg, noise mm along the constraint, block edge mm)
-DESIGNS = {"sphere": (6, 25, 60.0, 0.005, 400.0), "plane": (4, 50, 60.0, 0.005, 400.0),
+DESIGNS = {"sphere": (6, 25, 60.0, 0.005, 400.0), "plane": (5, 40, 60.0, 0.005, 500.0),
            "distance": (4, 40, 60.0, 0.002, 400.0)}
 
 

@@ -81,15 +81,19 @@ def test_measure_makes_the_touches_on_the_truth():
         assert np.max(np.abs(made["q_deg"] - plan.data["q_deg"])) > 1e-3  # reached by the truth's own angles
 
 
-@pytest.mark.parametrize("kind, stations, touches, noise", [("sphere", 6, 25, 0.005), ("distance", 4, 40, 0.002)])
-def test_the_plans_prediction_matches_what_its_campaigns_reach(kind, stations, touches, noise):
+@pytest.mark.parametrize("kind, stations, touches, noise, block", [
+    ("sphere", 6, 25, 0.005, 400.0),
+    ("plane", 5, 40, 0.005, 500.0),     # a 500 mm block's top, 3 sides and the plate it stands on
+    ("distance", 4, 40, 0.002, 400.0),
+])
+def test_the_plans_prediction_matches_what_its_campaigns_reach(kind, stations, touches, noise, block):
     robot = kincal.load_robot("kr500")
     lim = np.asarray(robot.limits_deg)
     q = np.random.default_rng(7).uniform(0.9 * lim[:, 0], 0.9 * lim[:, 1], size=(200, 6))
     predicted, measured = [], []
     for seed in range(1, 6):
         plan = pp.plan_probe(robot, kind, stations=stations, touches=touches, cone_deg=60, probe=PROBE,
-                             noise_mm=noise, configurations=q, seed=seed)
+                             block_mm=block, noise_mm=noise, configurations=q, seed=seed)
         truth = ident.default_truth(robot, seed=seed)
         fit = ident.identify(robot, pp.measure(truth, plan.data, PROBE, noise, seed=seed), effects=["joint_compliance"],
                              k_folds=0, fit=FitOptions(target_start=[PROBE]))

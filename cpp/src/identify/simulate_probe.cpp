@@ -64,18 +64,34 @@ struct Placer {
 
 /// The block whose faces a plane campaign probes: in front of the robot, its top face's centre at
 /// `top`, the probe pointing down in `frame` (a pose of the truth with joint angles q0); faces in the
-/// order top, the one towards the robot, the two sideways ones, the far one (hardest to reach).
+/// order top, the one towards the robot, the two sideways ones, and the surface plate it stands on
+/// (parallel to the top, the block's edge below it: probed round the block).
 struct Block {
+  static constexpr int kPlate = 4;
   explicit Block(double edge) : edge_mm(edge) { frame.linear() << 1, 0, 0, 0, -1, 0, 0, 0, -1; }
   double edge_mm;
   VecQ q0;
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
   Vec3 top = Vec3::Zero();
   static Vec3 normal(int s) {
-    const Vec3 n[] = {Vec3::UnitZ(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitX()};
+    const Vec3 n[] = {Vec3::UnitZ(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitZ()};
     return n[s];
   }
-  Vec3 centre(int s) const { return top - Vec3::UnitZ() * (0.5 * edge_mm) + normal(s) * (0.5 * edge_mm); }
+  /// A face's centre; the plate's: the block's foot on it, in front of the block (towards the robot)
+  Vec3 centre(int s) const {
+    if (s == kPlate) return top - Vec3::UnitZ() * edge_mm - Vec3::UnitX() * (0.85 * edge_mm);
+    return top - Vec3::UnitZ() * (0.5 * edge_mm) + normal(s) * (0.5 * edge_mm);
+  }
+  /// A point of face s to touch (u, v uniform in -0.5..0.5): within 70% of a face; on the plate, in
+  /// the ring 0.75-1.0 edges from the block's axis (clear of its foot), on the robot's side.
+  Vec3 point(int s, double u, double v) const {
+    if (s == kPlate) {
+      const double rho = (0.875 + 0.25 * u) * edge_mm, phi = M_PI + v * M_PI;  // the half ring towards the robot
+      return top - Vec3::UnitZ() * edge_mm + rho * Vec3(std::cos(phi), std::sin(phi), 0.0);
+    }
+    const Vec3 n = normal(s), a = n.unitOrthogonal(), b = n.cross(a);
+    return centre(s) + 0.7 * edge_mm * (u * a + v * b);
+  }
   /// The probe turned from `frame` to point into face s.
   Mat3 turn(int s) const {
     return Eigen::Quaterniond::FromTwoVectors(frame.linear().col(2), -normal(s)).toRotationMatrix() * frame.linear();
@@ -112,10 +128,12 @@ Block place_block(const Placer& place) {
 
 /// The artifact of a campaign: spheres and pivots, the distance of every station from the first
 /// (points: their places, base frame); planes, the 90 deg angles between the top face and the
-/// others and the block's edge between opposite faces.
+/// sideways faces and the one towards the robot, and the block's edge between the sideways faces and
+/// between the top and the plate it stands on.
 std::vector<ArtifactTerm> known_geometry(const ProbeSimulationOptions& opt, const std::vector<Vec3>& points) {
   std::vector<ArtifactTerm> out;
   for (int s = 1; s < opt.stations; ++s) {
+    if (opt.kind == MeasureKind::plane && s == Block::kPlate) continue;  // parallel to the top: its distance below
     ArtifactTerm a;
     a.a = 0;
     a.b = s;
@@ -124,7 +142,7 @@ std::vector<ArtifactTerm> known_geometry(const ProbeSimulationOptions& opt, cons
     out.push_back(a);
   }
   if (opt.kind == MeasureKind::plane)
-    for (const auto& [fa, fb] : {std::pair<int, int>{2, 3}, {1, 4}}) {  // y+ with y-, x- with x+
+    for (const auto& [fa, fb] : {std::pair<int, int>{2, 3}, {0, Block::kPlate}}) {  // y+ with y-, top with the plate
       if (fb >= opt.stations) continue;
       ArtifactTerm a;
       a.a = fa;
@@ -156,7 +174,7 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
     return fk_model(truth, q * kDeg, EffectContext{random_dir(), std::nan("")});
   };
   std::vector<Vec3> points;  // every sphere's centre or pivot (base frame)
-  const char* faces[] = {"top", "x-", "y+", "y-", "x+"};  // Block's order
+  const char* faces[] = {"top", "x-", "y+", "y-", "plate"};  // Block's order
   const Block block = opt.kind == MeasureKind::plane ? place_block(place) : Block(opt.block_mm);
   for (int s = 0; s < opt.stations; ++s) {
     const std::string name = opt.kind == MeasureKind::plane ? faces[s] : "S" + std::to_string(s + 1);
@@ -192,9 +210,10 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
       Vec3 c;
       Mat3 r;
       if (opt.kind == MeasureKind::plane) {
-        // a point of the face (70% of it), the ball centre radius + noise off it, the probe into it
-        const Vec3 a = normal.unitOrthogonal(), b = normal.cross(a);
-        const Vec3 on = centre + 0.7 * opt.block_mm * (ud(rng) * a + ud(rng) * b);
+        // a point of the face (70% of it; the plate's ring), the ball centre radius + noise off it,
+        // the probe into it
+        const double u = ud(rng), v = ud(rng);
+        const Vec3 on = block.point(s, u, v);
         c = on + normal * (opt.radius_mm + opt.noise_mm * nd(rng));
         r = tilt(rng, axis, cone) * block.turn(s);
         row.radius_mm = opt.radius_mm;

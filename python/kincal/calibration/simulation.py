@@ -66,7 +66,7 @@ def simulate_probe(truth: Robot, kind: Literal["sphere", "plane", "distance"], *
                    artifact: bool = True) -> dict[str, Any]:
     """A probe campaign (no tracker) on the truth's calibrated model: ``kind`` 'sphere' (the ball in
     ``stations`` fixed nests placed in reach), 'plane' (the faces of one block of ``block_mm``: top,
-    the face towards the robot, the sideways ones, the far one) or 'distance' (a ballbar of
+    the face towards the robot, the sideways ones, the surface plate it stands on) or 'distance' (a ballbar of
     ``length_mm`` at ``stations`` pivots); ``touches`` rows per station, the probe's axis within
     ``cone_deg`` of its station's mean direction, the ball centre at ``probe`` in the tool frame,
     ``noise_mm`` along each constraint. With ``artifact`` the data carry the known distances (from

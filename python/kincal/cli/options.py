@@ -176,7 +176,8 @@ def probe_opts(sp: argparse.ArgumentParser, title: str) -> None:
     probe = sp.add_argument_group(title)
     probe.add_argument("--kind", choices=["sphere", "plane", "distance"],
                        help="spheres in fixed nests, the faces of a block, or a ballbar at pivots")
-    probe.add_argument("--stations", type=int, default=3, help="spheres or pivots; planes: faces of the block (<= 5)")
+    probe.add_argument("--stations", type=int, default=3, help="spheres or pivots; planes: the block's top, the "
+                       "face towards the robot, the sideways ones, the plate it stands on (<= 5)")
     probe.add_argument("--touches", type=int, default=25, help="rows per station")
     probe.add_argument("--cone", type=float, default=35.0, metavar="DEG",
                        help="the probe's axis within this angle of its station's mean direction")

@@ -36,7 +36,7 @@ struct SimulationOptions {
 struct ProbeSimulationOptions {
   MeasureKind kind = MeasureKind::sphere;
   /// spheres or ballbar pivots placed in reach; planes: faces of one block in front of the robot (at
-  /// most 5: top, the face towards the robot, the two sideways, the far one)
+  /// most 5: top, the face towards the robot, the two sideways, the surface plate it stands on)
   int stations = 3;
   int touches = 25;            ///< rows per station
   double cone_deg = 35;        ///< the probe's axis within this angle of its station's mean direction

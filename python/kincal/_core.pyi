@@ -316,6 +316,7 @@ class IdentifyOptions:
     orientation_weight: float
     penalties: list[tuple[str, float]]
     target_start: list[np.ndarray]
+    noise_mm: float
     prior_sd: list[tuple[str, float]]
     prior_scale: float
     def __init__(self, compliance: bool = ..., loss: str = ..., loss_scale_mm: float = ..., max_iterations: int = ...,

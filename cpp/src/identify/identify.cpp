@@ -449,12 +449,14 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
     std::vector<int> determined;
     for (int i : free_idx)
       if (!res.at_prior[i]) determined.push_back(i);
-    res.noise_mm = least_squares_noise(at_start, determined, data, s2.row_size());
+    if (!(opt.noise_mm >= 0) || !std::isfinite(opt.noise_mm))
+      throw InputError("identify: the noise must be a finite number of mm >= 0 (0: estimated from the residuals)");
+    res.noise_mm = opt.noise_mm > 0 ? opt.noise_mm : least_squares_noise(at_start, determined, data, s2.row_size());
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
       s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == Loss::none ? 0.0 : scale,
                prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
-      if (pass == 1) break;
+      if (pass == 1 || opt.noise_mm > 0) break;  // a noise given is not re-estimated
       // res.noise_mm stays the one the final solve weighed the priors and set the loss with
       const double again = s2.noise(determined.size());
       if (std::abs(again / res.noise_mm - 1) < 0.02) break;

@@ -54,6 +54,7 @@ class FitOptions:
     orientation_weight: float = 100.0
     max_iterations: int = 100
     target_start: Optional[Sequence[Sequence[float]]] = None  #: each target's start on the tool (mm; a probe's ball)
+    noise_mm: Optional[float] = None  #: the instrument's noise per coordinate, when known (None: estimated)
 
     def __post_init__(self) -> None:
         if self.loss not in LOSSES:
@@ -65,6 +66,8 @@ class FitOptions:
                              f"{self.loss_scale_mm}")
         if self.max_iterations < 1:
             raise ValueError(f"the iteration cap must be at least 1, not {self.max_iterations}")
+        if self.noise_mm is not None and not (self.noise_mm > 0 and math.isfinite(self.noise_mm)):
+            raise ValueError(f"--noise must be a positive number of mm, not {self.noise_mm}")
 
     def with_(self, **changes: Any) -> FitOptions:
         return replace(self, **changes)
@@ -80,7 +83,7 @@ class FitOptions:
                        orientation_weight=self.orientation_weight, max_iterations=self.max_iterations,
                        penalties=penalties, prior_sd=self.prior_sd,
                        prior_scale=1.0 if self.prior_scale is None else float(self.prior_scale),
-                       gravity=gravity or self.gravity, target_start=self.target_start)
+                       gravity=gravity or self.gravity, target_start=self.target_start, noise_mm=self.noise_mm)
 
     def fitter(self, robot: Robot, seed: int = 0) -> priors.Fitter:
         """The fit of a data set from the starting model (priors centred there; their width chosen per
@@ -99,13 +102,15 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
             covariance: bool = True, orientation_weight: float = 100.0, max_iterations: int = 100,
             fix: Sequence[str] = (), penalties: Sequence[tuple[str, float]] = (),
             prior_sd: Optional[dict[str, float]] = None, prior_scale: float = 0.0,
-            gravity: str = "auto", target_start: Optional[Sequence[Sequence[float]]] = None) -> _core.IdentifyOptions:
+            gravity: str = "auto", target_start: Optional[Sequence[Sequence[float]]] = None,
+            noise_mm: Optional[float] = None) -> _core.IdentifyOptions:
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
     joint_map smoothness penalty. ``prior_sd`` (kinds in file units, priors.DEFAULT_PRIOR_SD) times
     ``prior_scale`` (0: no priors); ``loss_scale_mm`` 0: from the residuals; ``target_start``: each
-    target's start on the tool (mm), e.g. a probe's nominal ball offset."""
+    target's start on the tool (mm), e.g. a probe's nominal ball offset; ``noise_mm``: the noise per
+    coordinate when known (weighs the priors, bends the loss; None: estimated from the residuals)."""
     effects = list(effects)
     o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss, gravity=gravity,
                               loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
@@ -115,6 +120,8 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
     o.prior_scale = float(prior_scale) if prior_sd is None or prior_sd else 0.0
     if target_start is not None:
         o.target_start = [np.asarray(t, dtype=float) for t in target_start]
+    if noise_mm is not None:
+        o.noise_mm = float(noise_mm)
     return o
 
 

@@ -57,6 +57,9 @@ struct IdentifyOptions {
   /// origin, then fitted to the data on the nominal geometry): a probe's nominal ball offset, without
   /// which a ballbar's pivots may start on the wrong side of their balls
   std::vector<Vec3> target_start;
+  /// the instrument's (or probe's) noise per coordinate (mm), when known: it weighs the priors and
+  /// sets the robust loss's bend in place of the estimate from the residuals (0: estimated)
+  double noise_mm = 0;
   std::function<void(int iteration, double cost)> progress;
   double orientation_weight = 100.0;  ///< mm per rad: how orientation residuals weigh against positions
 };

@@ -1,11 +1,12 @@
 """Planning a probe campaign (`kincal plan --kind sphere|plane|distance`): the orientations to touch
 each station with, and the accuracy they promise.
 
-The stations are placed as `kincal simulate --kind` places them (spheres and pivots in reach, the
-faces of one block), and every station gets a pool of candidate touches: the probe's axis within the
-cone, the commanded angles by inverse kinematics on the robot's model, inside its limits. From the
-pool the plan takes ``touches`` per station, one station after the other in turns, each time the
-candidate that most increases log det of the information matrix (Bayesian D-optimality)
+The stations are placed as `kincal simulate --kind` places them (spheres and pivots in reach, a
+block's top, the face towards the robot, its sideways faces and the surface plate it stands on), and
+every station gets a pool of candidate touches: the probe's axis within the cone, the commanded
+angles by inverse kinematics on the robot's model, inside its limits and away from singularities.
+From the pool the plan takes ``touches`` per station, one station after the other in turns, each
+time the candidate that most increases log det of the information matrix (Bayesian D-optimality)
 
     M = P + A^T A / sigma^2 + sum over the chosen touches J_i^T J_i / sigma^2
 
@@ -16,12 +17,15 @@ the core weighs them as one row of the data each), P the priors of `kincal ident
 parameters that the identifiability analysis holds on the whole pool (e.g. the base frame, which the
 stations' unknowns absorb) are left out.
 
-The predicted TCP uncertainty is the root mean square, over the configurations given (or random
-ones inside the limits), of the ball centre's error predicted by the posterior covariance M^-1,
-after the best rigid transform: the part of the error that a rigid motion of the whole set explains
-is projected out, as the accuracy figure removes it (the base frame is free in these data). The same
-figure for the first ``touches`` candidates of each station (random touches) says what the plan
-gains over touching at random.
+The predicted TCP uncertainty is the ball centre's error over the configurations given (or random
+ones inside the limits) that the probe's noise leaves in the MAP estimate (its covariance
+M^-1 (M - P) M^-1), after the best rigid transform: the part of the error that a rigid motion of the
+whole set explains is projected out, as the accuracy figure removes it (the base frame is free in
+these data). Its RMS over the configurations is a weighted sum of chi-square variables; the median
+and the 90th percentile over repeated campaigns are reported. Apart: what the priors decide, the
+error of a robot one prior sd off the priors' centre (M^-1 P M^-1), large where the touches do not
+determine the model (a missing known length); and the same noise figure for the first ``touches``
+candidates of each station (random touches), what the plan gains over touching at random.
 """
 
 from __future__ import annotations

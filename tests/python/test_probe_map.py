@@ -54,6 +54,8 @@ from kincal import _core
 from kincal.calibration import identify as ident, priors
 from kincal.calibration import simulation as sim
 
+from conftest import run
+
 LEVER_MM = 1000.0  # kArtifactLever (point_eval.hpp): an artifact's angle weighs as mm on a 1 m lever
 PROBE = np.array([0.0, 0.0, 150.0])  # simulate_probe's ball centre in the tool frame
 # the kind of each Parameter (its `kind`) as priors.cpp's prior kinds, "{}": its unit appended
@@ -316,3 +318,14 @@ def test_told_the_noise_kincal_is_the_plain_map_fit(tmp_path):
     map_rms = _rigid_rms(_point_balls(kr500, fit.fit.layout, m.solve(), q), t)
     print(f"faces, noise given: kincal {kincal_rms:.5f} mm, plain MAP {map_rms:.5f} mm")
     assert kincal_rms <= map_rms * (1 + 1e-3), (kincal_rms, map_rms)
+
+
+def test_a_noise_that_is_no_noise_is_refused(tmp_path):
+    kr500 = kincal.load_robot("kr500")
+    data = sim.simulate_probe(ident.default_truth(kr500, seed=3), "sphere", stations=2, touches=5, seed=5)
+    (tmp_path / "m.csv").write_text(ident.measurements_csv(data, 6))
+    for bad in ("0", "-0.01", "nan"):
+        r = run("kincal", "identify", "--robot", "kr500", "--data", str(tmp_path / "m.csv"), "--noise", bad,
+                "--out", str(tmp_path / "o.json"))
+        assert r.returncode == 1 and "--noise must be a positive number of mm" in r.stderr, r.stderr
+        assert not (tmp_path / "o.json").exists()

@@ -210,7 +210,9 @@ def add_diagnose(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
                                                  "(the final model, for compensate)")
     sp.add_argument("--folds", type=int, default=5, help="folds of the cross-validation (whole configurations per fold)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the folds")
+    sp.add_argument("--noise", type=float, help="the instrument's noise per coordinate (mm), when known: the "
+                    "diagnosis stops when what remains is at it (the fits estimate theirs from the residuals)")
     effect_opts(sp, "none", "the model the diagnosis starts from besides the geometry (these are no candidates)")
-    fit_opts(sp)
+    fit_opts(sp, noise=False)
     artifact_opt(sp)
     sp.set_defaults(func=cmd_diagnose)

@@ -87,8 +87,9 @@ def probe_start(args: argparse.Namespace) -> Optional[list[list[float]]]:
     return [probe_offset(args)] if getattr(args, "probe", None) else None
 
 
-def fit_opts(sp: argparse.ArgumentParser) -> None:
-    """The fitting options of identify and diagnose: one group, one default each (kincal.calibration.fitting)."""
+def fit_opts(sp: argparse.ArgumentParser, noise: bool = True) -> None:
+    """The fitting options of identify and diagnose: one group, one default each (kincal.calibration.fitting).
+    ``noise``: the fits' noise is --noise (else --fit-noise: diagnose's --noise is where its steps stop)."""
     loss_opts(sp, DEFAULT_LOSS_SCALE_MM)
     sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated "
                     "geometry (e.g. last year's calibration; default: the starting model)")
@@ -105,9 +106,9 @@ def fit_opts(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--tool-targets", metavar="CSV",
                     help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
                          "order): places the tool frame (TCP), which reflectors alone cannot")
-    sp.add_argument("--noise", type=float, metavar="MM", help="the instrument's (or probe's) noise per coordinate, "
-                    "when known: it weighs the priors and bends the robust loss (default: estimated from the "
-                    "residuals); diagnose also stops when what remains is at it")
+    sp.add_argument("--noise" if noise else "--fit-noise", type=float, metavar="MM", dest="fit_noise",
+                    help="the instrument's (or probe's) noise per coordinate, when known: the fits weigh their "
+                    "priors and bend the robust loss with it (default: estimated from the residuals)")
     sp.add_argument("--orientation-weight", type=float, default=100.0, metavar="MM_PER_RAD",
                     help="with measured orientations (a,b,c): mm of position residual worth one rad (default "
                          "100: 0.02 mm against 0.011 deg of noise)")
@@ -125,7 +126,7 @@ def fit_options(args: argparse.Namespace, robot: _core.Robot) -> FitOptions:
                       prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
                       prior_scale=priors.parse_prior_scale(args.prior_scale), gravity=args.gravity,
                       orientation_weight=args.orientation_weight, max_iterations=args.max_iterations,
-                      target_start=probe_start(args), noise_mm=args.noise)
+                      target_start=probe_start(args), noise_mm=getattr(args, "fit_noise", None))
 
 
 def effects_arg(args: argparse.Namespace, robot: _core.Robot, data: dict[str, Any]) -> Union[str, list[_core.Effect]]:

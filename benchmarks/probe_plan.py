@@ -4,7 +4,7 @@ campaign").
 Truth: kincal simulate's default truth (the kr500 with 1 mm / 0.05 deg geometric errors and joint
 compliance of about 0.003 deg/kNm), one per seed. For each design and seed: the plan (stations placed
 with the seed, `--candidates` touches per station, the predicted TCP uncertainty over 200 random
-configurations 10% inside the limits), its touches made on the truth (probe_plan.measure: the ball
+configurations drawn within 90% of each limit), its touches made on the truth (probe_plan.measure: the ball
 where the plan puts it, the truth's own angles, the probe's noise along each constraint), the fit
 (`kincal identify --effects joint_compliance --probe 0,0,150` with the artifact), and the accuracy:
 the ball centre's RMS over the same 200 configurations against the noise-free truth after the best

@@ -5,7 +5,7 @@ errors and joint compliance of about 0.003 deg/kNm), one per seed 1-5. The plann
 the truth by probe_plan.measure (the ball where the plan puts it, the truth's angles, the probe's noise
 along each constraint: 0.005 mm on a sphere's coordinates, 0.002 mm on a ballbar's length), fitted
 with identify (--effects joint_compliance, the probe's nominal offset as the start of its fit) and
-scored as BENCHMARKS.md scores them: the ball centre's RMS over 200 configurations 10% inside the
+scored as BENCHMARKS.md scores them: the ball centre's RMS over 200 configurations drawn within 90% of each of the
 limits against the noise-free truth, after the best rigid transform."""
 
 from __future__ import annotations
@@ -60,6 +60,7 @@ def test_plan_writes_the_touches_and_the_stations_artifact(tmp_path):
     (["--kind", "sphere", "--touches", "10", "--candidates", "5"], "--candidates (5) must be at least --touches (10)"),
     (["--kind", "sphere", "--probe", "0,150"], "--probe 0,150: expected X,Y,Z"),
     (["--kind", "distance", "--noise", "0"], "--noise must be a positive number"),
+    (["--kind", "sphere", "--poses", "40"], "--poses: tracker campaign options"),
 ])
 def test_bad_plan_input(tmp_path, argv, expect):
     r = run("kincal", "plan", "--robot", "kr500", *argv, "--out", str(tmp_path / "p.csv"))
@@ -99,16 +100,22 @@ def test_the_plans_prediction_matches_what_its_campaigns_reach(kind, stations, t
                              k_folds=0, fit=FitOptions(target_start=[PROBE]))
         predicted.append(plan.tcp_uncertainty_mm)
         measured.append(_rigid_rms(_balls(fit.robot, q, np.asarray(fit.targets)[0]), _balls(truth, q, PROBE)))
-        assert plan.tcp_uncertainty_mm < plan.random_tcp_uncertainty_mm  # the plan beats random touches
+        # predicted, the plan's touches beat as many drawn at random from the same pools (measured, a
+        # random campaign at other stations may do as well: BENCHMARKS.md)
+        assert plan.tcp_uncertainty_mm < plan.random_tcp_uncertainty_mm
     p, m = float(np.median(predicted)), float(np.median(measured))
     print(f"{kind}: predicted {np.round(predicted, 4)}, measured {np.round(measured, 4)} mm")
+    # issue 32's marks: at most 0.05 mm, the prediction within 25% (both medians of 5 seeds). Fixed
+    # seeds: one campaign's RMS scatters widely about its expectation (the faces': 0.01-0.05 mm), so
+    # this holds the measured ground (1.06, 1.06, 1.06), it does not calibrate the prediction
     assert m <= 0.05 and abs(p / m - 1) <= 0.25, (p, m)
 
 
 def test_identify_probe_start_is_checked_and_places_the_ball(tmp_path):
     # a ballbar campaign planned at 4 pivots (seed 2): identified from the tool frame's origin the
     # pivots started through points 150 mm off the balls (40-120 mm off after the fit, before the
-    # start used --probe); with it the fit reaches the truth's ball within the plan's promise
+    # start used --probe); with it the fit places the ball within 0.05 mm (the issue's mark; the plan
+    # promised 0.010)
     robot = kincal.load_robot("kr500")
     truth = ident.default_truth(robot, seed=2)
     plan = pp.plan_probe(robot, "distance", stations=4, touches=40, cone_deg=60, noise_mm=0.002, seed=2)
@@ -129,3 +136,13 @@ def test_identify_probe_start_is_checked_and_places_the_ball(tmp_path):
     assert r.returncode == 1 and "--probe 0,0: expected X,Y,Z" in r.stderr
     with pytest.raises(_core.InputError, match="2 target start"):
         ident.identify(robot, data, effects="none", k_folds=0, fit=FitOptions(target_start=[PROBE, PROBE]))
+
+
+def test_a_calibrated_model_is_planned_at_its_nominal_one():
+    # a model file from an earlier calibration (here a simulated truth: nominal and calibrated differ by
+    # about 1 mm) plans as its nominal model does, where identify starts
+    robot = kincal.load_robot("kr500")
+    truth = ident.default_truth(robot, seed=2)
+    a = pp.plan_probe(truth, "sphere", stations=2, touches=6, cone_deg=40, candidates=40, seed=3)
+    b = pp.plan_probe(robot, "sphere", stations=2, touches=6, cone_deg=40, candidates=40, seed=3)
+    assert np.array_equal(a.data["q_deg"], b.data["q_deg"]) and a.tcp_uncertainty_mm == b.tcp_uncertainty_mm

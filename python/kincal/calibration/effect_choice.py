@@ -214,6 +214,7 @@ class _Linearised:
         self.w: Optional[FloatArray] = None
         self._stacked: Optional[tuple[FloatArray, FloatArray]] = None  # (the fit's columns, them with the added ones)
         self.prior: Optional[tuple[FloatArray, FloatArray]] = None  # the priors' pseudo-rows (probe data)
+        self._aug: Optional[tuple[FloatArray, FloatArray]] = None  # (current columns, them with the pseudo-rows)
 
     def raw(self, cand: Candidate) -> tuple[FloatArray, FloatArray, FloatArray]:
         """The unweighted residual, current columns and candidate columns at the fit."""
@@ -256,8 +257,10 @@ class _Linearised:
         if self.prior is None:
             return r, cur, R
         P, rp = self.prior
-        Pc = np.hstack([P, np.zeros((len(P), cur.shape[1] - P.shape[1]))])  # the steps' added columns: no prior
-        return np.concatenate([r, rp]), np.vstack([cur, Pc]), np.vstack([R, np.zeros((len(P), R.shape[1]))])
+        if self._aug is None or self._aug[0] is not cur:  # one array per current columns: the search's basis made once
+            Pc = np.hstack([P, np.zeros((len(P), cur.shape[1] - P.shape[1]))])  # the steps' added columns: no prior
+            self._aug = (cur, np.vstack([cur, Pc]))
+        return np.concatenate([r, rp]), self._aug[1], np.vstack([R, np.zeros((len(P), R.shape[1]))])
 
     def _weights(self, r: FloatArray, p: int) -> FloatArray:
         """The pseudo-residuals' weights of the residual r (p parameters fitted): the fit's loss, bending
@@ -283,6 +286,7 @@ class _Linearised:
         out.__dict__.update(self.__dict__)
         out.added = self.added + [R]
         out._stacked = None
+        out._aug = None
         out.r_now = r - A @ delta
         if self.prior is not None:  # the priors' pseudo-residuals after the step
             P, rp = self.prior

@@ -67,7 +67,7 @@ class FitOptions:
         if self.max_iterations < 1:
             raise ValueError(f"the iteration cap must be at least 1, not {self.max_iterations}")
         if self.noise_mm is not None and not (self.noise_mm > 0 and math.isfinite(self.noise_mm)):
-            raise ValueError(f"--noise must be a positive number of mm, not {self.noise_mm}")
+            raise ValueError(f"the noise (--noise, --fit-noise) must be a positive number of mm, not {self.noise_mm}")
 
     def with_(self, **changes: Any) -> FitOptions:
         return replace(self, **changes)

@@ -30,6 +30,7 @@ candidates of each station (random touches), what the plan gains over touching a
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Union
@@ -126,6 +127,8 @@ def _ball_jacobian(robot: Robot, q: FloatArray, probe: FloatArray, effects: list
     for p in pm.layout.parameters:
         if p.kind == "target":
             x[p.index] = probe["xyz".index(p.name[-1])]
+        elif p.kind == "base":  # the points in the robot's base frame, as the balls the projector sees
+            x[p.index] = 0.0
     _, G = pm.residuals(list(x), data, True)
     G = np.asarray(G)
     col = {p.name: p.index for p in pm.layout.parameters}
@@ -216,10 +219,10 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
                n_configurations: int = 200, seed: int = 0, least: Optional[int] = None,
                progress: Optional[Callable[[int, int], None]] = None) -> ProbePlan:
     """The probe campaign's plan (see the module's text). ``configurations``: where the TCP
-    uncertainty is predicted (deg), else ``n_configurations`` random ones 10% inside the limits."""
+    uncertainty is predicted (deg), else ``n_configurations`` random ones within 90% of each limit."""
     if touches < 1 or stations < 1:
         raise ValueError(f"--stations and --touches must be positive, not {stations} and {touches}")
-    if candidates < touches:
+    if candidates < 1 or candidates < touches:
         raise ValueError(f"--candidates ({candidates}) must be at least --touches ({touches})")
     if not (noise_mm > 0 and math.isfinite(noise_mm)):
         raise ValueError(f"--noise must be a positive number of mm, not {noise_mm}")
@@ -255,8 +258,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
     q = configurations
     if q is None:
         lim = np.asarray(robot.limits_deg, dtype=float)
-        mid, half = lim.mean(axis=1), 0.5 * (lim[:, 1] - lim[:, 0])
-        q = np.random.default_rng(seed + 1).uniform(mid - 0.9 * half, mid + 0.9 * half, size=(n_configurations, robot.dof))
+        q = np.random.default_rng(seed + 1).uniform(0.9 * lim[:, 0], 0.9 * lim[:, 1], size=(n_configurations, robot.dof))
     q = np.asarray(q, dtype=float)
     names = [params[i].name for i in free]
     G = _ball_jacobian(robot, q, probe_v, [e for e in core_effects if e.name != "joint_compliance"], names) * scale
@@ -272,15 +274,25 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
                      stddev=np.sqrt(np.maximum(np.diag(cov), 0.0)) * scale, units=[params[i].unit for i in free], left_out=left_out)
 
 
+def _nominal(robot: Robot) -> Robot:
+    """The robot with its nominal model as its calibrated one (the plan linearises at the nominal
+    model, where identify starts; a model file from an earlier calibration carries both)."""
+    if not robot.identified:
+        return robot
+    doc = json.loads(robot.to_json())
+    return Robot.from_json(json.dumps({k: v for k, v in doc.items() if k not in ("calibrated", "identification")}),
+                           "the nominal model")
+
+
 def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> dict[str, Any]:
-    """The candidate touches: `kincal simulate --kind`'s campaign on the robot's model, noise-free,
+    """The candidate touches: `kincal simulate --kind`'s campaign on the robot's nominal model, noise-free,
     without the candidates near a singularity (a touch there cannot be made again to the plan's
     orientation). Stations placed where the cone cannot be reached, or with fewer than ``needed``
     candidates left, are placed again (up to 10 placements, each drawn from the seed)."""
     why = ""
     for attempt in range(10):
         try:
-            pool = sim.simulate_probe(robot, kind, noise_mm=0.0, seed=seed + 7919 * attempt, **kw)
+            pool = sim.simulate_probe(_nominal(robot), kind, noise_mm=0.0, seed=seed + 7919 * attempt, **kw)
         except _core.InputError as e:
             why = str(e)
             if "block has 5 faces" in why:

@@ -37,7 +37,7 @@ def _plan_probe(args: argparse.Namespace, robot: _core.Robot) -> None:
     res = probe_plan.plan_probe(robot, args.kind, stations=args.stations, touches=args.touches, cone_deg=args.cone,
                                 probe=probe_offset(args), radius_mm=args.radius, length_mm=args.length,
                                 block_mm=args.block, effects=ident.parse_effects(args.effects, robot, args.harmonics),
-                                noise_mm=noise, candidates=args.candidates or 300, configurations=conf,
+                                noise_mm=noise, candidates=300 if args.candidates is None else args.candidates, configurations=conf,
                                 seed=args.seed, progress=step_progress("plan"))
     if sys.stderr.isatty():
         print(file=sys.stderr)
@@ -56,6 +56,11 @@ def cmd_plan(args: argparse.Namespace) -> None:
 
     robot = robot_of(args)
     if args.kind:
+        ignored = [o for o, v in (("--poses", args.poses), ("--box", args.box), ("--instrument", args.instrument))
+                   if v is not None] + (["--min-sigma"] if args.min_sigma else [])
+        if ignored:
+            raise ValueError(f"{', '.join(ignored)}: tracker campaign options; a probe campaign (--kind) places its "
+                             "stations and keeps away from singularities itself")
         _plan_probe(args, robot)
         return
     if args.poses is None:
@@ -79,7 +84,7 @@ def cmd_plan(args: argparse.Namespace) -> None:
                          max_range=args.range, max_incidence_deg=args.max_incidence)
     res = plan.plan(robot, args.poses, targets=targets, effects=ident.parse_effects(args.effects, robot, args.harmonics),
                     candidates=cand,
-                    n_candidates=args.candidates or 5000, rules=rules, noise_mm=args.noise, seed=args.seed,
+                    n_candidates=5000 if args.candidates is None else args.candidates, rules=rules, noise_mm=args.noise, seed=args.seed,
                     progress=step_progress("plan"))
     if sys.stderr.isatty():
         print(file=sys.stderr)

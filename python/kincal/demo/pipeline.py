@@ -152,18 +152,18 @@ def _balls(robot: Robot, q: FloatArray, offset: FloatArray) -> FloatArray:
 def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagnosed_model: Robot) -> dict[str, Any]:
     """The demo's probe step: six spheres with a length bar, 25 touches each planned, made on the
     truth (0.005 mm), identified with the effects the data choose; the ball centre's RMS over 200
-    configurations 10% inside the limits after the best rigid transform, against the tracker's models
+    configurations drawn within 90% of each limit after the best rigid transform, against the tracker's models
     (identified and diagnosed) and the nominal one."""
+    lim = np.asarray(robot.limits_deg)
+    q = np.random.default_rng(SEED).uniform(0.9 * lim[:, 0], 0.9 * lim[:, 1], size=(200, robot.dof))
     plan = probe_plan.plan_probe(robot, "sphere", stations=6, touches=25, cone_deg=60, probe=PROBE, noise_mm=0.005,
-                                 seed=SEED)
+                                 configurations=q, seed=SEED)
     touches = probe_plan.measure(truth, plan.data, PROBE, 0.005, seed=SEED)  # the truth's backlash acting
     _core.write_file_atomic(str(out / "spheres.csv"), ident.measurements_csv(
         dict(touches, q_deg=_core.joints_to_controller(robot, touches["q_deg"])), robot.dof))
     _core.write_file_atomic(str(out / "spheres-artifact.csv"), _core.format_artifact(touches, robot.dof))
     res = ident.identify(robot, touches, fit=FitOptions(target_start=[PROBE]))
     _core.write_file_atomic(str(out / "spheres_model.json"), res.model_json())
-    lim = np.asarray(robot.limits_deg)
-    q = np.random.default_rng(SEED).uniform(0.9 * lim[:, 0], 0.9 * lim[:, 1], size=(200, robot.dof))
     ball = np.asarray(PROBE)
     t = _balls(truth, q, ball)
     return {"touches": int(len(touches["pose"])), "stations": 6, "predicted_mm": plan.tcp_uncertainty_mm,

@@ -12,7 +12,6 @@ import kincal
 from kincal import _core
 from kincal.calibration import plan
 from kincal.calibration import identify as ident
-from kincal.io.urdf import spec_urdf
 
 from conftest import random_q, run
 

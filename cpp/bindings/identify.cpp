@@ -335,6 +335,8 @@ void define_identify(py::module_& m) {
                      "the compliance of their joints on")
       .def_readwrite("orientation_weight", &IdentifyOptions::orientation_weight,
                      "mm per rad: how orientation residuals weigh against positions")
+      .def_readwrite("artifact_sd_mm", &IdentifyOptions::artifact_sd_mm,
+                     "the artifact's uncertainty (mm): its terms weigh noise / it (0: as one row's coordinate)")
       .def_readwrite("noise_mm", &IdentifyOptions::noise_mm,
                      "the noise per coordinate (mm) when known: weighs the priors and bends the loss (0: estimated)")
       .def_readwrite("target_start", &IdentifyOptions::target_start,

@@ -317,6 +317,7 @@ class IdentifyOptions:
     penalties: list[tuple[str, float]]
     target_start: list[np.ndarray]
     noise_mm: float
+    artifact_sd_mm: float
     prior_sd: list[tuple[str, float]]
     prior_scale: float
     def __init__(self, compliance: bool = ..., loss: str = ..., loss_scale_mm: float = ..., max_iterations: int = ...,

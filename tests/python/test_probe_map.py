@@ -329,3 +329,24 @@ def test_a_noise_that_is_no_noise_is_refused(tmp_path):
                 "--out", str(tmp_path / "o.json"))
         assert r.returncode == 1 and "(--noise, --fit-noise) must be a positive number of mm" in r.stderr, r.stderr
         assert not (tmp_path / "o.json").exists()
+
+
+def test_the_artifacts_uncertainty_weighs_its_lengths():
+    # six spheres (truth seed 3, campaign seed 5, 0.005 mm) whose length bar reads 0.05 mm long: weighed
+    # as one probe reading the fit meets the data halfway; given its uncertainty (`--artifact-sd
+    # 0.0001`) the fitted centres keep the bar's lengths, to a small share of the 0.05 mm
+    from kincal.calibration.fitting import FitOptions
+    kr500 = kincal.load_robot("kr500")
+    data = simulation_of(ident.default_truth(kr500, seed=3), CASES["spheres"])
+    data["artifact"] = [(a, b, d + 0.05, ang, note) for a, b, d, ang, note in data["artifact"]]
+    names = list(data["station_names"])
+
+    def worst(fit: ident.Identification) -> float:
+        pts = {s.name: np.asarray(s.point) for s in fit.fit.stations}
+        return max(abs(np.linalg.norm(pts[a] - pts[b]) - d) for a, b, d, _, _ in data["artifact"]
+                   if a in names and b in names)
+    plain = worst(ident.identify(kr500, data, effects="joint_compliance", k_folds=0))
+    weighed = worst(ident.identify(kr500, data, effects="joint_compliance", k_folds=0,
+                                   fit=FitOptions(artifact_sd_mm=1e-4)))
+    print(f"largest length error of the fitted centres: as a row {plain:.4f} mm, weighed {weighed:.5f} mm")
+    assert weighed < 0.1 * plain and weighed < 0.005, (plain, weighed)

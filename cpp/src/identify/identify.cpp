@@ -111,19 +111,23 @@ class RowCost : public ceres::CostFunction {
 /// A known length or angle of the artifact (the --artifact file): one residual, no robust loss.
 class ArtifactCost : public ceres::CostFunction {
  public:
-  ArtifactCost(const AllRows& all, size_t k) : all_(all), k_(k) {
+  ArtifactCost(const AllRows& all, size_t k, double weight) : all_(all), k_(k), w_(weight) {
     set_num_residuals(1);
     mutable_parameter_block_sizes()->push_back(all.size());
   }
   bool Evaluate(double const* const*, double* residuals, double** jacobians) const override {
-    residuals[0] = all_.artifact_residual(k_);
-    if (jacobians && jacobians[0]) std::copy_n(all_.artifact_jacobian(k_), all_.size(), jacobians[0]);
+    residuals[0] = w_ * all_.artifact_residual(k_);
+    if (jacobians && jacobians[0]) {
+      const double* g = all_.artifact_jacobian(k_);
+      for (int i = 0; i < all_.size(); ++i) jacobians[0][i] = w_ * g[i];
+    }
     return true;
   }
 
  private:
   const AllRows& all_;
   size_t k_;
+  double w_;
 };
 
 /// Ridge penalties and Gaussian priors: residual w_k (z_k - m_k) for the free parameters that carry one.
@@ -200,9 +204,11 @@ enum class Report { silent, progress };
 
 /// Levenberg-Marquardt on the free parameters of all (written back into its x by finish()).
 void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, const IdentifyOptions& opt,
-           ceres::Solver::Summary& summary, Report report, const std::vector<PenaltyTerm>& penalties = {}) {
+           ceres::Solver::Summary& summary, Report report, const std::vector<PenaltyTerm>& penalties = {},
+           double artifact_weight = 1.0) {
   for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, all.z());
-  for (size_t k = 0; k < all.artifact_terms(); ++k) problem.AddResidualBlock(new ArtifactCost(all, k), nullptr, all.z());
+  for (size_t k = 0; k < all.artifact_terms(); ++k)
+    problem.AddResidualBlock(new ArtifactCost(all, k, artifact_weight), nullptr, all.z());
   if (!penalties.empty()) problem.AddResidualBlock(new PenaltyCost(penalties, all.size()), nullptr, all.z());
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -337,7 +343,7 @@ class Stage2 {
       : pm_(pm), data_(data), x_(x), opt_(opt), res_(res) {}
   /// start: the linearization at x when x is the start (its first evaluation reused).
   void solve(const std::vector<int>& free_idx, const Linearization* start, double scale_mm,
-             std::vector<PenaltyTerm> priors) {
+             std::vector<PenaltyTerm> priors, double artifact_weight = 1.0) {
     problem_.reset();  // before the rows and the loss it refers to
     all_ = std::make_unique<AllRows>(pm_.at(x_), data_, x_, free_idx, opt_.orientation_weight);
     if (start) all_->seed(*start);
@@ -347,7 +353,7 @@ class Stage2 {
     std::vector<PenaltyTerm> terms = penalty_terms(res_.layout, free_idx, opt_);
     terms.insert(terms.end(), priors.begin(), priors.end());
     free_ = free_idx;
-    kincal::solve(*problem_, *all_, loss_.get(), opt_, summary, Report::progress, terms);
+    kincal::solve(*problem_, *all_, loss_.get(), opt_, summary, Report::progress, terms, artifact_weight);
     if (first_) initial_cost = summary.initial_cost, first_ = false;
     iterations += static_cast<int>(summary.iterations.size()) - 1;
     ++passes_;
@@ -440,7 +446,10 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   // stage 2: everything identifiable, its first evaluation the linearization at the start
   Stage2 s2(pm, data, x, opt, res);
   const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double v) { return std::isfinite(v); });
-  if (!priors && (opt.loss_scale_mm > 0 || opt.loss == Loss::none)) {
+  if (!(opt.artifact_sd_mm >= 0) || !std::isfinite(opt.artifact_sd_mm))
+    throw InputError("identify: the artifact's uncertainty must be a finite number of mm >= 0 (0: as a row's)");
+  const bool weighed_artifact = opt.artifact_sd_mm > 0 && !data.artifact.empty();  // needs the noise
+  if (!priors && !weighed_artifact && (opt.loss_scale_mm > 0 || opt.loss == Loss::none)) {
     s2.solve(free_idx, &at_start, opt.loss_scale_mm, {});
   } else {
     // the noise from a least-squares start on what the data determine (one Gauss-Newton step from the
@@ -455,7 +464,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
     for (int pass = 0; pass < 2; ++pass) {
       const double scale = opt.loss_scale_mm > 0 ? opt.loss_scale_mm : loss_threshold(res.noise_mm, s2.row_size());
       s2.solve(free_idx, pass == 0 ? &at_start : nullptr, opt.loss == Loss::none ? 0.0 : scale,
-               prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm));
+               prior_terms(res.prior_sd, res.start, free_idx, res.noise_mm),
+               weighed_artifact ? res.noise_mm / opt.artifact_sd_mm : 1.0);
       if (pass == 1 || opt.noise_mm > 0) break;  // a noise given is not re-estimated
       // res.noise_mm stays the one the final solve weighed the priors and set the loss with
       const double again = s2.noise(determined.size());

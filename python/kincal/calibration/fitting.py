@@ -55,6 +55,7 @@ class FitOptions:
     max_iterations: int = 100
     target_start: Optional[Sequence[Sequence[float]]] = None  #: each target's start on the tool (mm; a probe's ball)
     noise_mm: Optional[float] = None  #: the instrument's noise per coordinate, when known (None: estimated)
+    artifact_sd_mm: Optional[float] = None  #: the artifact's uncertainty (None: its terms weigh as a row's)
 
     def __post_init__(self) -> None:
         if self.loss not in LOSSES:
@@ -66,6 +67,8 @@ class FitOptions:
                              f"{self.loss_scale_mm}")
         if self.max_iterations < 1:
             raise ValueError(f"the iteration cap must be at least 1, not {self.max_iterations}")
+        if self.artifact_sd_mm is not None and not (self.artifact_sd_mm > 0 and math.isfinite(self.artifact_sd_mm)):
+            raise ValueError(f"--artifact-sd must be a positive number of mm, not {self.artifact_sd_mm}")
         if self.noise_mm is not None and not (self.noise_mm > 0 and math.isfinite(self.noise_mm)):
             raise ValueError(f"the noise (--noise, --fit-noise) must be a positive number of mm, not {self.noise_mm}")
 
@@ -83,7 +86,8 @@ class FitOptions:
                        orientation_weight=self.orientation_weight, max_iterations=self.max_iterations,
                        penalties=penalties, prior_sd=self.prior_sd,
                        prior_scale=1.0 if self.prior_scale is None else float(self.prior_scale),
-                       gravity=gravity or self.gravity, target_start=self.target_start, noise_mm=self.noise_mm)
+                       gravity=gravity or self.gravity, target_start=self.target_start, noise_mm=self.noise_mm,
+                       artifact_sd_mm=self.artifact_sd_mm)
 
     def fitter(self, robot: Robot, seed: int = 0) -> priors.Fitter:
         """The fit of a data set from the starting model (priors centred there; their width chosen per
@@ -103,7 +107,7 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
             fix: Sequence[str] = (), penalties: Sequence[tuple[str, float]] = (),
             prior_sd: Optional[dict[str, float]] = None, prior_scale: float = 0.0,
             gravity: str = "auto", target_start: Optional[Sequence[Sequence[float]]] = None,
-            noise_mm: Optional[float] = None) -> _core.IdentifyOptions:
+            noise_mm: Optional[float] = None, artifact_sd_mm: Optional[float] = None) -> _core.IdentifyOptions:
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge
     penalties (parameter name, weight in mm per unit of the parameter), e.g. the diagnosis's
@@ -122,6 +126,8 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
         o.target_start = [np.asarray(t, dtype=float) for t in target_start]
     if noise_mm is not None:
         o.noise_mm = float(noise_mm)
+    if artifact_sd_mm is not None:
+        o.artifact_sd_mm = float(artifact_sd_mm)
     return o
 
 

@@ -151,7 +151,7 @@ def _copy(o: _core.IdentifyOptions, **changes: Any) -> _core.IdentifyOptions:
     c = _core.IdentifyOptions()
     for name in ("compliance", "loss", "loss_scale_mm", "max_iterations", "rank_tolerance", "min_torque_share",
                  "weak_tolerance", "correlation_threshold", "covariance", "fix", "compliance_joints", "effects",
-                 "orientation_weight", "penalties", "prior_sd", "prior_scale", "gravity", "target_start", "noise_mm"):
+                 "orientation_weight", "penalties", "prior_sd", "prior_scale", "gravity", "target_start", "noise_mm", "artifact_sd_mm"):
         setattr(c, name, changes.get(name, getattr(o, name)))
     return c
 

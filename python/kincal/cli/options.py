@@ -106,6 +106,9 @@ def fit_opts(sp: argparse.ArgumentParser, noise: bool = True) -> None:
     sp.add_argument("--tool-targets", metavar="CSV",
                     help="x,y,z of every target in the tool frame (designed or measured on a CMM, in target "
                          "order): places the tool frame (TCP), which reflectors alone cannot")
+    sp.add_argument("--artifact-sd", type=float, metavar="MM", help="the uncertainty of the --artifact file's "
+                    "lengths (mm; an angle's on a 1 m lever): they weigh the noise / it against the rows (default: "
+                    "each as one coordinate of a row)")
     sp.add_argument("--noise" if noise else "--fit-noise", type=float, metavar="MM", dest="fit_noise",
                     help="the instrument's (or probe's) noise per coordinate, when known: the fits weigh their "
                     "priors and bend the robust loss with it (default: estimated from the residuals)")
@@ -126,7 +129,8 @@ def fit_options(args: argparse.Namespace, robot: _core.Robot) -> FitOptions:
                       prior_sd=priors.parse_prior_sd(args.prior_sd), prior_model=prior_model,
                       prior_scale=priors.parse_prior_scale(args.prior_scale), gravity=args.gravity,
                       orientation_weight=args.orientation_weight, max_iterations=args.max_iterations,
-                      target_start=probe_start(args), noise_mm=getattr(args, "fit_noise", None))
+                      target_start=probe_start(args), noise_mm=getattr(args, "fit_noise", None),
+                      artifact_sd_mm=args.artifact_sd)
 
 
 def effects_arg(args: argparse.Namespace, robot: _core.Robot, data: dict[str, Any]) -> Union[str, list[_core.Effect]]:

@@ -60,6 +60,9 @@ struct IdentifyOptions {
   /// the instrument's (or probe's) noise per coordinate (mm), when known: it weighs the priors and
   /// sets the robust loss's bend in place of the estimate from the residuals (0: estimated)
   double noise_mm = 0;
+  /// the artifact's uncertainty (mm; an angle's on a 1 m lever): its known lengths and angles weigh
+  /// noise / artifact_sd against the rows (0: each as one coordinate of a row, as a probe reading)
+  double artifact_sd_mm = 0;
   std::function<void(int iteration, double cost)> progress;
   double orientation_weight = 100.0;  ///< mm per rad: how orientation residuals weigh against positions
 };
@@ -78,7 +81,10 @@ struct IdentifyResult {
   /// barely seen where a generic campaign would determine it)
   std::vector<bool> at_prior;
   std::vector<double> prior_sd;           ///< the prior's standard deviation (scaled; inf: none)
-  double noise_mm = 0;                    ///< the residuals' robust spread per coordinate (0: not estimated)
+  double noise_mm = 0;
+  /// the artifact's uncertainty (mm; an angle's on a 1 m lever): its known lengths and angles weigh
+  /// noise / artifact_sd against the rows (0: each as one coordinate of a row, as a probe reading)
+  double artifact_sd_mm = 0;                    ///< the residuals' robust spread per coordinate (0: not estimated)
   double loss_scale_mm = 0;               ///< the robust loss's scale used in the final fit (0: no robust loss)
   std::vector<std::string> fixed_reason;  ///< why it is held ("" when free)
   ModelSpec calibrated;

@@ -22,7 +22,6 @@ import time
 import numpy as np
 
 import kincal
-from kincal import _core
 from kincal.calibration import identify as ident
 from kincal.calibration import probe_plan as pp
 from kincal.calibration import simulation as sim
@@ -35,20 +34,13 @@ DESIGNS = {"sphere": (6, 25, 60.0, 0.005, 400.0), "plane": (5, 40, 60.0, 0.005, 
 
 
 def balls(robot: kincal.Robot, q: np.ndarray) -> np.ndarray:
-    p = _core.fk(robot, q)
-    return p[:, :3] + np.array([_core.abc_to_rotation(a) for a in p[:, 3:]]) @ PROBE
-
-
-def rigid_rms(a: np.ndarray, b: np.ndarray) -> float:
-    m = _core.rigid_fit(a, b)
-    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
+    return pp.ball_centres(robot, q, PROBE)
 
 
 def accuracy(robot: kincal.Robot, truth: kincal.Robot, data: dict, q: np.ndarray) -> float:
     fit = ident.identify(robot, data, effects=["joint_compliance"], k_folds=0, fit=FitOptions(target_start=[PROBE]))
-    p = _core.fk(fit.robot, q)
-    mine = p[:, :3] + np.array([_core.abc_to_rotation(a) for a in p[:, 3:]]) @ np.asarray(fit.targets)[0]
-    return rigid_rms(mine, balls(truth, q))
+    mine = pp.ball_centres(fit.robot, q, np.asarray(fit.targets)[0])
+    return pp.rigid_rms(mine, balls(truth, q))
 
 
 def main() -> None:

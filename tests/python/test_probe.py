@@ -15,21 +15,9 @@ import pytest
 import kincal
 from kincal import _core
 from kincal.calibration import identify as ident
+from kincal.calibration.probe_plan import ball_centres as _balls, rigid_rms as _rigid_rms
 
 from conftest import run
-
-
-def _rigid_rms(a: np.ndarray, b: np.ndarray) -> float:
-    """RMS distance between the points a and b after the best rigid transform of a onto b (the core's fit)."""
-    m = _core.rigid_fit(a, b)
-    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
-
-
-def _balls(robot: kincal.Robot, q: np.ndarray, offset: np.ndarray) -> np.ndarray:
-    """The ball centres (tool-frame offset) of a robot's calibrated model at q, base frame."""
-    p = _core.fk(robot, q)
-    rot = np.array([_core.abc_to_rotation(abc) for abc in p[:, 3:]])
-    return p[:, :3] + rot @ offset
 
 
 def test_spheres_with_a_length_bar_from_the_command_line(tmp_path):

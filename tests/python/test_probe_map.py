@@ -52,6 +52,7 @@ from scipy.optimize import least_squares
 import kincal
 from kincal import _core
 from kincal.calibration import identify as ident, priors
+from kincal.calibration.probe_plan import ball_centres as _balls, rigid_rms as _rigid_rms
 from kincal.calibration import simulation as sim
 
 from conftest import run
@@ -67,20 +68,6 @@ CASES = {
     "block_and_plate": {"kind": "plane", "stations": 5, "touches": 40, "noise_mm": 0.005},
     "ballbar": {"kind": "distance", "stations": 4, "touches": 40, "noise_mm": 0.002},
 }
-
-
-def _rigid_rms(a: np.ndarray, b: np.ndarray) -> float:
-    """RMS distance between the points a and b after the best rigid transform of a onto b (the core's fit)."""
-    m = _core.rigid_fit(a, b)
-    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
-
-
-def _balls(robot: kincal.Robot, q: np.ndarray, offset: np.ndarray) -> np.ndarray:
-    """The ball centres (tool-frame offset) of a robot's calibrated model at q, its base frame (as
-    test_probe.py); every joint's last motion positive (only a backlash reads it)."""
-    p = _core.fk(robot, q, dir=np.ones_like(q))
-    rot = np.array([_core.abc_to_rotation(abc) for abc in p[:, 3:]])
-    return p[:, :3] + rot @ offset
 
 
 def _unit_orthogonal(n: np.ndarray) -> np.ndarray:

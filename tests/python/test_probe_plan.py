@@ -18,22 +18,13 @@ import pytest
 import kincal
 from kincal import _core
 from kincal.calibration import identify as ident
+from kincal.calibration.probe_plan import ball_centres as _balls, rigid_rms as _rigid_rms
 from kincal.calibration import probe_plan as pp
 from kincal.calibration.fitting import FitOptions
 
 from conftest import run
 
 PROBE = np.array([0.0, 0.0, 150.0])
-
-
-def _balls(robot: kincal.Robot, q: np.ndarray, offset: np.ndarray) -> np.ndarray:
-    p = _core.fk(robot, q)
-    return p[:, :3] + np.array([_core.abc_to_rotation(a) for a in p[:, 3:]]) @ offset
-
-
-def _rigid_rms(a: np.ndarray, b: np.ndarray) -> float:
-    m = _core.rigid_fit(a, b)
-    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
 
 
 def test_plan_writes_the_touches_and_the_stations_artifact(tmp_path):

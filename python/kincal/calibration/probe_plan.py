@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Un
 import numpy as np
 
 from .. import _core
+from ..io import strict_json
 from .._core import Robot
 from . import identify as ident
 from . import simulation as sim
@@ -88,6 +89,22 @@ class ProbePlan:
             lines.append("held on every candidate (not determined by these data):")
             lines += [f"  {n:<22} {why}" for n, why in self.left_out]
         return "\n".join(lines)
+
+
+def ball_centres(robot: Robot, q: FloatArray, offset: Union[Sequence[float], FloatArray]) -> FloatArray:
+    """The ball centres (``offset``: mm in the tool frame) of a robot's calibrated model at q (deg),
+    base frame, every joint's last motion positive (a backlash reads it)."""
+    q = np.asarray(q, dtype=float)
+    p = np.asarray(_core.fk(robot, q, True, False, np.ones_like(q)))
+    out: FloatArray = p[:, :3] + np.array([_core.abc_to_rotation(abc) for abc in p[:, 3:]]) @ np.asarray(offset, dtype=float)
+    return out
+
+
+def rigid_rms(a: FloatArray, b: FloatArray) -> float:
+    """RMS distance of the points a from b after the best rigid transform of a onto b (the core's
+    Horn fit): the accuracy of a probe calibration, whose data do not see the base frame."""
+    m = np.asarray(_core.rigid_fit(a, b))
+    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
 
 
 def _subset(data: dict[str, Any], rows: IntArray) -> dict[str, Any]:
@@ -280,7 +297,7 @@ def _nominal(robot: Robot) -> Robot:
     if not robot.identified:
         return robot
     doc = json.loads(robot.to_json())
-    return Robot.from_json(json.dumps({k: v for k, v in doc.items() if k not in ("calibrated", "identification")}),
+    return Robot.from_json(strict_json.dumps({k: v for k, v in doc.items() if k not in ("calibrated", "identification")}),
                            "the nominal model")
 
 

@@ -136,19 +136,6 @@ def _fivebar(out: Path) -> tuple[dict[str, dict[str, Any]], list[float], dict[An
 PROBE = (0.0, 0.0, 150.0)
 
 
-def _rigid_rms(a: FloatArray, b: FloatArray) -> float:
-    """RMS distance of the points a from b after the best rigid transform of a onto b."""
-    m = _core.rigid_fit(a, b)
-    return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
-
-
-def _balls(robot: Robot, q: FloatArray, offset: FloatArray) -> FloatArray:
-    """The ball centres (an offset in the tool frame) of a robot's calibrated model at q, base frame,
-    every joint's last motion positive (a backlash reads it)."""
-    p = _core.fk(robot, q, True, False, np.ones_like(q))
-    return p[:, :3] + np.array([_core.abc_to_rotation(abc) for abc in p[:, 3:]]) @ offset
-
-
 def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagnosed_model: Robot) -> dict[str, Any]:
     """The demo's probe step: six spheres with a length bar, 25 touches each planned, made on the
     truth (0.005 mm), identified with the effects the data choose; the ball centre's RMS over 200
@@ -165,12 +152,12 @@ def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagno
     res = ident.identify(robot, touches, fit=FitOptions(target_start=[PROBE]))
     _core.write_file_atomic(str(out / "spheres_model.json"), res.model_json())
     ball = np.asarray(PROBE)
-    t = _balls(truth, q, ball)
+    t = probe_plan.ball_centres(truth, q, ball)
     return {"touches": int(len(touches["pose"])), "stations": 6, "predicted_mm": plan.tcp_uncertainty_mm,
-            "effects": res.effect_labels(), "nominal_mm": _rigid_rms(_balls(robot, q, ball), t),
-            "spheres_mm": _rigid_rms(_balls(res.robot, q, np.asarray(res.targets)[0]), t),
-            "tracker_mm": _rigid_rms(_balls(tracker_model, q, ball), t),
-            "tracker_diagnosed_mm": _rigid_rms(_balls(diagnosed_model, q, ball), t),
+            "effects": res.effect_labels(), "nominal_mm": probe_plan.rigid_rms(probe_plan.ball_centres(robot, q, ball), t),
+            "spheres_mm": probe_plan.rigid_rms(probe_plan.ball_centres(res.robot, q, np.asarray(res.targets)[0]), t),
+            "tracker_mm": probe_plan.rigid_rms(probe_plan.ball_centres(tracker_model, q, ball), t),
+            "tracker_diagnosed_mm": probe_plan.rigid_rms(probe_plan.ball_centres(diagnosed_model, q, ball), t),
             "held_out_rms_mm": res.validation["after_rms_mm"]}
 
 

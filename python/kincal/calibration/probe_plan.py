@@ -186,11 +186,10 @@ def predicted_rms(G: FloatArray, cov: FloatArray, points: FloatArray, seed: int 
     return float(np.median(rms)), float(np.percentile(rms, 90))
 
 
-def _greedy(Jw: FloatArray, station: IntArray, touches: int, M0: FloatArray, least: int,
+def _greedy(Jw: FloatArray, station: IntArray, touches: int, M0: FloatArray,
             progress: Optional[Callable[[int, int], None]] = None) -> tuple[list[int], FloatArray]:
-    """``touches`` x stations candidates, each the largest gain log det(I + J_i M^-1 J_i^T): the
-    stations in turns until each has ``least``, then wherever the gain is largest; returns the chosen
-    rows and the final M^-1."""
+    """``touches`` candidates per station, the stations in turns, each the largest gain
+    log det(I + J_i M^-1 J_i^T); returns the chosen rows and the final M^-1."""
     Minv = np.linalg.inv(M0)
     Minv = 0.5 * (Minv + Minv.T)
     stations = np.unique(station)
@@ -199,11 +198,11 @@ def _greedy(Jw: FloatArray, station: IntArray, touches: int, M0: FloatArray, lea
     e = Jw.shape[1]
     eye = np.eye(e)
     steps = touches * len(stations)
-    turns = [s for _ in range(min(least, touches)) for s in stations]
+    turns = [s for _ in range(touches) for s in stations]
     while len(chosen) < steps:
         if progress:
             progress(len(chosen), steps)
-        idx = np.flatnonzero(left & (station == turns[len(chosen)])) if len(chosen) < len(turns) else np.flatnonzero(left)
+        idx = np.flatnonzero(left & (station == turns[len(chosen)]))
         if len(idx) == 0:
             raise ValueError(f"plan: a station has fewer candidates than the {touches} touches asked for")
         A = Jw[idx]                                            # (c, e, p)
@@ -233,7 +232,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
                probe: Sequence[float] = (0.0, 0.0, 150.0), radius_mm: float = 3.0, length_mm: float = 150.0,
                block_mm: float = 400.0, effects: Union[str, Sequence[Union[str, _core.Effect]]] = ("joint_compliance",),
                noise_mm: float = 0.005, candidates: int = 300, configurations: Optional[FloatArray] = None,
-               n_configurations: int = 200, seed: int = 0, least: Optional[int] = None,
+               n_configurations: int = 200, seed: int = 0,
                progress: Optional[Callable[[int, int], None]] = None) -> ProbePlan:
     """The probe campaign's plan (see the module's text). ``configurations``: where the TCP
     uncertainty is predicted (deg), else ``n_configurations`` random ones within 90% of each limit."""
@@ -270,7 +269,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
     A = J[n_rows:] / noise_mm * scale
     P = np.diag(np.where(np.isfinite(sd), 1.0, 1e-6))
     M0 = P + A.T @ A
-    picked, _ = _greedy(Jw, station, touches, M0, touches if least is None else least, progress)
+    picked, _ = _greedy(Jw, station, touches, M0, progress)
     chosen = _path_within_stations(pool, picked)
     q = configurations
     if q is None:

@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "kincal/core/fastmath.hpp"
 
@@ -46,9 +49,8 @@ inline double wrap(double a) {  // to (-pi, pi]; the angles here are at most a f
     a -= two_pi * std::floor((a + kPi) / two_pi);
     return a <= -kPi ? a + two_pi : (a > kPi ? a - two_pi : a);
   }
-  while (a > kPi) a -= two_pi;
-  while (a <= -kPi) a += two_pi;
-  return a;
+  a -= two_pi * fastmath::round_nearest(a * (1 / two_pi));  // no data-dependent branch
+  return a <= -kPi ? a + two_pi : (a > kPi ? a - two_pi : a);
 }
 
 // An angle with its cosine and sine, taken from the atan2 arguments that define it: the rotations
@@ -110,10 +112,10 @@ inline Angle sub1(const Vec3& k, const Vec3& u, const Vec3& v) {
 // c = rot(k2, t2) u = rot(k1, -t1) v: k2.c = k2.u, k1.c = k1.v, |c| = |u|; c = a k1 + b k2 +- g n.
 // Both subproblem-1 solutions are linear in +-g: theta2 takes u to c about k2, theta1 takes c to v
 // about k1; with up, vp the parts of u, v normal to k2, k1 and m = k1 x n, the projections reduce to
-// dot products of v with k1, k2, n and m (the terms with a vector twice in a triple product vanish).
-int sub2_wrist(const IkSolver::Constants& k, const Vec3& k1, const Vec3& k2, const Vec3& v, Angle t1[2],
-               Angle t2[2], bool first_only, Tangency& tg) {
-  const double k1v = k1.dot(v), k2v = k2.dot(v), nv = k.n.dot(v), mv = k.m.dot(v);
+// dot products of v with k1, k2, n and m (the terms with a vector twice in a triple product vanish):
+// sub2_dots takes these four products.
+int sub2_dots(const IkSolver::Constants& k, double k1v, double k2v, double nv, double mv, Angle t1[2], Angle t2[2],
+              bool first_only, Tangency& tg) {
   const double alpha = (k.k12 * k.k2u - k1v) * k.inv_den;
   const double beta = (k.k12 * k1v - k.k2u) * k.inv_den;
   const double g2 = (k.u2 - alpha * alpha - beta * beta - 2 * alpha * beta * k.k12) * k.inv_n2;
@@ -135,6 +137,11 @@ int sub2_wrist(const IkSolver::Constants& k, const Vec3& k1, const Vec3& k2, con
   return count;
 }
 
+int sub2_wrist(const IkSolver::Constants& k, const Vec3& k1, const Vec3& k2, const Vec3& v, Angle t1[2],
+               Angle t2[2], bool first_only, Tangency& tg) {
+  return sub2_dots(k, k1.dot(v), k2.dot(v), k.n.dot(v), k.m.dot(v), t1, t2, first_only, tg);
+}
+
 // SP3 of the elbow: q3 with |rot(w3, q3)(pw - p3) - (p2 - p3)| = d (IkSolver::Constants).
 // Returns the count (0, 1 or 2).
 int sub3_elbow(const IkSolver::Constants& k, double d, Angle t[2], Tangency& tg) {
@@ -149,12 +156,8 @@ int sub3_elbow(const IkSolver::Constants& k, double d, Angle t[2], Tangency& tg)
   return 2;
 }
 
-// SP4: theta with h . rot(k, theta) u = d. Returns the count (0, 1 or 2).
-int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2], Tangency& tg) {
-  // h . (k (k.u) + cos t (u - k (k.u)) + sin t (k x u)) = d
-  const double A = h.dot(u - k * k.dot(u));
-  const double B = h.dot(k.cross(u));
-  const double C = d - h.dot(k) * k.dot(u);
+// SP4 reduced to A cos t + B sin t = C. Returns the count (0, 1 or 2).
+int sub4_abc(double A, double B, double C, Angle t[2], Tangency& tg) {
   const double r = std::sqrt(A * A + B * B);  // mm-sized terms: no overflow
   if (r < 1e-12) return 0;
   const double inv_r = 1 / r;
@@ -165,6 +168,12 @@ int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2], Tang
   plus_minus(phi, ca, t[0], t[1]);
   if (tangent) return 1;
   return 2;
+}
+
+// SP4: theta with h . rot(k, theta) u = d. Returns the count (0, 1 or 2).
+// h . (k (k.u) + cos t (u - k (k.u)) + sin t (k x u)) = d
+int sub4(const Vec3& h, const Vec3& k, const Vec3& u, double d, Angle t[2], Tangency& tg) {
+  return sub4_abc(h.dot(u - k * k.dot(u)), h.dot(k.cross(u)), d - h.dot(k) * k.dot(u), t, tg);
 }
 
 bool parallel(const Vec3& a, const Vec3& b, double tol) { return a.cross(b).norm() < tol; }
@@ -209,7 +218,7 @@ void fill_constants(IkSolver::Constants& k, const Vec3* w, const Vec3* p, const 
 
 }  // namespace
 
-IkSolver::IkSolver(const Model& m) {
+IkSolver::IkSolver(const Model& m, IkForm form) {
   const int n = m.dof();
   w_.fill(Vec3::Zero());
   p_.fill(Vec3::Zero());
@@ -248,31 +257,102 @@ IkSolver::IkSolver(const Model& m) {
       st_.wrist_flip = std::abs(w_[3].dot(w_[4])) < 1e-12 && std::abs(w_[4].dot(w_[5])) < 1e-12 &&
                        w_[3].cross(w_[5]).norm() < 1e-12;
       fill_constants(k_, w_.data(), p_.data(), c);
+      fill_ortho(form, c);
     }
   }
 }
 
-IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& opt) const {
-  const double* ref_deg = opt.reference_deg;
-  const bool greedy = opt.branches == Branches::NearestReference && ref_deg != nullptr;
-  // index of the candidate nearest the reference angle (deg), comparing modulo 360
-  auto nearer = [&](const Angle* cand, int n, int joint) {
+void IkSolver::fill_ortho(IkForm form, const Vec3& c) {
+  const Vec3 &w1 = w_[0], &w2 = w_[1], &w3 = w_[2];
+  const double sigma = w3.dot(w2) > 0 ? 1.0 : -1.0;
+  st_.ortho_parallel = form == IkForm::Fastest && st_.wrist_flip && std::abs(w1.dot(w2)) < 1e-12 &&
+                       (w3 - sigma * w2).norm() < 1e-12;
+  if (!st_.ortho_parallel) return;
+  Ortho& o = o_;
+  o.ct.row(0) = w1;
+  o.ct.row(1) = w2;
+  o.ct.row(2) = w1.cross(w2).normalized();
+  o.d = w2.dot(c - p_[0]);
+  o.p21 = o.ct * (p_[1] - p_[0]);
+  const Vec3 pw3 = o.ct * (c - p_[2]), p32 = o.ct * (p_[2] - p_[1]);
+  o.pw3_1 = pw3[0];
+  o.pw3_3 = pw3[2];
+  o.p32_1 = p32[0];
+  o.p32_3 = p32[2];
+  o.sigma = sigma;
+  o.tau = w_[5].dot(w_[3]) > 0 ? 1.0 : -1.0;
+  o.w4 = o.ct * w_[3];
+  o.w5 = o.ct * w_[4];
+  o.n = o.ct * k_.n;
+  o.m = o.ct * k_.m;
+}
+
+namespace {
+
+// Which branches of a subproblem's solutions a solve visits: all, or (NearestReference) the one
+// nearest the reference angle, comparing modulo 360.
+struct Branch {
+  const double* ref_deg;
+  bool greedy;
+  int pick(const Angle* cand, int n, int joint) const {
     if (!greedy || n < 2) return 0;
     const double r = ref_deg[joint] * kDeg;
     return std::abs(wrap(cand[1].q - r)) < std::abs(wrap(cand[0].q - r)) ? 1 : 0;
-  };
-  IkSolutions out;
-  Tangency tg;
-  tg.clamp = opt.out_of_reach == OutOfReach::Nearest;
-  if (!st_.spherical_wrist_parallel_23) {
-    out.status = IkStatus::Unsupported;
-    return out;
   }
-  const Vec3& pw = st_.wrist_center;
+  int pick_wrist(const Angle* t4, const Angle* t5, int n) const {
+    if (!greedy || n < 2) return 0;
+    auto dist = [&](int i) {
+      return std::abs(wrap(t4[i].q - ref_deg[3] * kDeg)) + std::abs(wrap(t5[i].q - ref_deg[4] * kDeg));
+    };
+    return dist(1) < dist(0) ? 1 : 0;
+  }
+  int begin(int b) const { return greedy ? b : 0; }
+  int end(int b, int n) const { return greedy ? std::min(b + 1, n) : n; }
+};
+
+IkSolutions unsupported() {
+  IkSolutions out;
+  out.status = IkStatus::Unsupported;
+  return out;
+}
+
+}  // namespace
+
+IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& opt) const {
+  if (!st_.spherical_wrist_parallel_23) return unsupported();
   // G = T M^-1 = e^{xi1 q1} ... e^{xi6 q6}; the wrist centre maps to p = G pw.
   const Mat3 gr = target.linear() * tool_.linear().transpose();
   const Vec3 gt = target.translation() - gr * tool_.translation();
-  const Vec3 p = gr * pw + gt;
+  const Vec3 p = gr * st_.wrist_center + gt;
+  IkSolutions out = st_.ortho_parallel ? solve_ortho(gr, p, opt) : solve_vector(gr, p, opt);
+  to_degrees(out, opt.reference_deg);
+  out.status = out.count > 0 ? IkStatus::Ok : IkStatus::OutOfReach;
+  return out;
+}
+
+// One solution (radians) into out, its wrist polished near the singularity (wrist: the sine of the
+// angle between axes 4 and 6), flagged; to_degrees converts all of them at the end.
+void IkSolver::record(IkSolutions& out, double* q, double wrist, const Mat3& gr, bool shoulder, bool clamped) const {
+  const Vec3 &w1 = w_[0], &w2 = w_[1], &w3 = w_[2];
+  IkSolution& s = out.sol[out.count];
+  if (wrist < 1e-3) {  // within 0.06 deg of the singularity q5 has lost digits
+    const Mat3 r456 = (axis_rotation(w1, q[0]) * axis_rotation(w2, q[1]) * axis_rotation(w3, q[2])).transpose() * gr;
+    polish_wrist(w_[3], w_[4], w_[5], r456, q + 3);
+  }
+  for (int j = 0; j < 6; ++j) s.q_deg[j] = q[j];
+  s.wrist_singular = wrist < 1e-7;
+  s.shoulder_singular = shoulder;
+  s.approximate = clamped;
+  ++out.count;
+}
+
+IkSolutions IkSolver::solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt) const {
+  const double* ref_deg = opt.reference_deg;
+  const Branch br{ref_deg, opt.branches == Branches::NearestReference && ref_deg != nullptr};
+  IkSolutions out;
+  Tangency tg;
+  tg.clamp = opt.out_of_reach == OutOfReach::Nearest;
+  const Vec3& pw = st_.wrist_center;
   const Vec3 &w1 = w_[0], &w2 = w_[1], &w3 = w_[2], &w4 = w_[3], &w5 = w_[4], &w6 = w_[5];
   const Vec3 &p1 = p_[0], &p2 = p_[1], &p3 = p_[2];
   // The wrist rotation R456 = (R1 R2 R3)^T G is needed only applied to w6 (for q4, q5) and to a
@@ -303,8 +383,8 @@ IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& op
     nq1 = n1;
   }
   const bool clamped1 = tg.clamped;  // q1 itself came from a tangency
-  const int b1 = nearer(q1s, nq1, 0);
-  for (int i1 = greedy ? b1 : 0; i1 < (greedy ? std::min(b1 + 1, nq1) : nq1); ++i1) {
+  const int b1 = br.pick(q1s, nq1, 0);
+  for (int i1 = br.begin(b1); i1 < br.end(b1, nq1); ++i1) {
     const Angle& a1 = q1s[i1];
     const Vec3 pp = rotv(w1, a1.c, -a1.s, p - p1) + p1;  // e^{-xi1 q1} p
     const Vec3 w6_1 = rotv(w1, a1.c, -a1.s, gw6), v6_1 = rotv(w1, a1.c, -a1.s, gv6);
@@ -312,8 +392,8 @@ IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& op
     tg.clamped = clamped1;
     const int n3 = sub3_elbow(kc, (pp - p2).norm(), t3, tg);
     const bool clamped3 = tg.clamped;  // flags of this shoulder and elbow branch only
-    const int b3 = nearer(t3, n3, 2);
-    for (int i3 = greedy ? b3 : 0; i3 < (greedy ? std::min(b3 + 1, n3) : n3); ++i3) {
+    const int b3 = br.pick(t3, n3, 2);
+    for (int i3 = br.begin(b3); i3 < br.end(b3, n3); ++i3) {
       const Angle& a3 = t3[i3];
       const Vec3 x = rotv(w3, a3.c, a3.s, pw - p3) + p3;
       const Angle a2 = sub1(w2, x - p2, pp - p2);
@@ -338,64 +418,187 @@ IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& op
       Angle a6_first;  // q6 of the first wrist solution, when the second is its flip
       if (flip && n45 == 2)
         a6_first = sub1(w6, v6, rotv(w5, t5[0].c, -t5[0].s, rotv(w4, t4[0].c, -t4[0].s, v6_456)));
-      int b45 = 0;
-      if (greedy && n45 == 2) {
-        auto dist = [&](int i) {
-          return std::abs(wrap(t4[i].q - ref_deg[3] * kDeg)) + std::abs(wrap(t5[i].q - ref_deg[4] * kDeg));
-        };
-        b45 = dist(1) < dist(0) ? 1 : 0;
-      }
-      for (int i45 = greedy ? b45 : 0; i45 < (greedy ? std::min(b45 + 1, n45) : n45); ++i45) {
+      const int b45 = br.pick_wrist(t4, t5, n45);
+      for (int i45 = br.begin(b45); i45 < br.end(b45, n45); ++i45) {
         const Angle &a4 = t4[i45], &a5 = t5[i45];
         // q6 takes v6 to rot(w5, -q5) rot(w4, -q4) R456 v6
         const Angle a6 = !(flip && n45 == 2) ? sub1(w6, v6, rotv(w5, a5.c, -a5.s, rotv(w4, a4.c, -a4.s, v6_456)))
                          : i45 == 0          ? a6_first
                                              : Angle{a6_first.q + kPi, -a6_first.c, -a6_first.s};
-        IkSolution& s = out.sol[out.count];
         double q[6] = {a1.q, a2.q, a3.q, a4.q, a5.q, a6.q};
         // sin of the angle between axes 4 and 6 (|sin q5| for a wrist with the flip)
         const double wrist = flip ? std::abs(a5.s) : w4.cross(rotv(w5, a5.c, a5.s, w6)).norm();
-        if (wrist < 1e-3) {  // within 0.06 deg of the singularity q5 has lost digits
-          const Mat3 r456 = (axis_rotation(w1, a1.q) * axis_rotation(w2, a2.q) * axis_rotation(w3, a3.q)).transpose() * gr;
-          polish_wrist(w4, w5, w6, r456, q + 3);
-        }
-        for (int j = 0; j < 6; ++j) s.q_deg[j] = wrap(q[j]) * (180 / kPi);
-        s.wrist_singular = wrist < 1e-7;
-        s.shoulder_singular = shoulder;
-        s.approximate = tg.clamped;
-        ++out.count;
+        record(out, q, wrist, gr, shoulder, tg.clamped);
       }
     }
   }
-  // shift by 360 deg into the limits, nearest the reference
-  for (int i = 0; i < out.count; ++i) {
-    IkSolution& s = out.sol[i];
-    bool ok = true;
-    for (int j = 0; j < 6; ++j) {
-      // the whole turn nearest the reference (|k| <= 2); when it falls outside the limits, the
-      // nearest of the five that lie inside
-      const double q = s.q_deg[j], ref = ref_deg ? ref_deg[j] : 0.0;
-      const double kn = std::min(2.0, std::max(-2.0, fastmath::round_nearest((ref - q) * (1.0 / 360))));
-      const double c = q + 360.0 * kn;
-      if (c >= lo_[j] && c <= hi_[j]) {
-        s.q_deg[j] = c;
-        continue;
-      }
-      double best = q;
-      bool found = false;
-      for (int k = -2; k <= 2; ++k) {
-        const double ck = q + 360.0 * k;
-        if (ck < lo_[j] || ck > hi_[j]) continue;
-        if (!found || std::abs(ck - ref) < std::abs(best - ref)) best = ck;
-        found = true;
-      }
-      s.q_deg[j] = best;
-      ok = ok && found;
-    }
-    s.within_limits = ok;
-  }
-  out.status = out.count > 0 ? IkStatus::Ok : IkStatus::OutOfReach;
   return out;
+}
+
+// The ortho-parallel robots: the subproblems of solve_vector in the frame C of axes 1 and 2, where a
+// rotation about axis 1 (axis 2, 3) turns components 2 and 3 (1 and 3) only, and the wrist's in the
+// frame (w4, w5, w4 x w5), with v6 = w5: each rotation is a plane rotation of two numbers. The arm
+// branches (q1, q3) go through each stage together, so that their independent arctangents overlap.
+// Same branches in the same order; a wrist centre on axis 1 (or out of reach) goes to solve_vector.
+IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt) const {
+  const double* ref_deg = opt.reference_deg;
+  const Branch br{ref_deg, opt.branches == Branches::NearestReference && ref_deg != nullptr};
+  Tangency tg;
+  tg.clamp = opt.out_of_reach == OutOfReach::Nearest;
+  const Ortho& o = o_;
+  const Constants& kc = k_;
+  const Vec3 u = o.ct * (p - p_[0]);
+  const Vec3 gw = o.ct * (gr * w_[5]), gv = o.ct * (gr * w_[4]);  // C G w6, C G w5
+  // q1 (sub4 with h = w2, k = w1: A = w2 . u, B = w2 . (w1 x u), C = d)
+  Angle t1[2];
+  const int n1 = sub4_abc(u[1], -u[2], o.d, t1, tg);
+  if (n1 == 0) return solve_vector(gr, p, opt);
+  const bool clamped1 = tg.clamped;
+  // the arm branches (q1, q3), in the order of solve_vector's loops
+  struct Arm {
+    Angle a1, a3, a2;
+    Vec3 y, w6, v6;  // e^{-xi1 q1} p - p2, and C G w6, C G w5 turned back by -q1
+    bool clamped;
+  };
+  Arm arm[4];
+  int na = 0;
+  Angle q1s[2];
+  for (int i = 0; i < n1; ++i) q1s[i] = negated(t1[i]);
+  const int b1 = br.pick(q1s, n1, 0);
+  for (int i1 = br.begin(b1); i1 < br.end(b1, n1); ++i1) {
+    const Angle& a1 = q1s[i1];
+    // rotation about axis 1 by -q1 on components 2, 3
+    auto r1 = [&](const Vec3& v) { return Vec3(v[0], v[1] * a1.c + v[2] * a1.s, -v[1] * a1.s + v[2] * a1.c); };
+    const Vec3 y = r1(u) - o.p21;
+    Angle t3[2];
+    tg.clamped = clamped1;
+    const int n3 = sub3_elbow(kc, y.norm(), t3, tg);
+    const int b3 = br.pick(t3, n3, 2);
+    for (int i3 = br.begin(b3); i3 < br.end(b3, n3); ++i3) arm[na++] = Arm{a1, t3[i3], Angle{}, y, r1(gw), r1(gv), tg.clamped};
+  }
+  // q2 (sub1 about w2 from x - p2 = rot(w2, sigma q3)(pw - p3) + p3 - p2 to y, components 1 and 3)
+  for (int k = 0; k < na; ++k) {
+    Arm& a = arm[k];
+    const double c3 = a.a3.c, s3 = o.sigma * a.a3.s;
+    const double x1 = o.pw3_1 * c3 + o.pw3_3 * s3 + o.p32_1, x3 = -o.pw3_1 * s3 + o.pw3_3 * c3 + o.p32_3;
+    a.a2 = from_xy(x1 * a.y[0] + x3 * a.y[2], x3 * a.y[0] - x1 * a.y[2]);
+  }
+  // q4, q5 (sub2 of the wrist) and q6 of the first wrist solution of each arm branch
+  Angle t4[4][2], t5[4][2], a6[4];
+  int n45[4];
+  for (int k = 0; k < na; ++k) {
+    Arm& a = arm[k];
+    // rotation about axis 2 by -(q2 + sigma q3) on components 1, 3
+    const double c = a.a2.c * a.a3.c - o.sigma * a.a2.s * a.a3.s, s = a.a2.s * a.a3.c + o.sigma * a.a2.c * a.a3.s;
+    const Vec3 w6(a.w6[0] * c - a.w6[2] * s, a.w6[1], a.w6[0] * s + a.w6[2] * c);
+    a.v6 = Vec3(a.v6[0] * c - a.v6[2] * s, a.v6[1], a.v6[0] * s + a.v6[2] * c);
+    tg.clamped = a.clamped;
+    n45[k] = sub2_dots(kc, o.w4.dot(w6), o.w5.dot(w6), o.n.dot(w6), o.m.dot(w6), t4[k], t5[k], true, tg);
+    a.clamped = tg.clamped;
+  }
+  for (int k = 0; k < na; ++k) {
+    if (n45[k] == 0) continue;
+    // q6 takes w5 to rot(w5, -q5) rot(w4, -q4) R456 w5; in the frame (w4, w5, n) a turn about w4
+    // moves components 2, 3 and one about w5 components 1, 3; sub1 about tau w4 from (0, 1, 0)
+    const Vec3& v = arm[k].v6;
+    const double e1 = o.w4.dot(v), e2 = o.w5.dot(v), e3 = o.n.dot(v);
+    const Angle &a4 = t4[k][0], &a5 = t5[k][0];
+    const double f2 = e2 * a4.c + e3 * a4.s, f3 = -e2 * a4.s + e3 * a4.c;
+    a6[k].q = fastmath::atan2(o.tau * (e1 * a5.s + f3 * a5.c), f2);
+  }
+  IkSolutions out;
+  for (int k = 0; k < na; ++k) {
+    if (n45[k] == 2) {  // the other wrist: (q4 + pi, -q5, q6 + pi)
+      t4[k][1].q = t4[k][0].q + kPi;
+      t5[k][1] = negated(t5[k][0]);
+    }
+    const int b45 = br.pick_wrist(t4[k], t5[k], n45[k]);
+    for (int i45 = br.begin(b45); i45 < br.end(b45, n45[k]); ++i45) {
+      double q[6] = {arm[k].a1.q, arm[k].a2.q, arm[k].a3.q, t4[k][i45].q, t5[k][i45].q, a6[k].q + i45 * kPi};
+      record(out, q, std::abs(t5[k][i45].s), gr, false, arm[k].clamped);
+    }
+  }
+  return out;
+}
+
+// The solutions' angles, radians within a few turns, to degrees, each shifted by whole turns into the
+// limits, nearest the reference. For a reference within the limits and less than a turn from zero
+// (the usual case): the turn nearest the reference when it lands inside; else the next turn towards
+// the limits (the candidates beyond are farther from both); else none (the angle in [-180, 180], out
+// of limits): the choice into_limits makes, up to rounding, joint by joint over the solutions, two at
+// a time in SSE2 registers without branches on the data (other targets: into_limits one by one).
+void IkSolver::to_degrees(IkSolutions& out, const double* ref_deg) const {
+  const int n = out.count;
+  bool simple = true;
+  for (int j = 0; j < 6; ++j) {
+    const double r = ref_deg ? ref_deg[j] : 0.0;
+    simple = simple && r >= lo_[j] && r <= hi_[j] && std::abs(r) < 360;
+  }
+#if defined(__SSE2__)
+  if (simple && n > 2) {  // (one or two solutions, the nearest branch: the scalar loop is as quick)
+    const __m128d magic = _mm_set1_pd(6755399441055744.0);  // fastmath::round_nearest
+    auto round = [&](__m128d v) { return _mm_sub_pd(_mm_add_pd(v, magic), magic); };
+    auto select = [](__m128d m, __m128d a, __m128d b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); };
+    const __m128d turn = _mm_set1_pd(360), inv_turn = _mm_set1_pd(1.0 / 360), half = _mm_set1_pd(-180);
+    const __m128d sign = _mm_set1_pd(-0.0), deg = _mm_set1_pd(180 / kPi);
+    __m128d ok[4];
+    for (auto& o : ok) o = _mm_castsi128_pd(_mm_set1_epi32(-1));
+    for (int j = 0; j < 6; ++j) {
+      const __m128d r = _mm_set1_pd(ref_deg ? ref_deg[j] : 0.0), lo = _mm_set1_pd(lo_[j]), hi = _mm_set1_pd(hi_[j]);
+      for (int i = 0; i < n; i += 2) {
+        const int i2 = i + 1 < n ? i + 1 : i;  // an odd count: the last lane repeats the last solution
+        const __m128d d = _mm_mul_pd(_mm_set_pd(out.sol[i2].q_deg[j], out.sol[i].q_deg[j]), deg);
+        // the turn nearest r, then the next turn towards the limits
+        const __m128d y0 = _mm_add_pd(d, _mm_mul_pd(turn, round(_mm_mul_pd(_mm_sub_pd(r, d), inv_turn))));
+        const __m128d above = _mm_cmpgt_pd(y0, hi);
+        const __m128d in0 = _mm_andnot_pd(above, _mm_cmpge_pd(y0, lo));
+        const __m128d y1 = _mm_add_pd(y0, _mm_xor_pd(turn, _mm_and_pd(above, sign)));
+        const __m128d in1 = _mm_and_pd(_mm_cmpge_pd(y1, lo), _mm_cmple_pd(y1, hi));
+        // none inside: the angle in (-180, 180]
+        __m128d w = _mm_sub_pd(d, _mm_mul_pd(turn, round(_mm_mul_pd(d, inv_turn))));
+        w = _mm_add_pd(w, _mm_and_pd(_mm_cmple_pd(w, half), turn));
+        const __m128d y = select(in0, y0, select(in1, y1, w));
+        ok[i / 2] = _mm_and_pd(ok[i / 2], _mm_or_pd(in0, in1));
+        _mm_storel_pd(&out.sol[i].q_deg[j], y);
+        _mm_storeh_pd(&out.sol[i2].q_deg[j], y);
+      }
+    }
+    for (int i = 0; i < n; ++i) out.sol[i].within_limits = (_mm_movemask_pd(ok[i / 2]) >> (i % 2)) & 1;
+    return;
+  }
+#endif
+  for (int i = 0; i < n; ++i) {
+    Vec6& q = out.sol[i].q_deg;
+    for (int j = 0; j < 6; ++j) q[j] = wrap(q[j]) * (180 / kPi);
+    out.sol[i].within_limits = into_limits(q, ref_deg);
+  }
+}
+
+// The angles (deg, in [-180, 180]) shifted by whole turns into the limits, nearest the reference
+// (or 0): the whole turn nearest the reference (|k| <= 2); when it falls outside the limits, the
+// nearest of the five that lie inside; none: q kept, out of limits (false). to_degrees' general case.
+bool IkSolver::into_limits(Vec6& qd, const double* ref_deg) const {
+  bool ok = true;
+  for (int j = 0; j < 6; ++j) {
+    const double q = qd[j], ref = ref_deg ? ref_deg[j] : 0.0;
+    const double kn = std::min(2.0, std::max(-2.0, fastmath::round_nearest((ref - q) * (1.0 / 360))));
+    const double c = q + 360.0 * kn;
+    if (c >= lo_[j] && c <= hi_[j]) {
+      qd[j] = c;
+      continue;
+    }
+    double best = q;
+    bool found = false;
+    for (int k = -2; k <= 2; ++k) {
+      const double ck = q + 360.0 * k;
+      if (ck < lo_[j] || ck > hi_[j]) continue;
+      if (!found || std::abs(ck - ref) < std::abs(best - ref)) best = ck;
+      found = true;
+    }
+    qd[j] = best;
+    ok = ok && found;
+  }
+  return ok;
 }
 
 int IkSolutions::nearest(const double* ref_deg) const {

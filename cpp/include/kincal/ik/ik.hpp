@@ -77,6 +77,17 @@ struct IkStructure {
   /// axis 5 normal to axes 4 and 6, which are parallel at zero: the second wrist solution of every
   /// arm solution is (q4 + 180, -q5, q6 + 180) (KUKA, ABB, FANUC wrists)
   bool wrist_flip = false;
+  /// the ortho-parallel robots among them (axis 1 normal to axis 2, axis 3 = +-axis 2, a wrist with
+  /// the flip, any offsets and any base placement): solved by the same subproblems written as plane
+  /// rotations in a frame of axes 1 and 2 (a fifth of the arithmetic), the same solutions in the
+  /// same order
+  bool ortho_parallel = false;
+};
+
+/// Which form of the closed form IkSolver uses.
+enum class IkForm {
+  Fastest,     ///< the plane-rotation form on ortho-parallel robots, the vector form on the others
+  PadenKahan,  ///< the vector form on every robot of the class (a cross-check of the faster form)
 };
 
 /// The closed-form IK of one model: its structure, its constants, and the solve.
@@ -98,7 +109,7 @@ class IkSolver {
 
   /// Checks the model's structure and, for a model of the class, computes the constants. A model
   /// outside the class gives a solver whose solve() answers Unsupported (structure().reason says why).
-  explicit IkSolver(const Model& m);
+  explicit IkSolver(const Model& m, IkForm form = IkForm::Fastest);
 
   const IkStructure& structure() const { return st_; }
   const Constants& constants() const { return k_; }
@@ -109,8 +120,27 @@ class IkSolver {
   IkSolutions solve(const Eigen::Isometry3d& target, const IkOptions& opt = IkOptions()) const;
 
  private:
+  /// The ortho-parallel form's constants: the frame C of axes 1 and 2 (rows w1, w2, w1 x w2) and
+  /// the model's vectors in it.
+  struct Ortho {
+    Mat3 ct = Mat3::Identity();
+    double d = 0;             ///< w2 . (pw - p1): the wrist centre's offset along axis 2
+    Vec3 p21 = Vec3::Zero();  ///< C (p2 - p1)
+    double pw3_1 = 0, pw3_3 = 0, p32_1 = 0, p32_3 = 0;  ///< C (pw - p3) and C (p3 - p2), components 1 and 3
+    double sigma = 1;         ///< w3 = sigma w2
+    double tau = 1;           ///< w6 = tau w4
+    Vec3 w4 = Vec3::Zero(), w5 = Vec3::Zero(), n = Vec3::Zero(), m = Vec3::Zero();  ///< C w4, C w5, C n, C m
+  };
+  IkSolutions solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt) const;
+  IkSolutions solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt) const;
+  bool into_limits(Vec6& q_deg, const double* ref_deg) const;
+  void to_degrees(IkSolutions& out, const double* ref_deg) const;
+  void fill_ortho(IkForm form, const Vec3& wrist_center);
+  void record(IkSolutions& out, double* q, double wrist, const Mat3& gr, bool shoulder, bool clamped) const;
+
   IkStructure st_;
   Constants k_;
+  Ortho o_;
   std::array<Vec3, 6> w_, p_;          ///< unit axes and axis points of the model
   Eigen::Isometry3d tool_;             ///< tool frame at the zero configuration
   std::array<double, 6> lo_{}, hi_{};  ///< joint limits (deg) widened by 1e-9

@@ -79,7 +79,7 @@ struct IkStructure {
   bool wrist_flip = false;
   /// the ortho-parallel robots among them (axis 1 normal to axis 2, axis 3 = +-axis 2, a wrist with
   /// the flip, any offsets and any base placement): solved by the same subproblems written as plane
-  /// rotations in a frame of axes 1 and 2 (a fifth of the arithmetic), the same solutions in the
+  /// rotations of two numbers in a frame of axes 1 and 2 (no 3-D rotation), the same solutions in the
   /// same order
   bool ortho_parallel = false;
 };

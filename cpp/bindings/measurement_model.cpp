@@ -102,7 +102,7 @@ void define_measurement_model(py::module_& m) {
       .def(
           "residuals",
           [](const PyPointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight,
-             bool artifact) {
+             bool artifact, const std::optional<std::vector<int>>& columns) {
             const ParamLayout& L = p.pm.layout();
             const MeasurementSet data = measurements_from_dict(d, L.dof);
             if (static_cast<int>(x.size()) != L.size) throw InputError("PointModel: wrong parameter count");
@@ -112,21 +112,33 @@ void define_measurement_model(py::module_& m) {
             const PointState at = PointModel(*p.model, p.options, &data).at(x);
             const size_t n = residual_size(residual_kind(data)) * data.rows.size();
             const size_t na = artifact ? data.artifact.size() : 0;
-            std::vector<int> every(L.size);
-            std::iota(every.begin(), every.end(), 0);
+            std::vector<int> cols(L.size);
+            std::iota(cols.begin(), cols.end(), 0);
+            if (columns) {
+              for (int c : *columns)
+                if (c < 0 || c >= L.size) throw InputError("PointModel.residuals: column " + std::to_string(c) + " of " +
+                                                           std::to_string(L.size));
+              cols = *columns;
+            }
+            const auto F = static_cast<Eigen::Index>(cols.size());
             Eigen::VectorXd r(n + na);
-            RowMatrix J(jac ? n + na : 0, L.size);
+            RowMatrix J(jac ? n + na : 0, F);
             {
               py::gil_scoped_release free;  // the rows run on the core's threads
-              all_residuals(at, data, weight, every, r.data(), jac ? J.data() : nullptr);
-              for (size_t k = 0; k < na; ++k)
-                r[static_cast<Eigen::Index>(n + k)] =
-                    at.artifact_residual(data.artifact[k], jac ? J.row(static_cast<Eigen::Index>(n + k)).data() : nullptr);
+              all_residuals(at, data, weight, cols, r.data(), jac ? J.data() : nullptr);
+              Eigen::VectorXd full(jac ? L.size : 0);  // an artifact term's whole row, then its columns
+              for (size_t k = 0; k < na; ++k) {
+                const auto row = static_cast<Eigen::Index>(n + k);
+                r[row] = at.artifact_residual(data.artifact[k], jac ? full.data() : nullptr);
+                for (Eigen::Index c = 0; jac && c < F; ++c) J(row, c) = full[cols[static_cast<size_t>(c)]];
+              }
             }
-            return py::make_tuple(r, J);
+            // moved into the arrays (not copied): a planning Jacobian is hundreds of MB
+            return py::make_tuple(py::cast(std::move(r)), py::cast(std::move(J)));
           },
           py::arg("x"), py::arg("data"), py::arg("jacobian") = false, py::arg("orientation_weight") = 100.0,
-          py::arg("artifact") = false,
+          py::arg("artifact") = false, py::arg("columns") = py::none(),
           "The rows' residuals (residual_size per row, unused equations 0) and with `artifact` the\n"
-          "artifact's terms after them (mm: a length's error, an angle's on a 1 m lever)");
+          "artifact's terms after them (mm: a length's error, an angle's on a 1 m lever); the Jacobian\n"
+          "of the layout's parameters, or of `columns` (their indices) only");
 }

@@ -152,7 +152,6 @@ ModelSpec random_ortho_robot(std::mt19937_64& rng) {
   auto rv = [&] { return Vec3(nd(rng), nd(rng), nd(rng)); };
   auto sgn = [&] { return nd(rng) > 0 ? 1.0 : -1.0; };
   const Mat3 r0 = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
-  (void)ud(rng);
   const Vec3 o = rv() * 200;
   const Vec3 w1 = r0 * Vec3::UnitZ() * sgn(), w2 = r0 * Vec3::UnitY() * sgn();
   const Vec3 p2 = o + r0 * Vec3(300 * ud(rng), 0, 300 + 500 * ud(rng));

@@ -137,3 +137,25 @@ def test_a_calibrated_model_is_planned_at_its_nominal_one():
     a = pp.plan_probe(truth, "sphere", stations=2, touches=6, cone_deg=40, candidates=40, seed=3)
     b = pp.plan_probe(robot, "sphere", stations=2, touches=6, cone_deg=40, candidates=40, seed=3)
     assert np.array_equal(a.data["q_deg"], b.data["q_deg"]) and a.tcp_uncertainty_mm == b.tcp_uncertainty_mm
+
+
+def test_residuals_of_chosen_columns_are_those_of_the_whole_jacobian():
+    """PointModel.residuals(columns=...): the Jacobian of those parameters only, artifact terms
+    included, equals the whole Jacobian's columns (a planned sphere campaign with its distances;
+    the planner asks for the free columns only); a column outside the layout is refused."""
+    robot = kincal.load_robot("kr500")
+    pool = pp._pool(robot, "sphere", 5, stations=3, touches=5, cone_deg=35.0, probe=np.array([0.0, 0.0, 150.0]),
+                    radius_mm=3.0, length_mm=150.0, block_mm=400.0, seed=3)
+    assert len(pool["artifact"]) > 0
+    res = _core.identify(robot, pool, pp.options([], loss="none", max_iterations=0, covariance=False, prior_sd=None,
+                                                 prior_scale=1.0, target_start=[[0.0, 0.0, 150.0]]))
+    pm = _core.PointModel(robot, 1, [], stations_of=res.layout)
+    x = list(res.start)
+    r_all, J_all = pm.residuals(x, pool, True, artifact=True)
+    cols = [0, 7, 12, len(x) - 1, 3]
+    r_some, J_some = pm.residuals(x, pool, True, artifact=True, columns=cols)
+    assert np.asarray(J_some).shape == (len(r_all), len(cols))
+    np.testing.assert_array_equal(np.asarray(r_some), np.asarray(r_all))
+    np.testing.assert_array_equal(np.asarray(J_some), np.asarray(J_all)[:, cols])
+    with pytest.raises(_core.InputError, match="column"):
+        pm.residuals(x, pool, True, columns=[len(x)])

@@ -255,10 +255,10 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
     pm = _core.PointModel(robot, 1, [e for e in core_effects if e.name != "joint_compliance"],
                           stations_of=res.layout)
     x = np.asarray(res.start, dtype=float)  # the ball at the probe's offset, the stations through it
-    r, J = pm.residuals(list(x), pool, True, artifact=True)
+    r, J = pm.residuals(list(x), pool, True, artifact=True, columns=free.tolist())
     if np.max(np.abs(r)) > 1e-6 * max(1.0, float(np.max(np.abs(probe_v)))):
         raise AssertionError(f"plan: the candidates are {np.max(np.abs(r)):.3g} mm off their stations at the start")
-    J = np.asarray(J)[:, free]
+    J = np.asarray(J)
     n_rows = len(J) - len(pool.get("artifact", []))
     Jw, station = _whitened_rows(J[:n_rows], pool, noise_mm)
     # columns scaled: by the prior's sd where there is one, else to unit RMS over the pool's rows

@@ -53,14 +53,7 @@ ModelSpec random_robot(std::mt19937_64& rng, bool orthogonal_wrist = false, bool
     axes[4] = axes[3].cross(rv()).normalized();
     axes[5] = (nd(rng) > 0 ? 1 : -1) * axes[3];
   }
-  for (int j = 0; j < 6; ++j) {
-    JointSpec js;
-    js.point = pts[j];
-    js.axis = axes[j];
-    js.lower_deg = -360;
-    js.upper_deg = 360;
-    s.joints.push_back(js);
-  }
+  test::add_joints(s, pts, axes);
   s.tool.xyz = wc + rv() * 200;
   s.tool.abc = Vec3(nd(rng) * 60, nd(rng) * 30, nd(rng) * 60);
   s.gravity = Vec3::Zero();
@@ -162,14 +155,12 @@ ModelSpec random_ortho_robot(std::mt19937_64& rng) {
   const Vec3 axes[6] = {w1, w2, sgn() * w2, w4, w5, w6};
   ModelSpec s;
   s.name = "random_ortho";
+  double lo[6], hi[6];
   for (int j = 0; j < 6; ++j) {
-    JointSpec js;
-    js.point = pts[j];
-    js.axis = axes[j];
-    js.lower_deg = -20 - 330 * ud(rng);
-    js.upper_deg = 20 + 330 * ud(rng);
-    s.joints.push_back(js);
+    lo[j] = -20 - 330 * ud(rng);
+    hi[j] = 20 + 330 * ud(rng);
   }
+  test::add_joints(s, pts, axes, lo, hi);
   s.tool.xyz = wc + rv() * 200;
   s.tool.abc = Vec3(nd(rng) * 60, nd(rng) * 30, nd(rng) * 60);
   s.gravity = Vec3::Zero();
@@ -238,18 +229,7 @@ TEST(Ik, OrthoParallelFormEqualsTheVectorForm) {
       const Vec3 w1 = m.axis(0), p1 = m.point(0);
       if (((wc - p1) - w1 * w1.dot(wc - p1)).norm() < 1.0) continue;  // the shoulder singularity
       const IkSolutions one = fast.solve(t, IkOptions(q));
-      // near a singularity of the wrist (axes 4 and 6 within 1 deg), of the shoulder or the elbow (two
-      // solutions of q1, or of q3 for one q1, within 1 deg): each form's rounding is magnified there
-      bool singular = one.count == 0;
-      for (int i = 0; i < one.count; ++i) {
-        singular = singular || std::abs(std::sin(one.sol[i].q_deg[4] * kDeg)) < std::sin(kDeg);
-        for (int k = 0; k < i; ++k) {
-          const double d1 = std::abs(std::remainder(one.sol[i].q_deg[0] - one.sol[k].q_deg[0], 360.0));
-          const double d3 = std::abs(std::remainder(one.sol[i].q_deg[2] - one.sol[k].q_deg[2], 360.0));
-          singular = singular || (d1 > 1e-6 && d1 < 1) || (d1 <= 1e-6 && d3 > 1e-6 && d3 < 1);
-        }
-      }
-      if (singular) continue;
+      if (test::near_singular(one, 1.0)) continue;  // each form's rounding is magnified there
       ++n;
       const Vec6 random_ref = test::random_q(m, rng);
       for (const Vec6& ref : {q, random_ref}) {

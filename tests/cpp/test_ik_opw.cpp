@@ -45,14 +45,7 @@ ModelSpec model(const Opw& r) {
   const Vec3 axes[6] = {Vec3::UnitZ(), Vec3::UnitY(), Vec3::UnitY(), Vec3::UnitZ(), Vec3::UnitY(), Vec3::UnitZ()};
   ModelSpec s;
   s.name = r.name;
-  for (int j = 0; j < 6; ++j) {
-    JointSpec js;
-    js.point = pts[j];
-    js.axis = axes[j];
-    js.lower_deg = -360;
-    js.upper_deg = 360;
-    s.joints.push_back(js);
-  }
+  test::add_joints(s, pts, axes);
   s.tool.xyz = wc + Vec3(0, 0, r.c4);
   s.tool.abc = Vec3::Zero();
   s.gravity = Vec3::Zero();
@@ -87,16 +80,7 @@ TEST(IkOpw, TheSixExampleRobotsOfOpwKinematicsGiveItsSolutions) {
       worst_fk = std::max(worst_fk, test::rot_dist(t.linear(), f.linear()));
       const IkSolutions s = ik.solve(t);
       ASSERT_EQ(s.status, IkStatus::Ok);
-      // near the shoulder or elbow singularity (two solutions of q1, or of q3 with one q1, within
-      // 2 deg) opw's arccosines lose digits: skipped
-      bool near = false;
-      for (int i = 0; i < s.count; ++i)
-        for (int k = 0; k < i; ++k) {
-          const double d1 = std::abs(std::remainder(s.sol[i].q_deg[0] - s.sol[k].q_deg[0], 360.0));
-          const double d3 = std::abs(std::remainder(s.sol[i].q_deg[2] - s.sol[k].q_deg[2], 360.0));
-          near = near || (d1 > 1e-6 && d1 < 2) || (d1 <= 1e-6 && d3 > 1e-6 && d3 < 2);
-        }
-      if (near) continue;
+      if (test::near_singular(s, 2.0)) continue;  // opw's arccosines lose digits there
       ++poses;
       const auto o = opw_kinematics::inverse(p, t);
       for (int i = 0; i < s.count; ++i) {  // each of ours is one of opw's

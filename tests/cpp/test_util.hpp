@@ -102,6 +102,35 @@ inline double singularity_distance_deg(const Model& m, const Vec6& q) {
   return std::min({std::abs(q[4]), std::abs(q[2] - elbow), shoulder});
 }
 
+/// A robot's joints from their axis points and directions (mm, any length), limits +-360 deg unless given.
+inline void add_joints(ModelSpec& s, const Vec3* points, const Vec3* axes, const double* lower_deg = nullptr,
+                       const double* upper_deg = nullptr) {
+  for (int j = 0; j < 6; ++j) {
+    JointSpec js;
+    js.point = points[j];
+    js.axis = axes[j];
+    js.lower_deg = lower_deg ? lower_deg[j] : -360;
+    js.upper_deg = upper_deg ? upper_deg[j] : 360;
+    s.joints.push_back(js);
+  }
+}
+
+/// Whether an IK's solutions lie within `deg` of a singularity: the wrist's (|sin q5| small, axes 4
+/// and 6 aligned in a wrist with the flip), the shoulder's or the elbow's (two solutions of q1, or of
+/// q3 for one q1, that close), where each closed form's rounding is magnified.
+inline bool near_singular(const IkSolutions& s, double deg) {
+  bool near = s.count == 0;
+  for (int i = 0; i < s.count; ++i) {
+    near = near || std::abs(std::sin(s.sol[i].q_deg[4] * kDeg)) < std::sin(deg * kDeg);
+    for (int k = 0; k < i; ++k) {
+      const double d1 = std::abs(std::remainder(s.sol[i].q_deg[0] - s.sol[k].q_deg[0], 360.0));
+      const double d3 = std::abs(std::remainder(s.sol[i].q_deg[2] - s.sol[k].q_deg[2], 360.0));
+      near = near || (d1 > 1e-6 && d1 < deg) || (d1 <= 1e-6 && d3 > 1e-6 && d3 < deg);
+    }
+  }
+  return near;
+}
+
 }  // namespace kincal::test
 
 /// Prints the test's seeds with a failure: KINCAL_SEED_TRACE(31) or KINCAL_SEED_TRACE(21, 3, 4).

@@ -80,6 +80,42 @@ TEST(Kinematics, GravityTorqueOfAHorizontalArm) {
   EXPECT_NEAR(tau[0], 0, 1e-9);
 }
 
+// The torque alone (two vector recursions in the joints' frames) against the torque the derivative
+// path computes (the chain walked with rotation matrices, moment arms in the base frame): the kr500
+// and UR10 with their masses and a payload, a tilted gravity, and a kr500 with random link masses and
+// centres (seeded), 500 configurations each. Truth: the walk's torque; agreement to 1e-9 relative.
+TEST(Kinematics, GravityTorqueAloneEqualsTheWalksTorque) {
+  KINCAL_SEED_TRACE(8, 9);
+  std::mt19937_64 rng(test::test_seed(8));
+  std::uniform_real_distribution<double> u(-1, 1);
+  ModelSpec tilted = kr500_spec();
+  tilted.gravity = Vec3(1.2, -0.7, -9.7);
+  ModelSpec random_masses = kr500_spec();
+  for (JointSpec& j : random_masses.joints) {
+    j.mass_kg = 50 + 200 * (1 + u(rng));
+    j.com = Vec3(300 * u(rng), 300 * u(rng), 300 * u(rng));
+  }
+  ModelSpec ur10 = ur10_spec();
+  for (const ModelSpec& spec : {kr500_spec(), ur10, tilted, random_masses}) {
+    const Model m(spec);
+    std::mt19937_64 rq(test::test_seed(9));
+    double worst = 0, largest = 0;
+    for (int i = 0; i < 500; ++i) {
+      const VecQ q = test::random_q(m, rq) * kDeg;
+      VecQ alone, walked;
+      MatQ d;
+      gravity_torque(m, q, alone);
+      gravity_torque(m, q, walked, &d);
+      ASSERT_EQ(alone.size(), walked.size());
+      worst = std::max(worst, (alone - walked).norm() / (1 + walked.norm()));
+      largest = std::max(largest, walked.cwiseAbs().maxCoeff());
+    }
+    std::printf("gravity torque alone vs walked: worst %.1e relative, largest torque %.0f N mm\n", worst, largest);
+    EXPECT_GT(largest, 1e5);  // the robots carry masses: the comparison is not of zeros
+    EXPECT_LT(worst, 1e-9);
+  }
+}
+
 // Every analytic derivative against central finite differences.
 TEST(Kinematics, DerivativesMatchFiniteDifferences) {
   KINCAL_SEED_TRACE(4, 12);

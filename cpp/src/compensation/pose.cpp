@@ -47,14 +47,19 @@ inline Vec6 deviation(const Eigen::Isometry3d& t, const Pose6& d) {
 // The rotation vector of a rotation (rad), accurate near the identity, where Newton works.
 inline Vec3 rotation_vector(const Mat3& r) {
   const Vec3 v(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1));  // 2 sin(theta) axis
-  const double c = 0.5 * (r(0, 0) + r(1, 1) + r(2, 2) - 1), s2 = v.norm();
+  const double c = 0.5 * (r(0, 0) + r(1, 1) + r(2, 2) - 1), s2 = 0.25 * v.squaredNorm();  // cos, sin^2
+  if (s2 < 4e-4 && c > 0) {
+    // theta / (2 sin theta) = asin(s) / (2 s) by its series in s^2 = sin^2 theta (|s| < 0.02: the
+    // first omitted term, 35 s^8 / 1152, is below 1e-15): no arctangent, no square root
+    const double f = 0.5 + s2 * (1.0 / 12 + s2 * (3.0 / 80 + s2 * (5.0 / 224)));
+    return f * v;
+  }
   if (c < -0.9) {  // near half a turn: the antisymmetric part loses the axis
     const Eigen::AngleAxisd aa(r);
     return aa.angle() * aa.axis();
   }
-  const double th = fastmath::atan2(0.5 * s2, c);
-  const double f = th < 1e-4 ? 0.5 + th * th / 12 : th / s2;  // theta / (2 sin theta)
-  return f * v;
+  const double s = std::sqrt(s2), th = fastmath::atan2(s, c);
+  return (0.5 * th / s) * v;
 }
 
 inline Mat3 skew3(const Vec3& v) {
@@ -144,9 +149,10 @@ struct DeviationEvaluator {
     if (!abc) rd_t = abc_to_rotation(d.abc).transpose();
   }
 
-  Vec6 deviation_at(const Vec6& q_deg) {
+  // F at q_deg; with derivative, d(actual joint angles)/dq as well (the Jacobian needs it)
+  Vec6 deviation_at(const Vec6& q_deg, bool derivative = true) {
     const VecQ qr = q_deg * kDeg;
-    fk_frames(cal, effects ? joint_angles(cal, qr, ctx, &dqd) : qr, frames);
+    fk_frames(cal, effects ? joint_angles(cal, qr, ctx, derivative ? &dqd : nullptr) : qr, frames);
     const Vec3 pos = scale * frames.tool.translation();
     if (abc) {
       tr = abc_trig(frames.tool.linear());
@@ -175,43 +181,104 @@ struct DeviationEvaluator {
     e_inv << tr.ca * tr.sb * icb, tr.sa * tr.sb * icb, 1, -tr.sa, tr.ca, 0, tr.ca * icb, tr.sa * icb, 0;
   }
 
-  // dF/dq at the last deviation_at (rows mm and degrees, columns per degree of q), and E for solve
-  void jacobian(Mat6r& jf, Mat3& e) const {
+  // dF/dq at the last deviation_at (rows mm and degrees, columns per degree of q), and E for the
+  // solve. With exact false (Newton's steps), the rotation vector's rates are taken as the angular
+  // velocity itself (E = I): they differ by a factor I + O(|phi|) and phi -> 0 at the solution, so
+  // the iteration converges as fast (quadratically) at a lower cost; the ABC rates are always exact.
+  void jacobian(Mat6r& jf, Mat3& e, bool exact = true) const {
     Mat3 e_inv;
-    rates(e, e_inv);
+    const bool rated = abc || exact;
+    if (rated)
+      rates(e, e_inv);
+    else
+      e.setIdentity();
     const Vec3 tip = frames.tool.translation();
     const double ks = kDeg * scale;
 #pragma GCC unroll 6
     for (int j = 0; j < 6; ++j) {
       const Vec3& z = frames.z[j];
       jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * ks;
-      jf.col(j).tail<3>() = e_inv * z;
+      if (rated)
+        jf.col(j).tail<3>() = e_inv * z;
+      else
+        jf.col(j).tail<3>() = z;
     }
     if (effects) jf = (jf * dqd.topLeftCorner<6, 6>()).eval();
   }
 
-  // Solves jf step = f for the step (f becomes it); returns |det jf|. The position rows are first
-  // moved from the tool point to the wrist (joint 5's origin): v_wrist = v_tool + d x w with
-  // d = tool - wrist and w = E (orientation rates), a row operation of determinant 1 on jf and f
-  // alike, after which the arm's position block alone is singular only where the arm is.
-  double solve(Mat6r& jf, Vec6& f, const Mat3& e) const {
-    const Vec3 d = frames.tool.translation() - frames.o[4];
-    const Mat3 m = (kDeg * scale) * skew3(d) * e;  // mm per degree of the orientation rates
-    jf.topRows<3>() += m * jf.bottomRows<3>();
-    f.head<3>() += m * f.tail<3>();
-    return solve_blocks(jf, f);
+  // d(actual joint angles)/dq at q_deg, for a Jacobian after an evaluation without it
+  void derivative_at(const Vec6& q_deg) {
+    if (effects) joint_angles(cal, q_deg * kDeg, ctx, &dqd);
   }
 };
 
+// The linear solve of one Jacobian, kept so that later steps can reuse it: jf step = f. The position
+// rows are first moved from the tool point to the wrist (joint 5's origin): v_wrist = v_tool + d x w
+// with d = tool - wrist and w = E (orientation rates), a row operation of determinant 1 on jf and f
+// alike, after which the arm's position block alone is singular only where the arm is; then the
+// 3x3 blocks of solve_blocks, or solve6's pivoting where the arm block or its Schur complement is
+// near singular.
+struct FactoredJacobian {
+  Mat3 shift;              // the row operation: f_position += shift * f_orientation
+  Mat3 ai, g, c, si;       // A^-1, A^-1 B, C, S^-1 of the blocks
+  Mat6r j;                 // the shifted Jacobian, when the blocks do not serve
+  bool blocks = false;
+
+  // returns |det jf| (0 when singular)
+  double factor(const DeviationEvaluator& ev, Mat6r& jf, const Mat3& e) {
+    const Vec3 d = ev.frames.tool.translation() - ev.frames.o[4];
+    shift = (kDeg * ev.scale) * skew3(d) * e;  // mm per degree of the orientation rates
+    jf.topRows<3>() += shift * jf.bottomRows<3>();
+    const Mat3 a = jf.topLeftCorner<3, 3>();
+    const double da = inverse3(a, ai);
+    if (well_conditioned3(a, da)) {
+      g = ai * jf.topRightCorner<3, 3>();
+      c = jf.bottomLeftCorner<3, 3>();
+      const Mat3 sc = jf.bottomRightCorner<3, 3>() - c * g;
+      const double ds = inverse3(sc, si);
+      if (well_conditioned3(sc, ds)) {
+        blocks = true;
+        return std::abs(da * ds);
+      }
+    }
+    blocks = false;
+    j = jf;
+    Vec6 probe = Vec6::Zero();
+    return solve6(j, probe);
+  }
+
+  // f becomes the step
+  void solve(Vec6& f) const {
+    f.head<3>() += shift * f.tail<3>();
+    if (!blocks) {
+      solve6(j, f);
+      return;
+    }
+    const Vec3 h = ai * f.head<3>();
+    const Vec3 y = si * (f.tail<3>() - c * h);
+    f.head<3>() = h - g * y;
+    f.tail<3>() = y;
+  }
+};
+
+// Newton's iteration with the Jacobian reused while it serves (a chord step): a new Jacobian is
+// taken at the start and whenever the last step contracted |F| by less than opt.reuse_contraction;
+// the Jacobian changes little over the steps near a solution, so each reused step costs an
+// evaluation of F only. The stopping rule is the same |F|^2 < epsilon on the exact F.
 CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
                                        const CompensationOptions& opt, const EffectContext& ctx) {
   CompensationResult res;
   Vec6 q = q0_deg;
   DeviationEvaluator ev(cal, desired, ctx, opt.residual);
+  FactoredJacobian fac;
   Mat6r jf;
   Mat3 e;
+  double f2_last = 0;
+  bool reused = true;  // the last step's Jacobian was a reused one (none yet)
+  const double reuse2 = opt.reuse_contraction * opt.reuse_contraction;
   for (int it = 0;; ++it) {
-    const Vec6 f = ev.deviation_at(q);
+    const bool with_derivative = reused || reuse2 == 0;  // a fresh Jacobian is certain
+    const Vec6 f = ev.deviation_at(q, with_derivative);
     const double f2 = f.squaredNorm();
     auto finish = [&](CompStatus status) {
       res.q_deg = q;
@@ -225,10 +292,18 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     if (f2 < opt.epsilon) return finish(CompStatus::Converged);
     if (it >= opt.max_iterations) return finish(CompStatus::NotConverged);
     if (ev.orientation_singular()) return finish(CompStatus::OrientationSingular);
-    ev.jacobian(jf, e);
+    const bool fresh = reused || !(f2 < reuse2 * f2_last);
+    if (fresh) {
+      if (!with_derivative) ev.derivative_at(q);
+      ev.jacobian(jf, e, false);
+      const double det = fac.factor(ev, jf, e);
+      if (!(det > 1e-18) || !std::isfinite(det)) return finish(CompStatus::SingularJacobian);
+    }
+    reused = !fresh;
+    f2_last = f2;
     Vec6 step = f;
-    const double det = ev.solve(jf, step, e);
-    if (!(det > 1e-18) || !std::isfinite(det) || !step.allFinite()) return finish(CompStatus::SingularJacobian);
+    fac.solve(step);
+    if (!step.allFinite()) return finish(CompStatus::SingularJacobian);
     q -= step;
   }
 }

@@ -99,7 +99,50 @@ void fk_jacobian(const Model& m, const VecQ& q, Eigen::Isometry3d& tool, Jac& ja
   tool = f.tool;
 }
 
+namespace {
+
+// The gravity torque alone, without rotation matrices: two recursions of 3-vectors in the joints' own
+// frames (the frame right after each joint's rotation, as walk_n visits it). Forward, gravity in
+// frame j: g_0 = Rz(th_0)^T C0^T g, g_j+1 = Rz(th_j+1)^T Rx(alpha_j)^T g_j. Backward, the first
+// moment about joint j's origin of everything it carries, in frame j:
+// A_j = mc_j + M_j+1 t_j + Rx(alpha_j) Rz(th_j+1) A_j+1 (M_j+1: the mass beyond joint j). Then
+// tau_j = z . (A_j x g_j), z = (0, 0, 1) in its own frame. About a third of the walk's work.
+void gravity_torque_local(const Model& m, const double* q, VecQ& tau) {
+  const int n = m.dof();
+  double s[kMaxJoints + 1], c[kMaxJoints + 1];
+  for (int j = 0; j < n; j += 2) {
+    const double a = q[j] + m.link(j).offset, b = j + 1 < n ? q[j + 1] + m.link(j + 1).offset : 0.0;
+    fastmath::sincos2(a, b, s[j], c[j], s[j + 1], c[j + 1]);
+  }
+  std::array<double, kMaxJoints> gx, gy;
+  Vec3 v = m.c0_r().transpose() * m.gravity();
+  for (int j = 0; j < n; ++j) {
+    const double x = c[j] * v[0] + s[j] * v[1], y = c[j] * v[1] - s[j] * v[0];
+    gx[j] = x;
+    gy[j] = y;
+    const Model::Link& l = m.link(j);
+    v = Vec3(x, l.ca * y + l.sa * v[2], l.ca * v[2] - l.sa * y);
+  }
+  tau.resize(n);
+  Vec3 a = m.link(n - 1).mc;
+  double mass = m.link(n - 1).m;
+  tau[n - 1] = a[0] * gy[n - 1] - a[1] * gx[n - 1];
+  for (int j = n - 2; j >= 0; --j) {
+    const Model::Link& l = m.link(j);
+    const double x = c[j + 1] * a[0] - s[j + 1] * a[1], y = s[j + 1] * a[0] + c[j + 1] * a[1];
+    a = l.mc + mass * l.t + Vec3(x, l.ca * y - l.sa * a[2], l.sa * y + l.ca * a[2]);
+    mass += l.m;
+    tau[j] = a[0] * gy[j] - a[1] * gx[j];
+  }
+}
+
+}  // namespace
+
 void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
+  if (!dtau) {
+    gravity_torque_local(m, q.data(), tau);
+    return;
+  }
   const int n = m.dof();
   std::array<Vec3, kMaxJoints> z, o, mc;
   std::array<double, kMaxJoints> mass;

@@ -1,18 +1,21 @@
 """Real data, the mission's user path on the UR10 of ../shared/data/ipa-robot-accuracy (Landgraf et al.,
 CASE 2021; laser tracker and T-Mac probe, each series from its own tracker placement): `kincal
-diagnose` on series B with its defaults (the fitting options identify uses: priors, Huber at 0.1 mm,
+diagnose` on series B with its defaults (the fitting options identify uses: priors, Huber bent where the residuals say,
 the effects the data choose), writes model.json; `kincal validate` checks it on series A, C and D,
 refitting only the tracker placement and the probe offset.
 
 Issue 29 asks for A <= 0.46, C <= 0.56, D <= 0.38 mm (3-D RMS; 5% better than the better start of
 the session before: geometry 0.512 / 0.591 / 0.449, compliance 0.482 / 0.675 / 0.398). Measured on
-2026-11-25: A 0.495, C 0.509, D 0.406 mm: C met, A and D NOT met (with --loss-scale 0.1: 0.463,
-0.500, 0.384; BENCHMARKS.md says why the data's bend stays the default). The diagnosis names joint
-compliance (every loaded joint, the model's masses) and a smooth joint_map of joint 1 (order 6), a
-periodic effect credited with what it gains on held-out ranges of its angle. This test holds that
-ground: each series within 2% of those figures and far below the nominal model, the effects named,
-and the warning where a series leaves the angles they were fitted on (C runs joint 1 at -308..-180
-deg, B at -180..-45)."""
+2026-11-25: A 0.495, C 0.509, D 0.406 mm. Since 2026-11-27 a joint_map step's order and smoothing
+are chosen again by refits holding out ranges of the joint's angle (the linearisation fitted the
+model's own parameters on the held ranges too, and kept order 6 at smoothing 0.001, which predicts
+B's held ranges at 0.496 mm against 0.411 for order 6 at 0.01): A 0.452, C 0.496, D 0.379 mm, all
+three met (D by 0.001 mm; BENCHMARKS.md shows how the choice moves with the number of ranges). The
+diagnosis names joint compliance (every loaded joint, the model's masses) and a smooth joint_map of
+joint 1, a periodic effect credited with what it gains on held-out ranges of its angle. This test
+holds that ground: each series within issue 29's target and within 2% of those figures, far below the
+nominal model, the effects named, and the warning where a series leaves the angles they were fitted
+on (C runs joint 1 at -308..-180 deg, B at -180..-45)."""
 
 from __future__ import annotations
 
@@ -29,8 +32,9 @@ from conftest import SHARED, run
 BASE = SHARED / "data" / "ipa-robot-accuracy"
 FILES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",
          "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
-#: the 3-D RMS (mm) this path measured on 2026-11-25
-MEASURED = {"A": 0.495, "C": 0.509, "D": 0.406}
+#: the 3-D RMS (mm) this path measured on 2026-11-27, and issue 29's targets
+MEASURED = {"A": 0.4517, "C": 0.4961, "D": 0.3786}
+TARGET = {"A": 0.46, "C": 0.56, "D": 0.38}
 
 
 def test_ur10_diagnose_on_b_validate_on_the_others(tmp_path):
@@ -49,7 +53,7 @@ def test_ur10_diagnose_on_b_validate_on_the_others(tmp_path):
         assert r.returncode == 0, r.stderr
         v = json.loads((tmp_path / f"v{k}.json").read_text())
         print(f"series {k}: RMS {v['before_rms_mm']:.3f} -> {v['rms_mm']:.3f} mm")
-        assert v["rms_mm"] <= 1.02 * rms, (k, v["rms_mm"])
+        assert v["rms_mm"] <= min(TARGET[k], 1.02 * rms), (k, v["rms_mm"])
         assert v["rms_mm"] < 0.7 * v["before_rms_mm"]
         if k == "C":
             joint1 = next(e for e in v["extrapolated"] if e["joint"] == 1)

@@ -307,6 +307,10 @@ class SerialProblem:
         self.candidates = list(candidates)
         #: (name, joint, order) -> the penalties of the variant chosen
         self.penalty: dict[tuple[str, int, int], list[tuple[str, float]]] = {}
+        #: joint -> the mean squared norm of its joint_map's order-1 columns (the smoothing's scale)
+        self.map_scale: dict[int, float] = {}
+        #: joint -> the refitted range-held-out RMS of each joint_map variant (refine())
+        self.refined: dict[int, dict[str, Any]] = {}
         self.fits: list[tuple[list[Candidate], _core.IdentifyResult]] = []
         self.dims = 6 if "abc" in data else 3
         self.point_dims = 3
@@ -335,9 +339,53 @@ class SerialProblem:
         if cand.name != "joint_map":
             return None
         s = float(np.mean(np.sum(R[:, :2] ** 2, axis=0)))
+        self.map_scale[cand.joint] = s
         kw = np.repeat(np.asarray(cand.harmonics, dtype=float), 2)
         return [(_core.Effect("joint_map", cand.joint, order=k), 2 * k, np.sqrt(lam * s) * kw[:2 * k])
                 for k in range(1, cand.order + 1) for lam in MAP_SMOOTHING]
+
+    def refine(self, effects: Sequence[Candidate], cand: Candidate) -> Candidate:
+        """A joint_map step's variant (order, smoothing), chosen on the linearisation, chosen again by
+        refits: each variant of the map added to the model with ``effects`` is fitted holding out, in
+        turn, each of VARIANT_BLOCKS ranges of the joint's angle and predicts it (every parameter
+        refitted without it: on the linearisation the model's own parameters are fitted on every row,
+        the held range included, and a map that only a refit of the geometry keeps in check there
+        looks better than it predicts); the first variant listed within ORDER_MARGIN of the best held-out
+        sum of squares. Orders the library's transmission_error covers on that joint are not offered
+        (covered()). Any other candidate is returned as it is."""
+        if cand.name != "joint_map" or cand.joint not in self.map_scale:
+            return cand
+        top = max([c.order for c in self.candidates if c.name == "joint_map" and c.joint == cand.joint] + [cand.order])
+        s = self.map_scale[cand.joint]
+        base = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]
+        held_masks = self.variant_folds(cand)
+        if any(h.all() or not h.any() for h in held_masks):  # the angle's ranges do not split the rows
+            return cand
+        offered: list[tuple[_core.Effect, list[tuple[str, float]], float]] = []
+        for k in range(1, top + 1):
+            e = _core.Effect("joint_map", cand.joint, order=k)
+            if self.covered(e, self.candidates):
+                continue
+            w = np.repeat(np.asarray(e.harmonics, dtype=float), 2)
+            names = [f"joint{cand.joint}.{n}" for n in e.parameter_names]
+            for lam in MAP_SMOOTHING:
+                offered.append((e, [(n, float(np.sqrt(lam * s) * x)) for n, x in zip(names, w)], lam))
+        ss = []
+        for e, pen, _ in offered:
+            spec = Spec(self.robot, list(effects) + [e], base + pen, self.fit_options)
+            total = 0.0
+            for held in held_masks:
+                total += float(np.sum(spec.errors(spec.fit(subset(self.data, ~held)), subset(self.data, held)) ** 2))
+            ss.append(total)
+        best = min(ss)
+        i = next(j for j, v in enumerate(ss) if v <= best * (1.0 + engine.ORDER_MARGIN))
+        e, pen, lam = offered[i]
+        n = len(self.data["pose"])
+        self.refined[cand.joint] = {"order": e.order, "smoothing": lam, "linear_order": cand.order,
+                                    "range_refit_rms_mm": [[o.order, l, float(np.sqrt(v / n))]
+                                                           for (o, _, l), v in zip(offered, ss)]}
+        self.penalty[(e.name, e.joint, e.order)] = pen
+        return e
 
     def variant_folds(self, cand: Candidate) -> list[BoolArray]:
         """joint_map's order and smoothing are chosen holding out, in turn, each of VARIANT_BLOCKS
@@ -382,6 +430,10 @@ class SerialProblem:
         if cand.name == "joint_map":
             out["order"] = cand.order
             out["order_range_cv_gain"] = [round(float(x), 6) for x in g.max(axis=1)]
+            ref = self.refined.get(cand.joint)
+            if ref and ref["order"] == cand.order:  # chosen again by refits (refine())
+                out.update(smoothing=ref["smoothing"], linear_order=ref["linear_order"],
+                           linear_smoothing=out["smoothing"], range_refit_rms_mm=ref["range_refit_rms_mm"])
         return out
 
     def chosen(self, cand: _core.Effect, ridge: FloatArray) -> None:

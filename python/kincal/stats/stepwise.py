@@ -20,6 +20,11 @@ the same folds.
 A mechanism supplies a Problem (its folds, its refit, its linearisation and its names) and its
 candidates; effects are _core.Effect objects (or objects with their ``name`` and ``joint``).
 
+With the refits' confirmation, a Problem's ``refine(effects, candidate)`` may choose the step's
+variant again by refits before it is confirmed (the serial robot's joint_map: its order and smoothing
+by refits holding out ranges of the joint's angle; the linearisation fits the model's own parameters
+on every row, held ones included).
+
 Without the refit's confirmation (``confirm=False``: `kincal identify --effects auto`, which chooses
 again inside every training fold of its own cross-validation, so its figure is honest without it) a
 step is taken on the F-test and the linear cross-validated gain alone, and no refit but the
@@ -325,6 +330,9 @@ def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, 
             break
         best = sig[0]
         cand = best["_cand"]
+        refine = getattr(problem, "refine", None)
+        if confirm and refine is not None:  # the variant chosen on the linearisation, chosen again by refits
+            cand = refine(effects, cand)
         say(f"step {len(steps) + 1}: {problem.label(cand)} (F = {best['F']:.3g}, cross-validated gain "
             f"{best['cv_gain']:.1%})" + ("; refitting" if confirm else ""))
         new = cv_rms(problem, effects + [cand]) if confirm else None

@@ -209,9 +209,11 @@ def _logdet_spd(G: "np.ndarray[Any, np.dtype[np.floating[Any]]]") -> "np.ndarray
 
 
 def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, epsilon: float = 0.01,
-                     seed: int = 0, progress: Optional[Callable[[int, int], None]] = None) -> list[int]:
-    """Indices of k candidates (J: candidates' rows in blocks of rows_per, columns scaled) chosen one
-    at a time for the largest gain log det(I + J_i M^-1 J_i^T), M = ridge I + the chosen J_i^T J_i.
+                     seed: int = 0, progress: Optional[Callable[[int, int], None]] = None,
+                     col_scale: Optional[FloatArray] = None) -> list[int]:
+    """Indices of k candidates (J: candidates' rows in blocks of rows_per, columns scaled, or divided by
+    ``col_scale`` here without changing J) chosen one at a time for the largest gain
+    log det(I + J_i M^-1 J_i^T), M = ridge I + the chosen J_i^T J_i.
 
     Each step scores a random sample of the candidates left, of size (n / k) ln(1 / epsilon) but at
     least 2,000 (all of them when fewer): the "stochastic greedy" of Mirzasoleiman et al. (AAAI 2015),
@@ -220,7 +222,10 @@ def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, 
     identity; a gain is log det of a small matrix from the rows times the Cholesky factor of M^-1."""
     n, p = J.shape[0] // rows_per, J.shape[1]
     Jb = J.reshape(n, rows_per, p)
-    Jb32 = Jb.astype(np.float32)   # for scoring only: the ranking needs no more digits
+    cs = np.ones(p) if col_scale is None else np.asarray(col_scale, dtype=float)
+    # for scoring only, the ranking needs no more digits: converted, then scaled in single precision
+    Jb32 = Jb.astype(np.float32)
+    Jb32 *= (1.0 / cs).astype(np.float32)
     eye = np.eye(rows_per)
     eye32 = eye.astype(np.float32)
     rng = np.random.default_rng(seed)
@@ -239,7 +244,7 @@ def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, 
         best = int(idx[int(np.argmax(gain))])
         chosen.append(best)
         left[best] = False
-        Jc = Jb[best]
+        Jc = Jb[best] / cs
         U = Minv @ Jc.T                                    # Woodbury: M'^-1 = M^-1 - U (I + J U)^-1 U^T
         Minv = Minv - U @ np.linalg.solve(eye + Jc @ U, U.T)
         Minv = 0.5 * (Minv + Minv.T)
@@ -286,23 +291,22 @@ def plan(robot: Robot, k: int, *, targets: FloatArray,
     free, left = _free_columns(robot, q, targets, list(core_effects), seed)
     J, params = _jacobian(robot, q, targets, list(core_effects), free)
     # columns scaled to unit RMS per candidate: a candidate's rows are O(1), the ridge a faint prior
-    # (in place: with 100,000 candidates J is hundreds of MB)
+    # (the greedy scales its float32 copy as it makes it: with 100,000 candidates J is hundreds of MB)
     scale = np.sqrt(np.einsum("ij,ij->j", J, J) / len(q))  # (no temporary as large as J)
     if np.any(scale == 0):
         raise ValueError("a parameter has no effect on any candidate")
-    J /= scale
     rows_per = 3 * len(targets)
-    picked = greedy_d_optimal(J, rows_per, k, seed=seed, progress=progress)
+    picked = greedy_d_optimal(J, rows_per, k, seed=seed, progress=progress, col_scale=scale)
     chosen = np.asarray(picked)[path_order(q[picked])]
     rows = (chosen[:, None] * rows_per + np.arange(rows_per)[None, :]).ravel()
-    s = np.linalg.svd(J[rows], compute_uv=False)
-    Jp = J[rows] * scale
+    Jp = J[rows]
+    s = np.linalg.svd(Jp / scale, compute_uv=False)
     info = Jp.T @ Jp
     cov = noise_mm ** 2 * np.linalg.pinv(info)
     # predicted error of a point at the candidates (up to 20,000 of them): the rows' variance, as the
     # RMS of the point's error
     some = np.random.default_rng(seed + 1).choice(len(q), size=min(len(q), 20000), replace=False)
-    Js = J[(some[:, None] * rows_per + np.arange(rows_per)[None, :]).ravel()] * scale
+    Js = J[(some[:, None] * rows_per + np.arange(rows_per)[None, :]).ravel()]
     var_rows = np.sum((Js @ cov) * Js, axis=1)
     tcp = math.sqrt(float(np.sum(var_rows)) / (len(var_rows) / 3))
     m = len(s)

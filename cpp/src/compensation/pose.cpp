@@ -206,6 +206,30 @@ struct DeviationEvaluator {
     if (effects) jf = (jf * dqd.topLeftCorner<6, 6>()).eval();
   }
 
+  // Half the second derivative of F along a step (deg of q) at the last deviation_at, in F's units:
+  // F(q - step) = F - J step + second_order(step) + O(step^3). Position: the tool point's
+  // acceleration sum_ij s_i s_j z_min x (z_max x (p - o_max)); orientation: the angular one,
+  // sum_i<j s_i s_j z_i x z_j (the rotation vector's own curvature is O(phi), small where Newton
+  // works). With joint effects the step acts through their derivative, their own curvature omitted.
+  Vec6 second_order(const Vec6& step_deg) const {
+    Vec6 s = step_deg * kDeg;
+    if (effects) s = dqd.topLeftCorner<6, 6>() * s;
+    const Vec3 tip = frames.tool.translation();
+    Vec3 w = Vec3::Zero(), acc = Vec3::Zero(), alpha = Vec3::Zero();
+#pragma GCC unroll 6
+    for (int j = 0; j < 6; ++j) {
+      const Vec3 zs = s[j] * frames.z[j];
+      const Vec3 v = zs.cross(tip - frames.o[j]);
+      acc += (zs + 2 * w).cross(v);
+      alpha += w.cross(zs);
+      w += zs;
+    }
+    Vec6 h;
+    h.head<3>() = (0.5 * scale) * acc;
+    h.tail<3>() = alpha * (0.5 / kDeg);
+    return h;
+  }
+
   // d(actual joint angles)/dq at q_deg, for a Jacobian after an evaluation without it
   void derivative_at(const Vec6& q_deg) {
     if (effects) joint_angles(cal, q_deg * kDeg, ctx, &dqd);
@@ -303,6 +327,15 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     f2_last = f2;
     Vec6 step = f;
     fac.solve(step);
+    if (it == 0 && opt.second_order) {  // the first, largest step: its second-order term as well
+      Vec6 more = ev.second_order(step);
+      fac.solve(more);
+      // a correction as large as the step itself: near a singularity, where the series does not hold
+      if (more.squaredNorm() < 0.25 * step.squaredNorm()) {
+        step += more;
+        reused = true;  // F left at 1e-5..1e-3 of its start: a fresh Jacobian converges in one more step
+      }
+    }
     if (!step.allFinite()) return finish(CompStatus::SingularJacobian);
     q -= step;
   }
@@ -320,6 +353,15 @@ Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& d
   Mat3 e;
   ev.jacobian(jf, e);
   return jf;
+}
+
+Vec6 pose_deviation_second_order(const Model& cal, const Vec6& q_deg, const Pose6& desired, const Vec6& step_deg,
+                                 Residual residual, const EffectContext& ctx) {
+  if (cal.dof() != 6) throw std::invalid_argument("pose_deviation_second_order needs a 6-joint robot");
+  check_context(cal, ctx, "");
+  DeviationEvaluator ev(cal, desired, ctx, residual);
+  ev.deviation_at(q_deg);
+  return ev.second_order(step_deg);
 }
 
 CompensationResult compensate(const Model& cal, const Pose6& desired, const Vec6& q0_deg, const CompensationOptions& opt,

@@ -10,9 +10,9 @@
 // the analytic one (default): the geometric Jacobian of the whole model (compliance, transmission
 // error, backlash, thermal expansion) mapped to the residual's rates. The analytic iteration reuses
 // its last Jacobian for a step while the steps shrink |F| tenfold (a chord step: F only, no Jacobian
-// and no factorisation; `reuse_contraction`), and takes the rotation vector's rates as the angular
-// velocity (exact at the solution): the same stopping rule on the exact F, at 0.8x the time per pose
-// (BENCHMARKS.md).
+// and no factorisation; `reuse_contraction`), corrects its first step by the step's second-order term
+// (`second_order`), and takes the rotation vector's rates as the angular velocity (exact at the
+// solution): the same stopping rule on the exact F, at 0.7x the time per pose (BENCHMARKS.md).
 #pragma once
 
 #include "kincal/kinematics/kinematics.hpp"
@@ -37,6 +37,10 @@ struct CompensationOptions {
   /// The analytic Jacobian is reused (a chord step) while each step shrinks |F| by at least this
   /// factor, and taken anew otherwise; 0 takes it at every step (Newton's iteration as eq. 8 reads).
   double reuse_contraction = 0.1;
+  /// The analytic iteration's first step corrected by its second-order term (the tool's acceleration
+  /// along the step, solved with the same Jacobian): F falls to 1e-5..1e-3 of its start instead of
+  /// 1e-3..1e-2, and one fresh step more converges. Skipped where the correction is over half the step.
+  bool second_order = true;
 };
 
 enum class CompStatus { Converged, NotConverged, SingularJacobian, OrientationSingular, NotSixJoints };
@@ -59,6 +63,14 @@ Vec6 pose_deviation(const Model& cal, const Vec6& q_deg, const Pose6& desired,
 /// it: rows mm and degrees, columns per degree (with the ABC residual singular at B = +-90 deg).
 Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& desired,
                              Residual residual = Residual::RotationVector, const EffectContext& ctx = EffectContext());
+
+/// Half the second derivative of pose_deviation along step_deg at q_deg, as the first step of the
+/// compensation uses it: pose_deviation(q + s) = F + J s + pose_deviation_second_order(s) + O(s^3)
+/// where the model's pose equals the desired one (the rotation vector's own curvature, O(phi), and
+/// the joint effects' curvature are omitted).
+Vec6 pose_deviation_second_order(const Model& cal, const Vec6& q_deg, const Pose6& desired, const Vec6& step_deg,
+                                 Residual residual = Residual::RotationVector,
+                                 const EffectContext& ctx = EffectContext());
 
 /// Newton compensation from the start q0_deg (normally the nominal IK solution), every effect of
 /// the model acting in the context ctx (InputError when the context lacks what the model needs).

@@ -239,49 +239,24 @@ struct DeviationEvaluator {
 // The linear solve of one Jacobian, kept so that later steps can reuse it: jf step = f. The position
 // rows are first moved from the tool point to the wrist (joint 5's origin): v_wrist = v_tool + d x w
 // with d = tool - wrist and w = E (orientation rates), a row operation of determinant 1 on jf and f
-// alike, after which the arm's position block alone is singular only where the arm is; then the
-// 3x3 blocks of solve_blocks, or solve6's pivoting where the arm block or its Schur complement is
-// near singular.
+// alike, after which the arm's position block alone is singular only where the arm is; then
+// BlockSolver's 3x3 blocks.
 struct FactoredJacobian {
-  Mat3 shift;              // the row operation: f_position += shift * f_orientation
-  Mat3 ai, g, c, si;       // A^-1, A^-1 B, C, S^-1 of the blocks
-  Mat6r j;                 // the shifted Jacobian, when the blocks do not serve
-  bool blocks = false;
+  Mat3 shift;  // the row operation: f_position += shift * f_orientation
+  BlockSolver blocks;
 
   // returns |det jf| (0 when singular)
   double factor(const DeviationEvaluator& ev, Mat6r& jf, const Mat3& e) {
     const Vec3 d = ev.frames.tool.translation() - ev.frames.o[4];
     shift = (kDeg * ev.scale) * skew3(d) * e;  // mm per degree of the orientation rates
     jf.topRows<3>() += shift * jf.bottomRows<3>();
-    const Mat3 a = jf.topLeftCorner<3, 3>();
-    const double da = inverse3(a, ai);
-    if (well_conditioned3(a, da)) {
-      g = ai * jf.topRightCorner<3, 3>();
-      c = jf.bottomLeftCorner<3, 3>();
-      const Mat3 sc = jf.bottomRightCorner<3, 3>() - c * g;
-      const double ds = inverse3(sc, si);
-      if (well_conditioned3(sc, ds)) {
-        blocks = true;
-        return std::abs(da * ds);
-      }
-    }
-    blocks = false;
-    j = jf;
-    Vec6 probe = Vec6::Zero();
-    return solve6(j, probe);
+    return blocks.factor(jf);
   }
 
   // f becomes the step
   void solve(Vec6& f) const {
     f.head<3>() += shift * f.tail<3>();
-    if (!blocks) {
-      solve6(j, f);
-      return;
-    }
-    const Vec3 h = ai * f.head<3>();
-    const Vec3 y = si * (f.tail<3>() - c * h);
-    f.head<3>() = h - g * y;
-    f.tail<3>() = y;
+    blocks.solve(f);
   }
 };
 

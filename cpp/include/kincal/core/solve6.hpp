@@ -63,30 +63,56 @@ inline bool well_conditioned3(const Mat3& a, double det) {
   return det * det > 1e-12 * a.col(0).squaredNorm() * a.col(1).squaredNorm() * a.col(2).squaredNorm();
 }
 
-/// Solves j x = b (b becomes x) for a Jacobian whose first three columns are the arm's and last three
-/// the wrist's, by 3x3 blocks: x_wrist from the Schur complement S = D - C A^-1 B, then x_arm. Two
-/// divisions instead of six dependent eliminations (the solve is latency-bound; BENCHMARKS.md has the figures).
-/// The rows should have the arm block A well conditioned (the position of the wrist, see
-/// DeviationEvaluator::solve); when A or S is near singular, solve6's partial pivoting takes over.
-/// Returns |det j| (0 when singular).
-inline double solve_blocks(const Mat6r& j, Vec6& b) {
-  const Mat3 a = j.topLeftCorner<3, 3>(), bb = j.topRightCorner<3, 3>(), c = j.bottomLeftCorner<3, 3>(),
-             d = j.bottomRightCorner<3, 3>();
-  Mat3 ai, si;
-  const double da = inverse3(a, ai);
-  if (well_conditioned3(a, da)) {
-    const Mat3 g = ai * bb;
-    const Vec3 h = ai * b.head<3>();
-    const Mat3 sc = d - c * g;
-    const double ds = inverse3(sc, si);
-    if (well_conditioned3(sc, ds)) {
-      const Vec3 y = si * (b.tail<3>() - c * h);
-      b.head<3>() = h - g * y;
-      b.tail<3>() = y;
-      return std::abs(da * ds);
+/// The factorisation of a Jacobian whose first three columns are the arm's and last three the
+/// wrist's, by 3x3 blocks, kept for several right-hand sides: x_wrist from the Schur complement
+/// S = D - C A^-1 B, then x_arm. Two divisions instead of six dependent eliminations (the solve is
+/// latency-bound; BENCHMARKS.md has the figures). The rows should have the arm block A well
+/// conditioned (the position of the wrist, see FactoredJacobian in compensation/pose.cpp); when A or
+/// S is near singular, solve6's partial pivoting takes over (then each solve eliminates anew).
+struct BlockSolver {
+  Mat3 ai, g, c, si;  // A^-1, A^-1 B, C, S^-1
+  Mat6r j;            // the matrix itself, when the blocks do not serve
+  bool blocks = false;
+
+  /// Returns |det j| (0 when singular).
+  double factor(const Mat6r& jm) {
+    const Mat3 a = jm.topLeftCorner<3, 3>();
+    const double da = inverse3(a, ai);
+    if (well_conditioned3(a, da)) {
+      g = ai * jm.topRightCorner<3, 3>();
+      c = jm.bottomLeftCorner<3, 3>();
+      const Mat3 sc = jm.bottomRightCorner<3, 3>() - c * g;
+      const double ds = inverse3(sc, si);
+      if (well_conditioned3(sc, ds)) {
+        blocks = true;
+        return std::abs(da * ds);
+      }
     }
+    blocks = false;
+    j = jm;
+    Vec6 probe = Vec6::Zero();
+    return solve6(j, probe);
   }
-  return solve6(j, b);
+
+  /// b becomes x with j x = b.
+  void solve(Vec6& b) const {
+    if (!blocks) {
+      solve6(j, b);
+      return;
+    }
+    const Vec3 h = ai * b.head<3>();
+    const Vec3 y = si * (b.tail<3>() - c * h);
+    b.head<3>() = h - g * y;
+    b.tail<3>() = y;
+  }
+};
+
+/// Solves j x = b (b becomes x) by BlockSolver; returns |det j| (0 when singular, b then undefined).
+inline double solve_blocks(const Mat6r& j, Vec6& b) {
+  BlockSolver s;
+  const double det = s.factor(j);
+  if (det > 0) s.solve(b);
+  return det;
 }
 
 }  // namespace kincal

@@ -183,6 +183,7 @@ int main(int argc, char** argv) {
                  "separated; default: the direction of the first motion; needed with --stream)");
   app.add_flag("--keep-branch", keep_branch, "a branch change inside the program is an error, not a warning");
   CLI11_PARSE(app, argc, argv);
+  kincal::remove_unfinished_files_on_signals();  // a long program interrupted: no temporary file left
 
   try {
     if (programs.size() > 1 && !fivebar.empty()) throw kincal::InputError("--fivebar: one --program");

@@ -2,11 +2,15 @@
 `kincal-compensate` write the joint program of the whole program (the poses compensated in memory by
 kincal.compensate, written with 10 decimals), byte for byte, for CSV and G-code, with every effect and
 backlash (the first motion's direction found, or given), on a program longer than one chunk; the summary
-is the one of the per-pose results; an error in a later chunk names its line and leaves no file."""
+is the one of the per-pose results; an error in a later chunk names its line and leaves no file, and so
+does an interrupted run."""
 
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import time
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +19,7 @@ import pytest
 import kincal
 from kincal import _core
 
-from conftest import run
+from conftest import _tool, run
 
 N = 18_000  # 1.3 MB as CSV: longer than the 1 MiB the commands read at a time
 LATE = 16_000  # a line past the first 1 MiB
@@ -167,4 +171,23 @@ def test_a_bad_line_in_the_second_chunk(tmp_path, calibrated, tool):
     r = run(tool, *args, "--model", str(model), "--program", str(src), "--out", str(tmp_path / "out.csv"),
             "--temperature", "26")
     assert r.returncode != 0 and f"{src}:{LATE}: pose out of reach" in r.stderr, r.stderr
+    assert not list(tmp_path.glob("out*"))
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_an_interrupted_run_leaves_no_file(tmp_path, calibrated, sig):
+    """kincal-compensate stopped by a signal while it writes: neither the output nor its temporary file
+    is left (a program of millions of poses takes a minute)."""
+    model = _every_effect_model(calibrated, tmp_path / "model.json")
+    src, out = tmp_path / "p.csv", tmp_path / "out.csv"
+    _write(src, np.tile(_path(N), (20, 1)))  # 360,000 poses: seconds of work
+    p = subprocess.Popen([_tool("kincal-compensate"), "--model", str(model), "--program", str(src), "--out", str(out),
+                          "--temperature", "26", "--initial-direction", "1"], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not list(tmp_path.glob("out.csv.tmp*")) and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert p.poll() is None, "the program ended before it could be interrupted"
+    p.send_signal(sig)
+    p.communicate(timeout=60)
+    assert p.returncode == -sig
     assert not list(tmp_path.glob("out*"))

@@ -1,11 +1,14 @@
 #include "kincal/io/file.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <csignal>
 #include <fstream>
+#include <signal.h>
 #include <sstream>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -89,15 +92,58 @@ bool TextChunks::more(size_t& pos) {
 
 // ---- AtomicFileWriter
 
+namespace {
+
+// The temporary files being written, for the signal handler: a slot is 0 free, 1 taken, 2 holding a path.
+constexpr int kSlots = 16;
+std::atomic<int> g_slot_state[kSlots];
+char g_slot_path[kSlots][4096];
+
+int claim_slot(const std::string& tmp) {
+  if (tmp.size() >= sizeof g_slot_path[0]) return -1;
+  for (int k = 0; k < kSlots; ++k) {
+    int expected = 0;
+    if (!g_slot_state[k].compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(g_slot_path[k], tmp.c_str(), tmp.size() + 1);
+    g_slot_state[k].store(2);
+    return k;
+  }
+  return -1;  // (more files open at once than slots: those are not removed on a signal)
+}
+
+void release_slot(int k) {
+  if (k >= 0) g_slot_state[k].store(0);
+}
+
+extern "C" void remove_unfinished_files(int sig) {
+  for (int k = 0; k < kSlots; ++k)
+    if (g_slot_state[k].load() == 2) ::unlink(g_slot_path[k]);
+  struct sigaction dfl {};
+  dfl.sa_handler = SIG_DFL;
+  ::sigaction(sig, &dfl, nullptr);
+  ::raise(sig);
+}
+
+}  // namespace
+
+void remove_unfinished_files_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = remove_unfinished_files;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+}
+
 AtomicFileWriter::AtomicFileWriter(const std::string& path, size_t buffer_bytes)
     : path_(path), tmp_(path + ".tmp" + std::to_string(::getpid())), cap_(buffer_bytes) {
   buf_.reserve(cap_);
+  slot_ = claim_slot(tmp_);
   file_ = std::fopen(tmp_.c_str(), "wb");
   if (!file_) error_ = path_ + ": cannot write the output file (" + std::strerror(errno) + ")";
 }
 
 AtomicFileWriter::~AtomicFileWriter() {
   if (!done_) discard();
+  release_slot(slot_);
 }
 
 void AtomicFileWriter::discard() {
@@ -138,11 +184,12 @@ void AtomicFileWriter::commit() {
     std::remove(tmp_.c_str());
     throw InputError(path_ + ": writing the output file failed");
   }
-  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
-    const std::string cause = std::strerror(errno);
-    std::remove(tmp_.c_str());
-    throw InputError(path_ + ": cannot move the output file into place (" + cause + ")");
-  }
+  const bool moved = std::rename(tmp_.c_str(), path_.c_str()) == 0;
+  const std::string cause = moved ? std::string() : std::strerror(errno);
+  if (!moved) std::remove(tmp_.c_str());
+  release_slot(slot_);
+  slot_ = -1;
+  if (!moved) throw InputError(path_ + ": cannot move the output file into place (" + cause + ")");
 }
 
 }  // namespace kincal

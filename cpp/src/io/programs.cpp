@@ -162,7 +162,8 @@ bool PoseProgramReader::next_gcode(ProgramLine& l) {
   std::string missing;
   for (int k = 0; k < 6; ++k)
     if (!set_[k]) missing += std::string(missing.empty() ? "" : " ") + kPoseLetters[k];
-  if (!missing.empty()) fail_at(source_.c_str(), line_, "pose word(s) " + missing + " not set yet on the first motion line");
+  if (!missing.empty())
+    fail_at(source_.c_str(), line_, "pose word(s) " + missing + " not set yet on the first motion line");
   char buf[4096];
   const CutLine cut = cut_words(b, n, words, cnt, buf, sizeof buf, source_.c_str(), line_);
   l.has_pose = true;

@@ -65,8 +65,9 @@ class TextChunks {
 
 /// A file written piece by piece into a temporary file beside it ("path.tmpPID"), renamed to path by
 /// commit(); destroyed without commit() (an error), the temporary file is removed and path is not
-/// touched. Writes are buffered (buffer_bytes). A file that cannot be created or written is reported by
-/// commit(), with the messages of write_file_atomic, so that an error of the content comes first.
+/// touched (and when the process is stopped by a signal: remove_unfinished_files_on_signals). Writes are
+/// buffered (buffer_bytes). A file that cannot be created or written is reported by commit(), with the
+/// messages of write_file_atomic, so that an error of the content comes first.
 class AtomicFileWriter {
  public:
   AtomicFileWriter(const std::string& path, size_t buffer_bytes = kProgramChunkBytes);
@@ -96,6 +97,12 @@ class AtomicFileWriter {
   size_t cap_;
   std::string error_;  ///< the first failure (reported by commit)
   bool done_ = false;
+  int slot_ = -1;  ///< where the signal handler finds the temporary file
 };
+
+/// For command-line programs: SIGINT, SIGTERM and SIGHUP remove the temporary files of the
+/// AtomicFileWriters still open, then stop the process as the signal would have. (A program file of
+/// millions of poses takes a minute: an interrupted run leaves neither the output nor a temporary file.)
+void remove_unfinished_files_on_signals();
 
 }  // namespace kincal

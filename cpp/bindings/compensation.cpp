@@ -45,6 +45,12 @@ py::dict result_dict(const ProgramResult& r) {
   for (size_t i = 0; i < r.dir.size(); ++i) dir.row(static_cast<Eigen::Index>(i)) = r.dir[i].transpose();
   d["dir"] = dir;
   d["warnings"] = r.warnings;
+  // the count and extremes, also when the per-pose arrays are not kept (keep_poses=False)
+  d["poses"] = r.poses;
+  d["iterations_min"] = r.min_iterations;
+  d["iterations_max"] = r.max_iterations;
+  d["iterations_total"] = r.total_iterations;
+  d["residual_max"] = r.max_residual;
   return d;
 }
 
@@ -114,11 +120,22 @@ void define_compensation(py::module_& m) {
       "IK + Newton compensation of every pose (N x 6), branch kept continuous");
   m.def(
       "compensate_program",
-      [](const Robot& r, const std::string& in, const std::string& out, KINCAL_COMP_PARAMS) {
-        return result_dict(compensate_program_file(r, in, out, KINCAL_COMP_OPTIONS));
+      [](const Robot& r, const std::string& in, const std::string& out, KINCAL_COMP_PARAMS, bool keep_poses,
+         size_t chunk_bytes) {
+        ProgramOptions o = KINCAL_COMP_OPTIONS;
+        o.keep_poses = keep_poses;
+        o.chunk_bytes = chunk_bytes;
+        ProgramResult res;
+        {
+          py::gil_scoped_release release;
+          res = compensate_program_file(r, in, out, o);
+        }
+        return result_dict(res);
       },
-      py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS,
-      "Compensates a pose program file (CSV or G-code) into a joint program file, atomically");
+      py::arg("robot"), py::arg("program"), py::arg("out"), KINCAL_COMP_ARGS, py::arg("keep_poses") = true,
+      py::arg("chunk_bytes") = kProgramChunkBytes,
+      "Compensates a pose program file (CSV or G-code) into a joint program file, atomically, a chunk of "
+      "chunk_bytes at a time; keep_poses=False: the result without per-pose arrays (bounded memory)");
   m.def(
       "compensate_to_controller",
       [](const Robot& r, const std::vector<std::string>& in, const std::string& out, KINCAL_COMP_PARAMS,
@@ -127,7 +144,8 @@ void define_compensation(py::module_& m) {
          const std::vector<double>& program_tool, const std::vector<double>& program_base, bool skip_unresolved,
          std::optional<double> tolerance, const std::vector<std::string>& uframes,
          const std::vector<std::string>& utools, const std::vector<std::string>& declarations,
-         bool allow_branch_change, const std::vector<std::string>& tracks, int threads, py::object progress) {
+         bool allow_branch_change, const std::vector<std::string>& tracks, int threads, py::object progress,
+         bool keep_poses, size_t chunk_bytes) {
         NativeOptions n = native_options(program_tool, program_base, skip_unresolved, tolerance, uframes, utools,
                                          allow_branch_change, tracks);
         if (in.empty()) throw InputError("--program: no input");
@@ -140,7 +158,9 @@ void define_compensation(py::module_& m) {
         if (speed) w.speed = *speed;
         if (zone) w.zone = *zone;
         w.max_targets_per_file = max_per_file;
-        const ProgramOptions o = KINCAL_COMP_OPTIONS;
+        ProgramOptions o = KINCAL_COMP_OPTIONS;
+        o.keep_poses = keep_poses;
+        o.chunk_bytes = chunk_bytes;
         if (in.size() > 1 || is_folder(in[0])) {  // a controller backup: the same tree under out
           if (format) throw InputError("--format: a backup's programs are written in their own languages");
           BackupOptions b;
@@ -195,13 +215,16 @@ void define_compensation(py::module_& m) {
       py::arg("tolerance") = py::none(), py::arg("uframes") = std::vector<std::string>{},
       py::arg("utools") = std::vector<std::string>{}, py::arg("declarations") = std::vector<std::string>{},
       py::arg("allow_branch_change") = false, py::arg("tracks") = std::vector<std::string>{}, py::arg("threads") = 0,
-      py::arg("progress") = py::none(),
+      py::arg("progress") = py::none(), py::arg("keep_poses") = true, py::arg("chunk_bytes") = kProgramChunkBytes,
       "Compensates a program into a program in a controller's language (format: krl, rapid, fanuc-ls, urscript, gcode, "
       "csv; None: by the output's extension), every file written or none; tolerance (mm): targets inserted where the "
       "path between two targets leaves the desired segment by more (path_before_mm, path_after_mm, inserted); uframes, "
       "utools: FANUC LS user frames and tools, 'N=X,Y,Z,A,B,C' each; tracks: 'E1=X,Y,Z' linear tracks. program: one "
       "file, or several files and folders (a controller backup: out is a folder with the same tree; the result lists "
-      "each program with its error or files, the files copied, and how many failed; progress(done, all))");
+      "each program with its error or files, the files copied, and how many failed; progress(done, all)). A CSV or "
+      "G-code program written as CSV or G-code joints is read and written a chunk of chunk_bytes at a time; with "
+      "keep_poses=False its result has no per-pose arrays (poses, iterations_min/max/total and residual_max say "
+      "what the summary needs), so that a program of any length is compensated in bounded memory");
   m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,

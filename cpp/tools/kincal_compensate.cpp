@@ -183,6 +183,7 @@ int main(int argc, char** argv) {
                  "separated; default: the direction of the first motion; needed with --stream)");
   app.add_flag("--keep-branch", keep_branch, "a branch change inside the program is an error, not a warning");
   CLI11_PARSE(app, argc, argv);
+  kincal::remove_unfinished_files_on_signals();  // a long program interrupted: no temporary file left
 
   try {
     if (programs.size() > 1 && !fivebar.empty()) throw kincal::InputError("--fivebar: one --program");
@@ -201,6 +202,7 @@ int main(int argc, char** argv) {
     if (temperature) opt.temperature_c = *temperature;
     opt.keep_branch = keep_branch;
     opt.initial_direction = kincal::parse_initial_direction(initial_direction);
+    opt.keep_poses = false;  // the summary needs the count and extremes only: any length in bounded memory
     const kincal::Robot robot = kincal::with_joint_convention(kincal::load_robot(model), model, joint_convention);
     if (opt.instrument_frame && !robot.identified())
       throw kincal::InputError(model + ": --frame instrument needs an identified model (kincal identify)");
@@ -257,7 +259,7 @@ int main(int argc, char** argv) {
         ++filtered;
         std::string files;
         for (const auto& f : p.result.files) files += (files.empty() ? "" : ", ") + f;
-        std::fprintf(stderr, "%s: %zu target(s) compensated; %s\n", files.c_str(), p.result.result.q_deg.size(),
+        std::fprintf(stderr, "%s: %zu target(s) compensated; %s\n", files.c_str(), p.result.result.poses,
                      p.result.targets_note.c_str());
       }
       std::fprintf(stderr, "%s: %zu program(s) filtered, %zu file(s) copied unchanged, %d program(s) failed\n",
@@ -277,7 +279,7 @@ int main(int argc, char** argv) {
     const auto& res = cr.result;
     for (const auto& w : res.warnings) std::fprintf(stderr, "kincal-compensate: warning: %s\n", w.c_str());
     std::fprintf(stderr, "%s: %zu poses, at most %d iterations, largest residual %.3g\n", out.c_str(),
-                 res.q_deg.size(), res.max_iterations, res.max_residual);
+                 res.poses, res.max_iterations, res.max_residual);
     if (!cr.targets_note.empty()) std::fprintf(stderr, "%s: %s\n", out.c_str(), cr.targets_note.c_str());
     if (tolerance)
       std::fprintf(stderr, "%s: path between targets: largest deviation from the desired segments %.4f mm before, "

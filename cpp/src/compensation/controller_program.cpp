@@ -456,6 +456,15 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
     throw InputError(in_path + ": --program-base and --program-tool give a native program's frames (KRL, RAPID, LS, "
                      "URScript); a CSV or G-code program's poses are in the robot's base frame (or the instrument's, "
                      "--frame instrument) for the model's tool");
+  const bool joint_file = w.targets == TargetKind::Joints &&
+                          (w.format == ControllerFormat::Csv || w.format == ControllerFormat::Gcode);
+  if (joint_file && !std::isfinite(native.tolerance_mm)) {  // pose after pose, in bounded memory
+    ControllerProgramResult r;
+    r.result = compensate_program_file(robot, in_path, out_path, opt,
+                                       w.format == ControllerFormat::Csv ? ProgramFormat::Csv : ProgramFormat::Gcode);
+    r.files.push_back(out_path);
+    return r;
+  }
   PoseProgram prog = read_pose_program(in_path);
   std::vector<std::string> where_of;
   where_of.reserve(prog.poses.size());
@@ -473,7 +482,7 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
     r.result = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
   }
   std::vector<OutputFile> files;
-  if (w.targets == TargetKind::Joints && (w.format == ControllerFormat::Csv || w.format == ControllerFormat::Gcode)) {
+  if (joint_file) {
     std::vector<Vec6> qc = r.result.q_deg;  // the controller's numbers
     for (Vec6& q : qc) joints_to_controller(robot.nominal->spec(), q.data(), 6);
     files.push_back({out_path, format_joint_program(prog, qc,

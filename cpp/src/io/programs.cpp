@@ -5,87 +5,12 @@
 #include "kincal/io/gcode.hpp"
 
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 namespace kincal {
 
 namespace {
-
-PoseProgram parse_pose_csv(const std::string& text, const std::string& source) {
-  PoseProgram p;
-  const CsvTable t = parse_csv(text, source);
-  int col[6];
-  const char* names[6] = {"x", "y", "z", "a", "b", "c"};
-  for (int k = 0; k < 6; ++k) col[k] = t.require(names[k]);
-  const int tc = t.find("temperature_c");
-  for (size_t r = 0; r < t.cells.size(); ++r) {
-    Pose6 pose;
-    for (int k = 0; k < 3; ++k) pose.xyz[k] = t.number(r, col[k]);
-    for (int k = 0; k < 3; ++k) pose.abc[k] = t.number(r, col[3 + k]);
-    p.poses.push_back(pose);
-    p.pose_line.push_back(t.line[r]);
-    if (tc >= 0) p.temperature_c.push_back(t.number(r, tc));
-  }
-  if (p.poses.empty()) throw InputError(source + ": the program has no poses");
-  return p;
-}
-
-// The text's lines without their ends, and each one's end: "\n", "\r\n", or for a last line without a
-// newline "" (or "\r").
-std::vector<std::pair<std::string, std::string>> lines_with_ends(const std::string& text) {
-  std::vector<std::pair<std::string, std::string>> out;
-  for (size_t b = 0; b < text.size();) {
-    size_t e = text.find('\n', b);
-    const bool nl = e != std::string::npos;
-    if (!nl) e = text.size();
-    const bool cr = e > b && text[e - 1] == '\r';
-    out.emplace_back(text.substr(b, e - b - (cr ? 1 : 0)), std::string(cr ? "\r" : "") + (nl ? "\n" : ""));
-    b = e + 1;
-  }
-  return out;
-}
-
-PoseProgram parse_pose_gcode(const std::string& text, const std::string& source) {
-  PoseProgram p;
-  int line = 0;
-  Pose6 modal;
-  bool set[6] = {false, false, false, false, false, false};
-  GcodeWord words[16];
-  const auto split = lines_with_ends(text);
-  if (!split.empty()) {
-    p.eol = split[0].second == "\r\n" ? "\r\n" : "\n";
-    p.final_newline = !split.back().second.empty() && split.back().second.back() == '\n';
-  }
-  for (const auto& [raw, eol] : split) {
-    ++line;
-    const int n = scan_gcode(raw.data(), raw.size(), GcodeWords::Pose, 6, words, 16, source.c_str(), line);
-    PoseProgram::Line l;
-    l.eol = eol;
-    if (n == 0) {
-      l.text = raw;
-      p.lines.push_back(std::move(l));
-      continue;
-    }
-    for (int k = 0; k < n; ++k) {
-      (words[k].axis < 3 ? modal.xyz : modal.abc)[words[k].axis % 3] = words[k].value;
-      set[words[k].axis] = true;
-    }
-    std::string missing;
-    for (int k = 0; k < 6; ++k)
-      if (!set[k]) missing += std::string(missing.empty() ? "" : " ") + kPoseLetters[k];
-    if (!missing.empty()) fail_at(source.c_str(), line, "pose word(s) " + missing + " not set yet on the first motion line");
-    char buf[4096];
-    const CutLine cut = cut_words(raw.data(), raw.size(), words, n, buf, sizeof buf, source.c_str(), line);
-    l.text.assign(buf, cut.size);
-    l.insert_at = cut.insert_at;
-    l.pose = static_cast<int>(p.poses.size());
-    p.poses.push_back(modal);
-    p.pose_line.push_back(line);
-    p.lines.push_back(std::move(l));
-  }
-  if (p.poses.empty()) throw InputError(source + ": the program has no poses (no X Y Z A B C words)");
-  return p;
-}
 
 void parse_joint_csv(const std::string& text, JointProgram& p) {
   const CsvTable t = parse_csv(text, p.source);
@@ -131,10 +56,143 @@ ProgramFormat program_format(const std::string& path) {
   return is_csv_path(path) ? ProgramFormat::Csv : ProgramFormat::Gcode;
 }
 
+namespace {
+constexpr const char* kPoseColumns[6] = {"x", "y", "z", "a", "b", "c"};
+}  // namespace
+
+PoseProgramReader::PoseProgramReader(const std::string& path, size_t chunk_bytes)
+    : source_(path), format_(program_format(path)) {
+  if (format_ == ProgramFormat::Csv) {
+    csv_ = std::make_unique<CsvReader>(path, chunk_bytes);
+  } else {
+    text_ = std::make_unique<TextChunks>(path, chunk_bytes);
+  }
+  if (csv_) {
+    for (int k = 0; k < 6; ++k) {
+      const std::string e = csv_->missing(kPoseColumns[k], cols_[k]);
+      if (!e.empty()) fail_after_rest(e);
+    }
+    temperature_col_ = csv_->find("temperature_c");
+  }
+}
+
+PoseProgramReader::PoseProgramReader(std::string text, const std::string& source, ProgramFormat format)
+    : source_(source), format_(format) {
+  if (format_ == ProgramFormat::Csv) {
+    csv_ = std::make_unique<CsvReader>(std::move(text), source);
+    for (int k = 0; k < 6; ++k) {
+      const std::string e = csv_->missing(kPoseColumns[k], cols_[k]);
+      if (!e.empty()) fail_after_rest(e);
+    }
+    temperature_col_ = csv_->find("temperature_c");
+  } else {
+    text_ = std::make_unique<TextChunks>(std::move(text));
+  }
+}
+
+// An error that comes after the broken rows of the whole file (CSV: a missing column, a cell that is not
+// a number): the rest of the file is read first, and its first broken row is the error.
+void PoseProgramReader::fail_after_rest(const std::string& error) {
+  if (csv_)
+    while (csv_->next()) {
+    }
+  throw InputError(error);
+}
+
+bool PoseProgramReader::next(ProgramLine& l) { return csv_ ? next_csv(l) : next_gcode(l); }
+
+void PoseProgramReader::rest() {
+  ProgramLine l;
+  while (next(l)) {
+  }
+}
+
+bool PoseProgramReader::next_csv(ProgramLine& l) {
+  if (!csv_->next()) {
+    if (poses_ == 0) throw InputError(source_ + ": the program has no poses");
+    return false;
+  }
+  std::string error;
+  double v[7];
+  for (int k = 0; k < 6 && error.empty(); ++k) v[k] = csv_->number(cols_[k], &error);
+  v[6] = temperature_col_ >= 0 && error.empty() ? csv_->number(temperature_col_, &error)
+                                                : std::numeric_limits<double>::quiet_NaN();
+  if (!error.empty()) fail_after_rest(error);
+  l.has_pose = true;
+  l.pose.xyz = Vec3(v[0], v[1], v[2]);
+  l.pose.abc = Vec3(v[3], v[4], v[5]);
+  l.temperature_c = v[6];
+  l.line = csv_->line();
+  ++poses_;
+  return true;
+}
+
+// The lines as lines_with_ends would split the whole text: each without its end, and its end: "\n",
+// "\r\n", or for a last line without a newline "" (or "\r").
+bool PoseProgramReader::next_gcode(ProgramLine& l) {
+  if (pos_ >= text_->limit() && !text_->more(pos_)) {
+    if (poses_ == 0) throw InputError(source_ + ": the program has no poses (no X Y Z A B C words)");
+    return false;
+  }
+  const char* b = text_->data() + pos_;
+  const char* end = text_->data() + text_->limit();
+  const char* e = static_cast<const char*>(std::memchr(b, '\n', static_cast<size_t>(end - b)));
+  const bool nl = e != nullptr;
+  if (!nl) e = end;
+  const bool cr = e > b && e[-1] == '\r';
+  const size_t n = static_cast<size_t>(e - b) - (cr ? 1 : 0);
+  l.eol.assign(cr ? "\r" : "");
+  if (nl) l.eol += '\n';
+  pos_ = static_cast<size_t>(e - text_->data()) + (nl ? 1 : 0);
+  ++line_;
+  l.line = line_;
+  l.temperature_c = std::numeric_limits<double>::quiet_NaN();
+  GcodeWord words[16];
+  const int cnt = scan_gcode(b, n, GcodeWords::Pose, 6, words, 16, source_.c_str(), line_);
+  if (cnt == 0) {
+    l.has_pose = false;
+    l.text.assign(b, n);
+    l.insert_at = 0;
+    return true;
+  }
+  for (int k = 0; k < cnt; ++k) {
+    (words[k].axis < 3 ? modal_.xyz : modal_.abc)[words[k].axis % 3] = words[k].value;
+    set_[words[k].axis] = true;
+  }
+  std::string missing;
+  for (int k = 0; k < 6; ++k)
+    if (!set_[k]) missing += std::string(missing.empty() ? "" : " ") + kPoseLetters[k];
+  if (!missing.empty())
+    fail_at(source_.c_str(), line_, "pose word(s) " + missing + " not set yet on the first motion line");
+  char buf[4096];
+  const CutLine cut = cut_words(b, n, words, cnt, buf, sizeof buf, source_.c_str(), line_);
+  l.has_pose = true;
+  l.pose = modal_;
+  l.text.assign(buf, cut.size);
+  l.insert_at = cut.insert_at;
+  ++poses_;
+  return true;
+}
+
 PoseProgram parse_pose_program(const std::string& text, const std::string& source, ProgramFormat format) {
-  PoseProgram p = format == ProgramFormat::Csv ? parse_pose_csv(text, source) : parse_pose_gcode(text, source);
+  PoseProgramReader rd(text, source, format);
+  PoseProgram p;
   p.source = source;
   p.format = format;
+  ProgramLine l;
+  bool first = true;
+  while (rd.next(l)) {
+    if (format == ProgramFormat::Gcode) {
+      if (first) p.eol = l.eol == "\r\n" ? "\r\n" : "\n";
+      first = false;
+      p.final_newline = !l.eol.empty() && l.eol.back() == '\n';
+      p.lines.push_back({l.text, l.insert_at, l.has_pose ? static_cast<int>(p.poses.size()) : -1, l.eol});
+    }
+    if (!l.has_pose) continue;
+    p.poses.push_back(l.pose);
+    p.pose_line.push_back(l.line);
+    if (rd.has_temperature()) p.temperature_c.push_back(l.temperature_c);
+  }
   return p;
 }
 

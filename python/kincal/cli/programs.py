@@ -11,8 +11,6 @@ import sys
 from pathlib import Path
 from typing import Any, Callable, Optional
 
-import numpy as np
-
 from .. import _core, load_robot
 from ..programs import feed
 from .options import joint_convention_option, robot_of, robot_opts, step_progress
@@ -84,7 +82,9 @@ def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[s
                progress: Optional[Callable[[int, int], None]] = None) -> dict[str, Any]:
     """Compensates args.program (a file, or several files and folders: a controller backup) into args.out
     in the chosen language; returns the result dict (with `files`, the files written; a backup: `programs`,
-    `copied`, `failed`). A model whose TCP is nominal (not measured) gets one warning line."""
+    `copied`, `failed`). A model whose TCP is nominal (not measured) gets one warning line. One program's
+    result has its count and extremes only (`poses`, `iterations_min`, ...; no per-pose arrays): a CSV or
+    G-code program of any length is compensated in bounded memory."""
     warn_nominal_tcp(robot, args.model, "kincal compensate")
     return _core.compensate_to_controller(robot, [str(p) for p in args.program], str(args.out), **comp_kwargs,
                                           format=args.format, targets=args.targets, name=args.name,
@@ -96,7 +96,7 @@ def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[s
                                           uframes=args.uframe, utools=args.utool,
                                           declarations=[str(d) for d in args.declarations],
                                           allow_branch_change=args.allow_branch_change, tracks=args.track,
-                                          threads=args.jobs, progress=progress)
+                                          threads=args.jobs, progress=progress, keep_poses=False)
 
 
 def summary(res: dict[str, Any]) -> list[str]:
@@ -151,10 +151,10 @@ def cmd_compensate(args: argparse.Namespace) -> None:
     res = compensate(robot, args, _comp_kwargs(args))
     for w in res["warnings"]:
         print(f"kincal compensate: warning: {w}", file=sys.stderr)
-    it = np.asarray(res["iterations"])
+    n = res["poses"]
     written = ", ".join(res.get("files") or [str(args.out)])  # a KRL program is its .src and .dat
-    print(f"{written}: {len(it)} poses compensated, iterations {it.min()}..{it.max()} "
-          f"(mean {it.mean():.2f}), largest residual |F| {max(res['residual']):.3g}", file=sys.stderr)
+    print(f"{written}: {n} poses compensated, iterations {res['iterations_min']}..{res['iterations_max']} "
+          f"(mean {res['iterations_total'] / n:.2f}), largest residual |F| {res['residual_max']:.3g}", file=sys.stderr)
     for line in summary(res):
         print(f"{written}: {line}", file=sys.stderr)
 

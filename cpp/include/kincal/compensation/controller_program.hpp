@@ -52,7 +52,9 @@ void add_numbered_frame(std::map<int, Pose6>& frames, const std::string& text, c
 void add_track_axis(std::map<int, Vec3>& track, const std::string& text);
 
 /// Reads a pose program (CSV or G-code; a KRL or RAPID program: see NativeOptions), compensates it and writes it in w.format (every file, or
-/// none when anything fails). A G-code program written as G-code joints keeps its other lines.
+/// none when anything fails). A G-code program written as G-code joints keeps its other lines. A CSV or
+/// G-code program written as CSV or G-code joints (without --tolerance) is compensated pose after pose in
+/// bounded memory (compensate_program_file; opt.keep_poses false: the result without per-pose vectors).
 /// Returns the result with the files written in `files`.
 struct ControllerProgramResult {
   ProgramResult result;

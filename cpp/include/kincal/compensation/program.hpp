@@ -7,6 +7,8 @@
 
 #include "kincal/compensation/pose.hpp"
 #include "kincal/ik/ik.hpp"
+#include "kincal/io/file.hpp"
+#include "kincal/io/programs.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 #include "kincal/model/model.hpp"
 
@@ -31,6 +33,13 @@ struct ProgramOptions {
   /// nominal solution (one fixed-point step); false: from the nominal IK solution, as the paper.
   bool corrected_start = true;
   CompensationOptions comp;
+  /// compensate_program_file: the program file is read, and the joint program written, this many bytes
+  /// at a time (a test makes it small to cross chunks in a short program)
+  size_t chunk_bytes = kProgramChunkBytes;
+  /// compensate_program_file: the result keeps every pose's joints, iterations, residual and directions;
+  /// false: only their count and extremes (ProgramResult::poses ...), so that a program of any length
+  /// is compensated in bounded memory
+  bool keep_poses = true;
 };
 
 /// How solve_pose ended.
@@ -65,7 +74,9 @@ struct ProgramResult {
   std::vector<double> residual;
   std::vector<Vec6> dir;  ///< backlash: each joint's direction into each pose
   std::vector<std::string> warnings;             ///< "file:line: cause", e.g. branch changes
-  int max_iterations = 0;
+  size_t poses = 0;  ///< poses compensated (q_deg.size(), unless ProgramOptions::keep_poses is false)
+  int min_iterations = 0, max_iterations = 0;
+  long long total_iterations = 0;
   double max_residual = 0;
 };
 
@@ -122,9 +133,15 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
                                const std::vector<double>& temperature_c = {},
                                const std::vector<std::optional<Vec6>>& references = {});
 
-/// Reads a pose program, compensates it and writes the joint program (CSV or G-code by the output
-/// file's extension). Nothing is written when any pose fails.
+/// Reads a pose program, compensates it and writes the joint program (CSV or G-code: out_format, by
+/// default by the output file's extension), as compensate_poses and format_joint_program would, in
+/// bounded memory: the file is read a chunk at a time (opt.chunk_bytes) and the joint program written
+/// as it goes into a temporary file beside out_path, renamed into place at the end; nothing is written
+/// when anything fails, and the error is the one the whole program read at once would give (a broken
+/// line anywhere in the file before a pose that fails). With backlash and no initial direction the file
+/// is read twice (the first pass finds the direction of each joint's first motion). A file that cannot
+/// be read twice (a pipe) is read whole.
 ProgramResult compensate_program_file(const Robot& robot, const std::string& in_path, const std::string& out_path,
-                                      const ProgramOptions& opt);
+                                      const ProgramOptions& opt, std::optional<ProgramFormat> out_format = {});
 
 }  // namespace kincal

@@ -302,7 +302,9 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     f2_last = f2;
     Vec6 step = f;
     fac.solve(step);
-    if (it == 0 && opt.second_order) {  // the first, largest step: its second-order term as well
+    // the first, largest step: its second-order term as well (of the rotation vector's rows; the ABC
+    // angles' own curvature is not in it)
+    if (it == 0 && opt.second_order && opt.residual == Residual::RotationVector) {
       Vec6 more = ev.second_order(step);
       fac.solve(more);
       // a correction as large as the step itself: near a singularity, where the series does not hold
@@ -333,6 +335,8 @@ Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& d
 Vec6 pose_deviation_second_order(const Model& cal, const Vec6& q_deg, const Pose6& desired, const Vec6& step_deg,
                                  Residual residual, const EffectContext& ctx) {
   if (cal.dof() != 6) throw std::invalid_argument("pose_deviation_second_order needs a 6-joint robot");
+  if (residual != Residual::RotationVector)
+    throw std::invalid_argument("pose_deviation_second_order: the rotation-vector residual only");
   check_context(cal, ctx, "");
   DeviationEvaluator ev(cal, desired, ctx, residual);
   ev.deviation_at(q_deg);

@@ -39,7 +39,8 @@ struct CompensationOptions {
   double reuse_contraction = 0.1;
   /// The analytic iteration's first step corrected by its second-order term (the tool's acceleration
   /// along the step, solved with the same Jacobian): F falls to 1e-5..1e-3 of its start instead of
-  /// 1e-3..1e-2, and one fresh step more converges. Skipped where the correction is over half the step.
+  /// 1e-3..1e-2, and one fresh step more converges. Skipped where the correction is over half the step,
+  /// and with the ABC residual.
   bool second_order = true;
 };
 
@@ -67,7 +68,8 @@ Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& d
 /// Half the second derivative of pose_deviation along step_deg at q_deg, as the first step of the
 /// compensation uses it: pose_deviation(q + s) = F + J s + pose_deviation_second_order(s) + O(s^3)
 /// where the model's pose equals the desired one (the rotation vector's own curvature, O(phi), and
-/// the joint effects' curvature are omitted).
+/// the joint effects' curvature are omitted). The rotation-vector residual only (invalid_argument
+/// for Residual::Abc).
 Vec6 pose_deviation_second_order(const Model& cal, const Vec6& q_deg, const Pose6& desired, const Vec6& step_deg,
                                  Residual residual = Residual::RotationVector,
                                  const EffectContext& ctx = EffectContext());

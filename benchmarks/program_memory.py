@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import shutil
 import subprocess
@@ -29,6 +28,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
+
+from scale import smooth_joint_path  # the same path as the scale's programs (this folder)
 
 BIN = Path(sys.executable).parent
 SEGMENT = 20_000
@@ -64,15 +65,8 @@ def model(wd: Path, kincal: str) -> Path:
 
 def segment(wd: Path, kincal: str) -> list[str]:
     """The pose lines (CSV x,y,z,a,b,c, no header) of a smooth joint path of the kr500: each joint a sum
-    of two slow sines inside 60% of its range (as benchmarks/scale.py), through `kincal fk`."""
-    rng = np.random.default_rng(1)
-    t = np.linspace(0.0, 1.0, SEGMENT)[:, None]
-    lo = np.array([-185, -130, -100, -350, -120, -350.0])
-    hi = np.array([185, 20, 144, 350, 120, 350.0])
-    mid, half = (lo + hi) / 2, 0.3 * (hi - lo)
-    f1, f2 = rng.uniform(1, 5, 6), rng.uniform(5, 20, 6)
-    q = mid + half * (0.7 * np.sin(2 * math.pi * f1 * t) + 0.3 * np.sin(2 * math.pi * f2 * t))
-    q[:, 4] = np.where(np.abs(q[:, 4]) < 5, 5.0, q[:, 4])  # away from the wrist singularity
+    of two slow sines inside 60% of its range (scale.py's smooth_joint_path), through `kincal fk`."""
+    q = smooth_joint_path(SEGMENT, 1)
     joints, poses = wd / "segment.joints.csv", wd / "segment.csv"
     np.savetxt(joints, q, delimiter=",", header="q1,q2,q3,q4,q5,q6", comments="", fmt="%.6f")
     subprocess.run([kincal, "fk", "--robot", "kr500", "--joints", str(joints), "--out", str(poses)], check=True,

@@ -37,9 +37,9 @@ def timed(argv: list[str], cores: str) -> float:
     return dt
 
 
-def program(path: Path, n: int, seed: int = 1) -> None:
-    """A pose program of n poses: a smooth joint path of the kr500 (each joint a sum of two slow
-    sines inside 60% of its range), through `kincal fk`."""
+def smooth_joint_path(n: int, seed: int = 1) -> np.ndarray:
+    """n configurations (deg) of a smooth joint path of the kr500: each joint a sum of two slow sines
+    inside 60% of its range, joint 5 kept 5 deg from the wrist singularity."""
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 1.0, n)[:, None]
     lo = np.array([-185, -130, -100, -350, -120, -350.0])
@@ -47,7 +47,13 @@ def program(path: Path, n: int, seed: int = 1) -> None:
     mid, half = (lo + hi) / 2, 0.3 * (hi - lo)
     f1, f2 = rng.uniform(1, 5, 6), rng.uniform(5, 20, 6)
     q = mid + half * (0.7 * np.sin(2 * math.pi * f1 * t) + 0.3 * np.sin(2 * math.pi * f2 * t))
-    q[:, 4] = np.where(np.abs(q[:, 4]) < 5, 5.0, q[:, 4])  # away from the wrist singularity
+    q[:, 4] = np.where(np.abs(q[:, 4]) < 5, 5.0, q[:, 4])
+    return q
+
+
+def program(path: Path, n: int, seed: int = 1) -> None:
+    """A pose program of n poses: smooth_joint_path through `kincal fk`."""
+    q = smooth_joint_path(n, seed)
     joints = path.with_suffix(".joints.csv")
     np.savetxt(joints, q, delimiter=",", header="q1,q2,q3,q4,q5,q6", comments="", fmt="%.6f")
     subprocess.run([KINCAL, "fk", "--robot", "kr500", "--joints", str(joints), "--out", str(path)], check=True,

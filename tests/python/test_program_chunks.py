@@ -187,6 +187,7 @@ def test_an_interrupted_run_leaves_no_file(tmp_path, calibrated, sig):
     while not list(tmp_path.glob("out.csv.tmp*")) and p.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)
     assert p.poll() is None, "the program ended before it could be interrupted"
+    assert list(tmp_path.glob("out.csv.tmp*")), "no temporary file appeared within 60 s: nothing to clean up"
     p.send_signal(sig)
     p.communicate(timeout=60)
     assert p.returncode == -sig

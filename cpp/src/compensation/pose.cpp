@@ -50,7 +50,7 @@ inline Vec3 rotation_vector(const Mat3& r) {
   const double c = 0.5 * (r(0, 0) + r(1, 1) + r(2, 2) - 1), s2 = 0.25 * v.squaredNorm();  // cos, sin^2
   if (s2 < 4e-4 && c > 0) {
     // theta / (2 sin theta) = asin(s) / (2 s) by its series in s^2 = sin^2 theta (|s| < 0.02: the
-    // first omitted term, 35 s^8 / 1152, is below 1e-15): no arctangent, no square root
+    // first omitted term, 35 s^8 / 2304, is below 1e-15): no arctangent, no square root
     const double f = 0.5 + s2 * (1.0 / 12 + s2 * (3.0 / 80 + s2 * (5.0 / 224)));
     return f * v;
   }
@@ -187,7 +187,8 @@ struct DeviationEvaluator {
   // the iteration converges as fast (quadratically) at a lower cost; the ABC rates are always exact.
   void jacobian(Mat6r& jf, Mat3& e, bool exact = true) const {
     Mat3 e_inv;
-    const bool rated = abc || exact;
+    // (far from the solution, as from a previous pose's joints, the exact rates: |phi| > 0.05 rad)
+    const bool rated = abc || exact || phi.squaredNorm() > 2.5e-3;
     if (rated)
       rates(e, e_inv);
     else

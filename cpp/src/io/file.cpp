@@ -130,7 +130,12 @@ void remove_unfinished_files_on_signals() {
   struct sigaction sa {};
   sa.sa_handler = remove_unfinished_files;
   sigemptyset(&sa.sa_mask);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // a signal the user had ignored (nohup, a background job's SIGINT) stays ignored
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &sa, nullptr);
+  }
 }
 
 AtomicFileWriter::AtomicFileWriter(const std::string& path, size_t buffer_bytes)

@@ -12,7 +12,8 @@
 // its last Jacobian for a step while the steps shrink |F| tenfold (a chord step: F only, no Jacobian
 // and no factorisation; `reuse_contraction`), corrects its first step by the step's second-order term
 // (`second_order`), and takes the rotation vector's rates as the angular velocity (exact at the
-// solution): the same stopping rule on the exact F, at 0.7x the time per pose (BENCHMARKS.md).
+// solution, and used once |phi| < 0.05 rad): the same stopping rule on the exact F, at 0.76x the time
+// per pose (BENCHMARKS.md).
 #pragma once
 
 #include "kincal/kinematics/kinematics.hpp"

@@ -128,6 +128,9 @@ inline constexpr const char* kNeedsTemperature =
 /// pose is compensated with the directions its own commanded motion has (motion_directions);
 /// thermal expansion: temperature_c per pose (or opt.temperature_c). The first pose that fails
 /// throws an InputError naming where[i] and the cause.
+/// The result's count and extremes (poses, iterations, residual) with one more pose.
+void count_pose(ProgramResult& res, const PoseSolution& s);
+
 ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& poses,
                                const std::vector<std::string>& where, const ProgramOptions& opt,
                                const std::vector<double>& temperature_c = {},

@@ -73,7 +73,7 @@ def carriers(res: _core.IdentifyResult, data: dict[str, Any]) -> tuple[FloatArra
     """The residual r (dims per row) of a fit and the carriers C (one column per way the model moves
     a point: the instrument's 6 placement parameters, then each joint's angle, in mm per rad) at
     that fit."""
-    from ..calibration.effect_choice import evaluate
+    from ..calibration.linearisation import evaluate
 
     dof = res.robot.dof
     extra = [_core.Effect("joint_map", j, order=1) for j in range(1, dof + 1)]

@@ -1,5 +1,6 @@
 // kincal: what a fit asks of the data and the effects before Ceres runs (fit_setup.hpp).
 #include "fit_setup.hpp"
+#include "kincal/identify/identifiability.hpp"
 
 #include "kincal/kinematics/kinematics.hpp"
 
@@ -121,20 +122,24 @@ void start_carried_effects(const Model& nominal, const IdentifyOptions& opt, Ide
 
 /// The free parameters; InputError when the data give no more equations than them or, with priors,
 /// fewer measured points than there are free parameters without a prior (the frames: what only the
-/// data can determine).
+/// data can determine; a frame held as unseen, hold_unseen_frames, counts as free).
 std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResult& res, const std::vector<double>& sd) {
   std::vector<int> free_idx;
-  size_t unconstrained = 0;
-  for (int i = 0; i < res.layout.size; ++i)
+  size_t unconstrained = 0, unseen = 0;  // the frames held because these rows do not see them count as free here
+  for (int i = 0; i < res.layout.size; ++i) {
     if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
+    if (res.fixed[i] && res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0) ++unseen;
+  }
+  const size_t n_free = free_idx.size() + unseen;
+  unconstrained += unseen;
   size_t nres = 0;  // a reflector row among 6-D rows gives 3 equations
   for (const auto& r : data.rows) nres += data.orientation && r.has_abc ? 6 : position_equations(r);
   nres += data.artifact.size();
   const std::string points = data.source + ": " + std::to_string(data.rows.size()) + " measured points";
-  if (unconstrained == free_idx.size() && nres <= free_idx.size())
-    throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(free_idx.size()) +
+  if (unconstrained == n_free && nres <= n_free)
+    throw InputError(points + " give " + std::to_string(nres) + " equations for " + std::to_string(n_free) +
                      " free parameters: too few to identify the model");
-  if (unconstrained < free_idx.size() && data.rows.size() < unconstrained)
+  if (unconstrained < n_free && data.rows.size() < unconstrained)
     throw InputError(points + " for " + std::to_string(unconstrained) +
                      " free parameters without a prior (frames and targets): too few to identify the model");
   return free_idx;

@@ -237,11 +237,13 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
   std::vector<int> frames;
   // with measured orientations the frame measured is the tool frame (its target held at zero): the
   // probe's mounting, position and rotation, is a frame too
+  const auto unseen = [&](int i) { return res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0; };
   if (data.orientation)
-    for (int i = L.tool; i < L.tool + 6; ++i) frames.push_back(i);
+    for (int i = L.tool; i < L.tool + 6; ++i)
+      if (!unseen(i)) frames.push_back(i);
   for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
     if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != kSetupNeverMeasured &&
-                          res.fixed_reason[i] != kProbeOnlySetup))
+                          res.fixed_reason[i] != kProbeOnlySetup && !unseen(i)))
       frames.push_back(i);
   for (int i = L.stations; i < L.size; ++i)  // the probe stations are the campaign's frames too
     if (!res.fixed[i]) frames.push_back(i);
@@ -439,6 +441,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   std::vector<double> x = res.start;
   // stage 1: the frames on the nominal geometry; then what the data cannot determine is held (or,
   // with priors, left to them)
+  hold_unseen_frames(pm, data, x, opt, res);
   fit_frames(pm, nominal, data, opt, x, res);
   res.prior_sd = prior_sds(res.layout, opt);
   const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd);

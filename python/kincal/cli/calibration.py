@@ -10,9 +10,12 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from .. import _core, diagnose as diagnosis, fivebar, load_robot
 from ..calibration import identify as ident
 from ..io import strict_json
+from ..programs.kinematics_files import carried_targets
 from ..io.urdf import spec_urdf, urdf_left_out
 from .. import report
 from ..calibration import simulation as sim
@@ -104,8 +107,17 @@ def cmd_identify(args: argparse.Namespace) -> None:
 def cmd_validate(args: argparse.Namespace) -> None:
     robot = load_robot(args.model)
     data = ident.read_measurements(args.data, robot, args.artifact)
-    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale, target_start=probe_start(args))
+    # the targets start where the model's campaign put them, when it had as many (a depth these rows do
+    # not see, a reflector's along the axis every orientation shares, is then held there, not at the flange)
+    start = probe_start(args)
+    carried = carried_targets(args.model)
+    n_targets = int(np.max(data["target"])) + 1 if len(data["target"]) else 0
+    from_model = start is None and carried is not None and len(carried) == n_targets
+    v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale,
+                       target_start=carried.tolist() if from_model and carried is not None else start)
     v["model"] = str(args.model)
+    if from_model:
+        v["refitted"] += "; the target offsets started from the model's"
     _core.write_file_atomic(args.out, strict_json.dumps(v, indent=1, sort_keys=True) + "\n")
     print(ident.validation_summary(v))
 

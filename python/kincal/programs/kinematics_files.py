@@ -47,15 +47,21 @@ def effect_columns(path: str, robot: _core.Robot, n: int, temperature: Optional[
     return out
 
 
-def identified_targets(robot_arg: str) -> FloatArray:
-    """Target offsets (tool frame, mm) an identified model JSON carries; only the tool point otherwise."""
+def carried_targets(robot_arg: str) -> Optional[FloatArray]:
+    """Target offsets (tool frame, mm) an identified model JSON carries, or None."""
     if str(robot_arg).lower().endswith(".json"):
         with open(robot_arg) as f:
             d = json.load(f)
         t = d.get("identification", {}).get("targets_mm")
         if t:
             return np.asarray(t, dtype=float)
-    return np.zeros((1, 3))
+    return None
+
+
+def identified_targets(robot_arg: str) -> FloatArray:
+    """Target offsets (tool frame, mm) an identified model JSON carries; only the tool point otherwise."""
+    t = carried_targets(robot_arg)
+    return np.zeros((1, 3)) if t is None else t
 
 
 def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: str = "base",

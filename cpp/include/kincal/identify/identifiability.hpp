@@ -28,6 +28,23 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
 /// The reasons a setup's placement is held when the data cannot see it.
 inline constexpr const char* kSetupNeverMeasured = "setup never measured";
 inline constexpr const char* kProbeOnlySetup = "probe rows only: the stations' unknowns absorb the base frame";
+/// The start of the reason a frame's parameter is held before the frames' fit (hold_unseen_frames).
+inline constexpr const char* kUnseenFrame = "held at its start before the frames' fit";
+
+/// Before the frames' fit (the first stage, without priors): while the smallest singular value of the
+/// unit-scaled columns of the base placements, target offsets and (6-D rows) tool frame on these
+/// tracker rows is below opt.weak_tolerance, one parameter of its direction is held at its start
+/// (res.fix, the reason kUnseenFrame, the singular value and what moves with it): the largest part of
+/// the direction on the tool (a target's offset, the tool frame) when it is at least half the largest,
+/// else the largest. The case: every row's tool shares one axis direction (a campaign of one or two
+/// tool orientations about it, or a fold that holds out the only configurations of another), so a
+/// reflector's depth along that axis and the base's translation along it move together, seen through
+/// a lever of 1e-4; an unprioritised fit slides along it (1.9 m on a 15-configuration fold of the
+/// UR10's series B) and the model then predicts any other tool orientation wrong by depth x angle.
+/// Probe rows: nothing held (the stations' unknowns absorb the base frame exactly; the later analysis
+/// decides).
+void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
+                        const IdentifyOptions& opt, IdentifyResult& res);
 
 /// The data's residuals (every row's block, then one per artifact term) and their Jacobian.
 struct Linearization {

@@ -115,6 +115,7 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
   reuse.epsilon = newton.epsilon = 1e-18;
   newton.reuse_contraction = 0;
   newton.second_order = false;
+  newton.actual_angles = false;  // and on the whole model
   for (const Model& cal : models) {
     int converged = 0, converged_newton = 0, both = 0, poses = 0;
     long it_reuse = 0, it_newton = 0;

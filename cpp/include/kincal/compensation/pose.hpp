@@ -8,7 +8,9 @@
 // mm^2 + deg^2 (for the rotation vector: the squared rotation angle in deg^2). J is either the
 // paper's finite-difference Jacobian (eq. 7, step delta in degrees of the machine coordinates) or
 // the analytic one (default): the geometric Jacobian of the whole model (compliance, transmission
-// error, backlash, thermal expansion) mapped to the residual's rates. The analytic iteration reuses
+// error, backlash, thermal expansion) mapped to the residual's rates. With the joint-angle effects
+// (compliance, transmission error, backlash) the analytic iteration runs on the actual joint angles,
+// a rigid chain's, and the commanded angles follow by a fixed point (`actual_angles`). It reuses
 // its last Jacobian for a step while the steps shrink |F| tenfold (a chord step: F only, no Jacobian
 // and no factorisation; `reuse_contraction`), corrects its first step by the step's second-order term
 // (`second_order`), and takes the rotation vector's rates as the angular velocity (exact at the
@@ -43,6 +45,12 @@ struct CompensationOptions {
   /// 1e-3..1e-2, and one fresh step more converges. Skipped where the correction is over half the step,
   /// and with the ABC residual.
   bool second_order = true;
+  /// With joint-angle effects (compliance, transmission error, backlash): the analytic iteration runs
+  /// on the actual joint angles (the chain alone, a rigid robot's cost per step) and the commanded
+  /// angles follow from them by a fixed point (about 1e-3 contraction per step on a real compliance);
+  /// false: Newton on the whole model, its Jacobian through the effects' derivative. The same
+  /// solutions (to 1e-9 deg); the whole model's iteration where the first fails.
+  bool actual_angles = true;
 };
 
 enum class CompStatus { Converged, NotConverged, SingularJacobian, OrientationSingular, NotSixJoints };

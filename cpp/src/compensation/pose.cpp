@@ -383,7 +383,9 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     const double gain = std::hypot(reach * rigid.scale, 1 / kDeg);
     const double enough = (std::sqrt(opt.epsilon) - res.residual) / gain;
     if (res.status == CompStatus::Converged && commanded_for(cal, res.q_deg * kDeg, rigid.frames, ctx, 0.5 * enough, q, r)) {
-      const double r1 = r.cwiseAbs().sum();
+      // and the rounding of the actual angles q + d(q) themselves (a few ulps of each)
+      const double ulps = 24 * std::numeric_limits<double>::epsilon() * (q.cwiseAbs().maxCoeff() + 1);
+      const double r1 = r.cwiseAbs().sum() + ulps;
       res.position_error_mm += reach * rigid.scale * r1;
       res.orientation_error_deg += r1 / kDeg;
       res.residual += gain * r1;

@@ -40,7 +40,8 @@ def test_auto_on_15_configurations_of_each_ur10_series():
     (1.0; draws 1.89 and 1.18 above), through reflector depths the data did not determine (264, 178,
     -650, 146, 361 mm, slid to along a 2e-4 lever), and B's fourth draw cross-validated at 123.6 mm (a
     fold holding out the only configuration of B's third orientation slid 1.9 m): no draw may do that
-    again (every cross-validated RMS below 1.1 mm; the largest here, D's fifth, 1.016 mm). (A fixed
+    again (every cross-validated RMS below 1.1 mm; the largest here, D's fifth, 1.016 mm); D is held
+    where it stands (median at most 1.25, no draw above 2.1). (A fixed
     choice whose fit the 12-point training folds refuse counts as infinitely bad; the default must not
     refuse.)"""
     robot = kincal.load_robot("ur10")
@@ -67,3 +68,5 @@ def test_auto_on_15_configurations_of_each_ur10_series():
         if s != "D":  # D: not met (the docstring)
             assert np.median(r) <= 1.03, (s, r)
             assert max(r) <= 1.10, (s, r)
+        else:  # no worse than measured (median 1.199, worst draw 2.034)
+            assert np.median(r) <= 1.25 and max(r) <= 2.1, (s, r)

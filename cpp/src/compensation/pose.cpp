@@ -363,6 +363,10 @@ bool commanded_for(const Model& cal, const VecQ& theta, const ChainFrames& at, c
   return false;
 }
 
+// A compensation moves a joint by a calibration's correction, well under a degree; beyond this the
+// solution is checked against the whole model's iteration.
+constexpr double kFarFromStartDeg = 5.0;
+
 // With joint-angle effects: Newton on the actual angles theta (the chain alone, its geometry and
 // thermal scale: a rigid robot's cost per step), then the commanded angles whose actual ones are
 // theta (commanded_for). F at those commanded angles is F(theta) - J r + O(r^2) with |r| at rounding:
@@ -372,10 +376,14 @@ bool commanded_for(const Model& cal, const VecQ& theta, const ChainFrames& at, c
 CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
                                        const CompensationOptions& opt, const EffectContext& ctx) {
   const bool effects = cal.has_compliance() || cal.has_joint_effects();
-  if (effects && opt.actual_angles) {
+  // (the rotation vector's rows are the angular velocity at the solution, which the bound below uses;
+  // the ABC rows are not: E^-1 grows toward their pole)
+  if (effects && opt.actual_angles && opt.residual == Residual::RotationVector) {
     DeviationEvaluator rigid(cal, desired, ctx, opt.residual, true);
     rigid.moments = cal.has_compliance();  // the torque at theta from the last FK pass
-    CompensationResult res = newton(rigid, q0_deg, opt);
+    // started at the start's actual angles (near singularities the commanded ones, a deflection away,
+    // may lead Newton to another solution than the whole model's iteration from them)
+    CompensationResult res = newton(rigid, joint_angles(cal, q0_deg * kDeg, ctx) / kDeg, opt);
     VecQ q, r;
     double reach = 0;
     for (int j = 0; j < 6; ++j) reach = std::max(reach, (rigid.frames.tool.translation() - rigid.frames.o[j]).norm());
@@ -383,14 +391,24 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     const double gain = std::hypot(reach * rigid.scale, 1 / kDeg);
     const double enough = (std::sqrt(opt.epsilon) - res.residual) / gain;
     if (res.status == CompStatus::Converged && commanded_for(cal, res.q_deg * kDeg, rigid.frames, ctx, 0.5 * enough, q, r)) {
-      // and the rounding of the actual angles q + d(q) themselves (a few ulps of each)
+      // and the rounding of the actual angles q + d(q) themselves (a few ulps of each; it also covers
+      // the rounding of F itself when the whole model evaluates it at q)
       const double ulps = 24 * std::numeric_limits<double>::epsilon() * (q.cwiseAbs().maxCoeff() + 1);
       const double r1 = r.cwiseAbs().sum() + ulps;
       res.position_error_mm += reach * rigid.scale * r1;
       res.orientation_error_deg += r1 / kDeg;
       res.residual += gain * r1;
       res.q_deg = q / kDeg;
-      if (res.residual * res.residual < opt.epsilon) return res;
+      const double moved = (res.q_deg - q0_deg).cwiseAbs().maxCoeff();
+      if (res.residual * res.residual < opt.epsilon && moved <= kFarFromStartDeg) return res;
+      if (res.residual * res.residual < opt.epsilon) {
+        // a solution far from the start (near a singularity either iteration may jump to another
+        // branch): the whole model's, when it converges nearer
+        DeviationEvaluator ev(cal, desired, ctx, opt.residual);
+        const CompensationResult whole = newton(ev, q0_deg, opt);
+        const bool nearer = (whole.q_deg - q0_deg).cwiseAbs().maxCoeff() < moved;
+        return whole.status == CompStatus::Converged && nearer ? whole : res;
+      }
     }
   }
   DeviationEvaluator ev(cal, desired, ctx, opt.residual);

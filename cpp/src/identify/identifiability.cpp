@@ -449,6 +449,21 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
   }
 }
 
+std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data, const IdentifyResult& res) {
+  const auto unseen = [&](int i) { return res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0; };
+  std::vector<int> frames;
+  // with measured orientations the frame measured is the tool frame (its target held at zero): the
+  // probe's mounting, position and rotation, is a frame too
+  if (data.orientation)
+    for (int i = L.tool; i < L.tool + 6; ++i)
+      if (!unseen(i)) frames.push_back(i);
+  for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
+    if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != kSetupNeverMeasured &&
+                          res.fixed_reason[i] != kProbeOnlySetup && !unseen(i)))
+      frames.push_back(i);
+  return frames;
+}
+
 void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
                         const IdentifyOptions& opt, IdentifyResult& res) {
   if (data.has_probe() || data.rows.empty()) return;
@@ -457,16 +472,17 @@ void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const 
     return (i >= L.targets && i < L.effects) || (data.orientation && i >= L.tool && i < L.tool + 6);
   };
   const Eigen::MatrixXd J = linearize(pm, data, x, opt.orientation_weight).jacobian;
-  std::vector<int> cols;
-  for (int i = 0; i < L.size; ++i)
-    if ((on_tool(i) || (i >= L.base && i < L.targets)) && !res.fixed[i] && J.col(i).norm() > 0) cols.push_back(i);
+  std::vector<int> cols;  // what the frames' fit moves (frame_columns), where the rows see it at all
+  for (int i : frame_columns(L, data, res))
+    if (J.col(i).norm() > 0) cols.push_back(i);
   // the smallest singular value of the unit-scaled columns: below the weak tolerance its direction is
   // held by one parameter, the largest part of it on the tool when the tool takes a fair share (the
   // depth of a reflector along the axis every orientation shares), else the largest; again until none
   while (!cols.empty()) {
     Eigen::MatrixXd A(J.rows(), static_cast<Eigen::Index>(cols.size()));
     for (size_t c = 0; c < cols.size(); ++c) A.col(static_cast<Eigen::Index>(c)) = J.col(cols[c]).normalized();
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinV);
+    // the full V: with fewer residuals than columns its last columns span the null space
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
     const Eigen::Index last = A.cols() - 1;
     const double sigma = last < static_cast<Eigen::Index>(svd.singularValues().size()) ? svd.singularValues()[last] : 0.0;
     if (sigma >= opt.weak_tolerance) break;

@@ -234,17 +234,7 @@ Vec3 target_of(const ParamLayout& L, const std::vector<double>& x, int t) {
 void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
                 std::vector<double>& x, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
-  std::vector<int> frames;
-  // with measured orientations the frame measured is the tool frame (its target held at zero): the
-  // probe's mounting, position and rotation, is a frame too
-  const auto unseen = [&](int i) { return res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0; };
-  if (data.orientation)
-    for (int i = L.tool; i < L.tool + 6; ++i)
-      if (!unseen(i)) frames.push_back(i);
-  for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
-    if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != kSetupNeverMeasured &&
-                          res.fixed_reason[i] != kProbeOnlySetup && !unseen(i)))
-      frames.push_back(i);
+  std::vector<int> frames = frame_columns(L, data, res);
   for (int i = L.stations; i < L.size; ++i)  // the probe stations are the campaign's frames too
     if (!res.fixed[i]) frames.push_back(i);
   if (L.drift >= 0)  // the instrument's own motion belongs to the frames

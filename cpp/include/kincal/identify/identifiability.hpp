@@ -43,6 +43,11 @@ inline constexpr const char* kUnseenFrame = "held at its start before the frames
 /// UR10's series B) and the model then predicts any other tool orientation wrong by depth x angle.
 /// Probe rows: nothing held (the stations' unknowns absorb the base frame exactly; the later analysis
 /// decides).
+/// The parameters the frames' fit (the first stage) moves: the tool frame with measured orientations,
+/// every placement measured by points (held or not: the first stage places it) and the targets not
+/// held; what hold_unseen_frames held excluded. (The probe stations and the drift come on top.)
+std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data, const IdentifyResult& res);
+
 void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
                         const IdentifyOptions& opt, IdentifyResult& res);
 

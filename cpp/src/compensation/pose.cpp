@@ -7,7 +7,6 @@
 
 #include <Eigen/LU>
 #include <cmath>
-#include <limits>
 
 #include "kincal/core/fastmath.hpp"
 #include "kincal/core/solve6.hpp"
@@ -134,21 +133,18 @@ struct DeviationEvaluator {
   const bool abc;      // the paper's ABC residual, else the rotation vector
   const bool effects;  // joint-angle effects (compliance, transmission error, backlash)
   const double scale;  // thermal expansion
-  bool moments = false;  // the frames' first mass moments too (fk_frames_moments; rigid only)
   Mat3 rd_t;           // R_desired^T (rotation vector)
   ChainFrames frames;
   MatQ dqd;  // d(actual joint angles)/dq, with effects
   AbcTrig tr;
   Vec3 phi;  // rotation vector of R_model R_desired^T (rad)
 
-  // rigid: the chain at the angles given, its joint-angle effects left out (they map commanded
-  // angles to actual ones: compensate_analytic inverts that map apart)
-  DeviationEvaluator(const Model& m, const Pose6& d, const EffectContext& c, Residual r, bool rigid = false)
+  DeviationEvaluator(const Model& m, const Pose6& d, const EffectContext& c, Residual r)
       : cal(m),
         desired(d),
         ctx(c),
         abc(r == Residual::Abc),
-        effects(!rigid && (m.has_compliance() || m.has_joint_effects())),
+        effects(m.has_compliance() || m.has_joint_effects()),
         scale(length_scale(m, c)) {
     if (!abc) rd_t = abc_to_rotation(d.abc).transpose();
   }
@@ -156,10 +152,7 @@ struct DeviationEvaluator {
   // F at q_deg; with derivative, d(actual joint angles)/dq as well (the Jacobian needs it)
   Vec6 deviation_at(const Vec6& q_deg, bool derivative = true) {
     const VecQ qr = q_deg * kDeg;
-    if (moments)  // (rigid: no joint-angle effects)
-      fk_frames_moments(cal, qr, frames);
-    else
-      fk_frames(cal, effects ? joint_angles(cal, qr, ctx, derivative ? &dqd : nullptr) : qr, frames);
+    fk_frames(cal, effects ? joint_angles(cal, qr, ctx, derivative ? &dqd : nullptr) : qr, frames);
     const Vec3 pos = scale * frames.tool.translation();
     if (abc) {
       tr = abc_trig(frames.tool.linear());
@@ -272,9 +265,11 @@ struct FactoredJacobian {
 // taken at the start and whenever the last step contracted |F| by less than opt.reuse_contraction;
 // the Jacobian changes little over the steps near a solution, so each reused step costs an
 // evaluation of F only. The stopping rule is the same |F|^2 < epsilon on the exact F.
-CompensationResult newton(DeviationEvaluator& ev, const Vec6& q0_deg, const CompensationOptions& opt) {
+CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
+                                       const CompensationOptions& opt, const EffectContext& ctx) {
   CompensationResult res;
   Vec6 q = q0_deg;
+  DeviationEvaluator ev(cal, desired, ctx, opt.residual);
   FactoredJacobian fac;
   Mat6r jf;
   Mat3 e;
@@ -322,97 +317,6 @@ CompensationResult newton(DeviationEvaluator& ev, const Vec6& q0_deg, const Comp
     if (!step.allFinite()) return finish(CompStatus::SingularJacobian);
     q -= step;
   }
-}
-
-// The commanded angles q (rad) whose actual ones a(q) = q + d(q) (joint_angles: deflection,
-// transmission error, backlash) are theta, d's derivative D = K dtau/dq + diag(offsets') about 1e-3 on
-// a real robot. Started where the linearisation at theta puts it, q = theta - (I + D)^-1 d(theta)
-// (its torque and D from the frames of the FK at theta, `at`, with their moments: no pass over the
-// chain), then q <- q + (I - D) (theta - a(q)) (what is left falls by |D|^2 a step, about 1e-6) until
-// |theta - a(q)|_1 <= enough, or it stops falling at rounding. r: theta - a(q) at the q returned.
-// False when it does not get there within 12 steps (D not small: the whole model's Newton instead).
-bool commanded_for(const Model& cal, const VecQ& theta, const ChainFrames& at, const EffectContext& ctx,
-                   double enough, VecQ& q, VecQ& r) {
-  VecQ tau, dd;
-  MatQ dtau;
-  Mat6 D = Mat6::Zero();  // six joints (compensate's): fixed sizes
-  Vec6 d = Vec6::Zero();
-  if (cal.has_compliance()) {
-    gravity_torque_from(cal, at, tau, &dtau);
-    for (int j = 0; j < 6; ++j) {
-      d[j] = cal.compliance(j) * tau[j];
-      D.row(j) = cal.compliance(j) * dtau.row(j);
-    }
-  }
-  if (cal.has_joint_effects()) {
-    d += joint_offsets(cal, theta, ctx, &dd);
-    D.diagonal() += dd;
-  }
-  const Vec6 Dd = D * d;
-  q = theta - (d - Dd + D * Dd);  // (I + D)^-1 d to |D|^3
-  double last = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 12; ++k) {
-    r = theta - joint_angles(cal, q, ctx);
-    const double size = r.cwiseAbs().sum();
-    if (!std::isfinite(size)) return false;
-    if (size <= enough || (size >= 0.5 * last && size < 1e-13)) return true;
-    last = size;
-    const Vec6 r6 = r;
-    q += r6 - D * r6;
-  }
-  return false;
-}
-
-// A compensation moves a joint by a calibration's correction, well under a degree; beyond this the
-// solution is checked against the whole model's iteration (the branches the tests saw apart: 525 deg).
-constexpr double kFarFromStartDeg = 30.0;
-
-// With joint-angle effects: Newton on the actual angles theta (the chain alone, its geometry and
-// thermal scale: a rigid robot's cost per step), then the commanded angles whose actual ones are
-// theta (commanded_for). F at those commanded angles is F(theta) - J r + O(r^2) with |r| at rounding:
-// |F| is reported as |F(theta)| plus the bound |J r| <= (reach |r|_1, |r|_1) of what r leaves. The same
-// solution as Newton on the whole model (to 1e-9 deg, test_compensation_pose); that iteration where
-// this one fails.
-CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
-                                       const CompensationOptions& opt, const EffectContext& ctx) {
-  const bool effects = cal.has_compliance() || cal.has_joint_effects();
-  // (the rotation vector's rows are the angular velocity at the solution, which the bound below uses;
-  // the ABC rows are not: E^-1 grows toward their pole)
-  if (effects && opt.actual_angles && opt.residual == Residual::RotationVector) {
-    DeviationEvaluator rigid(cal, desired, ctx, opt.residual, true);
-    rigid.moments = cal.has_compliance();  // the torque at theta from the last FK pass
-    // started at the start's actual angles (near singularities the commanded ones, a deflection away,
-    // may lead Newton to another solution than the whole model's iteration from them)
-    CompensationResult res = newton(rigid, joint_angles(cal, q0_deg * kDeg, ctx) / kDeg, opt);
-    VecQ q, r;
-    double reach = 0;
-    for (int j = 0; j < 6; ++j) reach = std::max(reach, (rigid.frames.tool.translation() - rigid.frames.o[j]).norm());
-    // what r may leave: |F(theta)| + |J r| within sqrt(epsilon), |J r| <= hypot(reach, 1 / kDeg) |r|_1
-    const double gain = std::hypot(reach * rigid.scale, 1 / kDeg);
-    const double enough = (std::sqrt(opt.epsilon) - res.residual) / gain;
-    if (res.status == CompStatus::Converged && commanded_for(cal, res.q_deg * kDeg, rigid.frames, ctx, 0.5 * enough, q, r)) {
-      // and the rounding of the actual angles q + d(q) themselves (a few ulps of each; it also covers
-      // the rounding of F itself when the whole model evaluates it at q)
-      const double ulps = 24 * std::numeric_limits<double>::epsilon() * (q.cwiseAbs().maxCoeff() + 1);
-      const double r1 = r.cwiseAbs().sum() + ulps;
-      res.position_error_mm += reach * rigid.scale * r1;
-      res.orientation_error_deg += r1 / kDeg;
-      res.residual += gain * r1;
-      res.q_deg = q / kDeg;
-      const double moved = (res.q_deg - q0_deg).cwiseAbs().maxCoeff();
-      if (res.residual * res.residual < opt.epsilon && moved <= kFarFromStartDeg) return res;
-      if (res.residual * res.residual < opt.epsilon) {
-        // a solution far from the start (near a singularity either iteration may jump to another
-        // branch): the whole model's, when it converges nearer
-        DeviationEvaluator ev(cal, desired, ctx, opt.residual);
-        const CompensationResult whole = newton(ev, q0_deg, opt);
-        const bool nearer = (whole.q_deg - q0_deg).cwiseAbs().maxCoeff() < moved;
-        return whole.status == CompStatus::Converged && nearer ? whole : res;
-      }
-    }
-  }
-  DeviationEvaluator ev(cal, desired, ctx, opt.residual);
-  return newton(ev, q0_deg, opt);
 }
 
 }  // namespace

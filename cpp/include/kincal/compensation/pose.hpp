@@ -8,9 +8,7 @@
 // mm^2 + deg^2 (for the rotation vector: the squared rotation angle in deg^2). J is either the
 // paper's finite-difference Jacobian (eq. 7, step delta in degrees of the machine coordinates) or
 // the analytic one (default): the geometric Jacobian of the whole model (compliance, transmission
-// error, backlash, thermal expansion) mapped to the residual's rates. With the joint-angle effects
-// (compliance, transmission error, backlash) the analytic iteration runs on the actual joint angles,
-// a rigid chain's, and the commanded angles follow by a fixed point (`actual_angles`). It reuses
+// error, backlash, thermal expansion) mapped to the residual's rates. The analytic iteration reuses
 // its last Jacobian for a step while the steps shrink |F| tenfold (a chord step: F only, no Jacobian
 // and no factorisation; `reuse_contraction`), corrects its first step by the step's second-order term
 // (`second_order`), and takes the rotation vector's rates as the angular velocity (exact at the
@@ -45,14 +43,6 @@ struct CompensationOptions {
   /// 1e-3..1e-2, and one fresh step more converges. Skipped where the correction is over half the step,
   /// and with the ABC residual.
   bool second_order = true;
-  /// With joint-angle effects (compliance, transmission error, backlash) and the rotation-vector
-  /// residual: the analytic iteration runs on the actual joint angles (the chain alone, a rigid
-  /// robot's cost per step) and the commanded angles follow from them by a fixed point (about 1e-6
-  /// per step on a real compliance); its residual and errors are then bounds (F at the actual angles
-  /// plus what the fixed point and the rounding leave, about 1e-10 mm). false: Newton on the whole
-  /// model, its Jacobian through the effects' derivative. The same solutions (to 1e-8 deg); the whole
-  /// model's iteration where the first fails.
-  bool actual_angles = true;
 };
 
 enum class CompStatus { Converged, NotConverged, SingularJacobian, OrientationSingular, NotSixJoints };
@@ -61,10 +51,8 @@ const char* to_string(CompStatus s);
 struct CompensationResult {
   Vec6 q_deg;
   int iterations = 0;        ///< Newton updates made
-  /// |F| at q_deg (mm and degrees mixed as in eq. 9), |dXYZ| and |dABC| at q_deg; upper bounds of
-  /// them with CompensationOptions::actual_angles' iteration
-  double residual = 0;
-  double position_error_mm = 0, orientation_error_deg = 0;
+  double residual = 0;       ///< |F| at q_deg (mm and degrees mixed as in eq. 9)
+  double position_error_mm = 0, orientation_error_deg = 0;  ///< |dXYZ| and |dABC| at q_deg
   CompStatus status = CompStatus::NotConverged;
 };
 

@@ -83,21 +83,6 @@ void fk_frames(const Model& m, const VecQ& q, ChainFrames& f) {
   f.tool.makeAffine();
 }
 
-void fk_frames_moments(const Model& m, const VecQ& q, ChainFrames& f) {
-  Mat3 r;
-  Vec3 t;
-  walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
-    f.z[j] = rj.col(2);
-    f.o[j] = tj;
-    const Model::Link& l = m.link(j);
-    f.mc[j] = rj * l.mc + l.m * tj;  // first moment about the base origin
-  });
-  f.n = m.dof();
-  f.tool.linear() = r;
-  f.tool.translation() = t;
-  f.tool.makeAffine();
-}
-
 void jacobian_from(const ChainFrames& f, Jac& jac) {
   const Vec3 t = f.tool.translation();
   jac.resize(6, f.n);
@@ -153,44 +138,49 @@ void gravity_torque_local(const Model& m, const double* q, VecQ& tau) {
 
 }  // namespace
 
-void gravity_torque_from(const Model& m, const ChainFrames& f, VecQ& tau, MatQ* dtau) {
-  const int n = f.n;
+void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
+  if (!dtau) {
+    gravity_torque_local(m, q.data(), tau);
+    return;
+  }
+  const int n = m.dof();
+  std::array<Vec3, kMaxJoints> z, o, mc;
+  std::array<double, kMaxJoints> mass;
+  Mat3 r;
+  Vec3 t;
+  walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
+    z[j] = rj.col(2);
+    o[j] = tj;
+    const Model::Link& l = m.link(j);
+    mass[j] = l.m;
+    mc[j] = rj * l.mc + l.m * tj;  // first moment about the base origin
+  });
   // r_j = sum_{k>=j} m_k (c_k - o_j): the moment arm of everything joint j carries.
   std::array<Vec3, kMaxJoints> arm;
   Vec3 s = Vec3::Zero();
   double msum = 0;
   for (int j = n - 1; j >= 0; --j) {
-    s += f.mc[j];
-    msum += m.link(j).m;
-    arm[j] = s - msum * f.o[j];
+    s += mc[j];
+    msum += mass[j];
+    arm[j] = s - msum * o[j];
   }
   const Vec3& g = m.gravity();
   tau.resize(n);
   // torque about axis z_j of the weight: z_j . (arm_j x g)  [kg mm m/s^2 = N mm]
-  for (int j = 0; j < n; ++j) tau[j] = f.z[j].dot(arm[j].cross(g));
+  for (int j = 0; j < n; ++j) tau[j] = z[j].dot(arm[j].cross(g));
   if (dtau) {
     // i <= j: the whole sub-chain rotates about z_i, d tau_j / d q_i = g . (z_i x (z_j x arm_j));
     // i > j: only the part beyond joint i moves, g . (z_j x (z_i x arm_i)). Both are u_k . h_l with
     // u_k = z_k x arm_k, h_l = g x z_l, k = max(i, j), l = min(i, j).
     std::array<Vec3, kMaxJoints> u, h;
     for (int j = 0; j < n; ++j) {
-      u[j] = f.z[j].cross(arm[j]);
-      h[j] = g.cross(f.z[j]);
+      u[j] = z[j].cross(arm[j]);
+      h[j] = g.cross(z[j]);
     }
     dtau->resize(n, n);
     for (int i = 0; i < n; ++i)  // column by column (column-major)
       for (int j = 0; j < n; ++j) (*dtau)(j, i) = i <= j ? u[j].dot(h[i]) : u[i].dot(h[j]);
   }
-}
-
-void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
-  if (!dtau) {
-    gravity_torque_local(m, q.data(), tau);
-    return;
-  }
-  ChainFrames f;
-  fk_frames_moments(m, q, f);
-  gravity_torque_from(m, f, tau, dtau);
 }
 
 VecQ deflected(const Model& m, const VecQ& q, MatQ* dqd) {
@@ -230,27 +220,21 @@ void check_context(const Model& m, const EffectContext& ctx, const std::string& 
     throw InputError(who + "the model has thermal expansion: the temperature is needed (temperature_c)");
 }
 
-VecQ joint_offsets(const Model& m, const VecQ& q, const EffectContext& ctx, VecQ* derivative) {
-  VecQ out = VecQ::Zero(m.dof());
-  if (derivative) *derivative = VecQ::Zero(m.dof());
-  double b[128], db[128];
-  for (const EffectValue& ev : m.joint_effects()) {
-    const int j = ev.effect.joint;
-    joint_basis(ev.effect, q[j], ev.effect.kind().reads_dir() ? ctx.dir[j] : 0.0, b, derivative ? db : nullptr);
-    for (size_t k = 0; k < ev.p.size(); ++k) {
-      out[j] += ev.p[k] * b[k];
-      if (derivative) (*derivative)[j] += ev.p[k] * db[k];
-    }
-  }
-  return out;
-}
-
 VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ* dqd) {
   VecQ out = deflected(m, q, dqd);
   if (!m.has_joint_effects()) return out;
-  VecQ d;
-  out += joint_offsets(m, q, ctx, dqd ? &d : nullptr);
-  if (dqd) dqd->diagonal() += d;
+  double b[128], db[128];
+  for (const EffectValue& ev : m.joint_effects()) {
+    const int j = ev.effect.joint;
+    joint_basis(ev.effect, q[j], ev.effect.kind().reads_dir() ? ctx.dir[j] : 0.0, b, dqd ? db : nullptr);
+    double d = 0, dd = 0;
+    for (size_t k = 0; k < ev.p.size(); ++k) {
+      d += ev.p[k] * b[k];
+      if (dqd) dd += ev.p[k] * db[k];
+    }
+    out[j] += d;
+    if (dqd) (*dqd)(j, j) += dd;
+  }
   return out;
 }
 

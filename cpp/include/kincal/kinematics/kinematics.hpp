@@ -27,22 +27,14 @@ inline Mat3 axis_rotation(const Vec3& k, double q) {
 Eigen::Isometry3d fk(const Model& m, const VecQ& q);
 
 /// The joint frames of one FK pass: axis z_j and origin o_j of every joint (base frame) and the tool.
-/// mc: every link's first mass moment about the base origin, m_j c_j (kg mm, base frame).
 struct ChainFrames {
   std::array<Vec3, kMaxJoints> z, o;
-  std::array<Vec3, kMaxJoints> mc;  ///< filled by fk_frames_moments only
   Eigen::Isometry3d tool;
   int n = 0;
 };
 
 /// FK keeping the joint frames, so that the Jacobian can follow only when it is needed.
 void fk_frames(const Model& m, const VecQ& q, ChainFrames& f);
-/// The same with the links' first mass moments (gravity_torque_from reads them).
-void fk_frames_moments(const Model& m, const VecQ& q, ChainFrames& f);
-
-/// The gravity torque (N mm) and, when dtau is not null, dtau/dq at the angles of frames filled with
-/// their moments: what gravity_torque gives there, from an FK pass already made.
-void gravity_torque_from(const Model& m, const ChainFrames& f, VecQ& tau, MatQ* dtau = nullptr);
 
 /// The geometric Jacobian (as fk_jacobian) from the frames of fk_frames.
 void jacobian_from(const ChainFrames& f, Jac& jac);
@@ -73,9 +65,6 @@ void check_context(const Model& m, const EffectContext& ctx, const std::string& 
 /// The angles the joints stand at for commanded q (rad): q + K tau(q) + transmission error(q) +
 /// backlash * dir; with dqd their derivative with respect to q. The context must suffice.
 VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ* dqd = nullptr);
-/// joint_angles' part besides the deflection (transmission error, backlash): their sum on each joint
-/// (rad) and, with derivative, its derivative along the joint's own angle (they act joint by joint).
-VecQ joint_offsets(const Model& m, const VecQ& q, const EffectContext& ctx, VecQ* derivative = nullptr);
 
 /// The factor every length of the robot scales by (thermal expansion; 1 without it).
 inline double length_scale(const Model& m, const EffectContext& ctx) {

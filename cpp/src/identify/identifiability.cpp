@@ -9,7 +9,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -446,67 +445,6 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
     auto it = std::find(L.names.begin(), L.names.end(), name);
     if (it == L.names.end()) throw InputError("identify: no parameter named '" + name + "'");
     res.fix(static_cast<int>(it - L.names.begin()), "held by request");
-  }
-}
-
-std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data, const IdentifyResult& res) {
-  const auto unseen = [&](int i) { return res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0; };
-  std::vector<int> frames;
-  // with measured orientations the frame measured is the tool frame (its target held at zero): the
-  // probe's mounting, position and rotation, is a frame too
-  if (data.orientation)
-    for (int i = L.tool; i < L.tool + 6; ++i)
-      if (!unseen(i)) frames.push_back(i);
-  for (int i = L.base; i < L.effects; ++i)  // the placements even when held, but those never measured
-    if (!res.fixed[i] || (i < L.targets && res.fixed_reason[i] != kSetupNeverMeasured &&
-                          res.fixed_reason[i] != kProbeOnlySetup && !unseen(i)))
-      frames.push_back(i);
-  return frames;
-}
-
-void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
-                        const IdentifyOptions& opt, IdentifyResult& res) {
-  if (data.has_probe() || data.rows.empty()) return;
-  const ParamLayout& L = res.layout;
-  const auto on_tool = [&](int i) {  // a target's offset, or the tool frame a 6-D row measures
-    return (i >= L.targets && i < L.effects) || (data.orientation && i >= L.tool && i < L.tool + 6);
-  };
-  const Eigen::MatrixXd J = linearize(pm, data, x, opt.orientation_weight).jacobian;
-  std::vector<int> cols;  // what the frames' fit moves (frame_columns), where the rows see it at all
-  for (int i : frame_columns(L, data, res))
-    if (J.col(i).norm() > 0) cols.push_back(i);
-  // the smallest singular value of the unit-scaled columns: below the weak tolerance its direction is
-  // held by one parameter, the largest part of it on the tool when the tool takes a fair share (the
-  // depth of a reflector along the axis every orientation shares), else the largest; again until none
-  while (!cols.empty()) {
-    Eigen::MatrixXd A(J.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (size_t c = 0; c < cols.size(); ++c) A.col(static_cast<Eigen::Index>(c)) = J.col(cols[c]).normalized();
-    // the full V: with fewer residuals than columns its last columns span the null space
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
-    const Eigen::Index last = A.cols() - 1;
-    const double sigma = last < static_cast<Eigen::Index>(svd.singularValues().size()) ? svd.singularValues()[last] : 0.0;
-    if (sigma >= opt.weak_tolerance) break;
-    const Eigen::VectorXd v = svd.matrixV().col(last);
-    Eigen::Index pick = 0, pick_tool = -1;
-    for (Eigen::Index c = 0; c < v.size(); ++c) {
-      if (std::abs(v[c]) > std::abs(v[pick])) pick = c;
-      if (on_tool(cols[static_cast<size_t>(c)]) && (pick_tool < 0 || std::abs(v[c]) > std::abs(v[pick_tool]))) pick_tool = c;
-    }
-    if (pick_tool >= 0 && std::abs(v[pick_tool]) >= 0.5 * std::abs(v[pick])) pick = pick_tool;
-    std::string with;  // the direction in the parameters' units, per unit of the one held
-    const auto unit_step = [&](Eigen::Index c) { return v[c] / J.col(cols[static_cast<size_t>(c)]).norm(); };
-    for (Eigen::Index c = 0; c < v.size(); ++c)
-      if (c != pick && std::abs(v[c]) >= 0.2) {
-        char part[96];
-        std::snprintf(part, sizeof part, "%s%+.3g %s", with.empty() ? "" : ", ", unit_step(c) / unit_step(pick),
-                      L.names[cols[static_cast<size_t>(c)]].c_str());
-        with += part;
-      }
-    char buf[320];
-    std::snprintf(buf, sizeof buf, "%s: these rows see it only through %.1e of its effect, moving with %s (do all the tool's "
-                  "orientations share an axis?)", kUnseenFrame, sigma, with.empty() ? "nothing else" : with.c_str());
-    res.fix(cols[static_cast<size_t>(pick)], buf);
-    cols.erase(cols.begin() + pick);
   }
 }
 

@@ -128,7 +128,7 @@ std::vector<int> free_parameters(const MeasurementSet& data, const IdentifyResul
   size_t unconstrained = 0, unseen = 0;  // the frames held because these rows do not see them count as free here
   for (int i = 0; i < res.layout.size; ++i) {
     if (!res.fixed[i]) free_idx.push_back(i), unconstrained += std::isfinite(sd[i]) ? 0 : 1;
-    if (res.fixed[i] && res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0) ++unseen;
+    if (held_unseen(res, i)) ++unseen;
   }
   const size_t n_free = free_idx.size() + unseen;
   unconstrained += unseen;

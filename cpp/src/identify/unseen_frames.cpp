@@ -14,7 +14,7 @@ namespace kincal {
 using detail::linearize;
 
 std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data, const IdentifyResult& res) {
-  const auto unseen = [&](int i) { return res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0; };
+  const auto unseen = [&](int i) { return held_unseen(res, i); };
   std::vector<int> frames;
   // with measured orientations the frame measured is the tool frame (its target held at zero): the
   // probe's mounting, position and rotation, is a frame too

@@ -30,6 +30,10 @@ inline constexpr const char* kSetupNeverMeasured = "setup never measured";
 inline constexpr const char* kProbeOnlySetup = "probe rows only: the stations' unknowns absorb the base frame";
 /// The start of the reason a frame's parameter is held before the frames' fit (hold_unseen_frames).
 inline constexpr const char* kUnseenFrame = "held at its start before the frames' fit";
+/// Whether parameter i was held by hold_unseen_frames.
+inline bool held_unseen(const IdentifyResult& res, int i) {
+  return res.fixed[i] && res.fixed_reason[i].rfind(kUnseenFrame, 0) == 0;
+}
 
 /// Before the frames' fit (the first stage, without priors): while the smallest singular value of the
 /// unit-scaled columns of the base placements, target offsets and (6-D rows) tool frame on these

@@ -7,6 +7,7 @@
 #include <optional>
 #include <tuple>
 
+#include "kincal/identify/identifiability.hpp"
 #include "kincal/identify/identify.hpp"
 #include "kincal/identify/simulate.hpp"
 #include "kincal/model/model.hpp"
@@ -366,6 +367,15 @@ void define_identify(py::module_& m) {
                                return a;
                              })
       .def_property_readonly("fixed_reason", [](const PyIdentifyResult& r) { return r.r.fixed_reason; })
+      .def_property_readonly("held_unseen",
+                             [](const PyIdentifyResult& r) {
+                               py::array_t<bool> a(r.r.fixed.size());
+                               for (size_t i = 0; i < r.r.fixed.size(); ++i)
+                                 a.mutable_at(i) = held_unseen(r.r, static_cast<int>(i));
+                               return a;
+                             },
+                             "held at its start because these rows do not see it (a frame's direction every "
+                             "tool orientation shares); counted as free by the core's too-few-points refusal")
       .def_property_readonly("at_prior",
                              [](const PyIdentifyResult& r) {
                                py::array_t<bool> a(r.r.layout.size);

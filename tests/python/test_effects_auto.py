@@ -151,3 +151,41 @@ def test_diagnose_on_task_data_holds_the_wrist_at_its_prior(tmp_path):
     wrist = [n for n in held if n.startswith(("joint5.", "joint6."))]
     assert len(wrist) >= 4, held
     assert kincal.load_robot(str(tmp_path / "d" / "model.json")).identified
+
+
+def test_the_choice_offers_compliance_exactly_where_the_core_fits_it(robots):
+    """The search offers a candidate only where the core will fit the model with it (the core's
+    refusal: more free parameters without a prior, frames held as unseen included, than measured
+    points; as many is fitted). Joint compliance with the model's masses adds only the compliances of
+    the joints these poses load (the core holds the others), and its admission counts them so. Truth:
+    the kr500 with default_truth (seed 3) and 0.003 deg/kN m compliance, one reflector, 0.02 mm noise;
+    campaigns of 7-13 configurations, one point each, ten draws: the search agrees with the core on
+    every one, and the draws reach both a refusal and a fit with exactly as many points as such
+    parameters (the rule's edge)."""
+    from kincal.calibration.effect_choice import SerialProblem, candidates
+    from kincal.calibration.fitting import FitOptions, folds
+    kr500 = robots["kr500"]
+    truth = ident.default_truth(kr500, seed=3, compliance=0.003)
+    fit = FitOptions()
+    jc = JointCompliance("masses")
+    refused = edge = 0
+    for draw in range(10):
+        for n in range(7, 14):
+            data = ident.simulate(truth, n, seed=100 * draw + n, targets=1)
+            problem = SerialProblem(kr500, data, folds(data, 3, 0), fit, candidates(kr500, data)[0])
+            try:
+                problem.linearise([])
+            except ValueError:  # the geometry alone is refused: nothing to offer
+                continue
+            try:
+                fit.fit(kr500, data, ident.effect_choice.expand([jc], kr500)[0], gravity="masses")
+                fits = True
+            except ValueError as e:
+                assert "too few" in str(e)
+                fits = False
+            assert problem.admits([], jc) == fits, (draw, n, fits)
+            res = problem.fits[0][1]
+            free = (np.asarray(res.fixed) == 0) & ~np.isfinite(np.asarray(res.prior_sd))
+            refused += not fits
+            edge += fits and int(free.sum()) + problem.size(jc) == n
+    assert refused and edge, (refused, edge)

@@ -59,6 +59,19 @@ def applicable_joints(robot: Robot, kind: _core.EffectKind) -> list[int]:
     return list(range(1, robot.dof + 1))
 
 
+def loaded_joints(robot: Robot, q_deg: Any, loaded: Sequence[int]) -> list[int]:
+    """Of the gravity-loaded joints ``loaded`` (from 1), those whose compliance the core identifies on
+    these poses with the model's masses: the largest gravity torque over the poses at least the
+    core's min_torque_share of the largest joint's (identifiability's fix_unloaded_compliances)."""
+    q = np.atleast_2d(np.asarray(q_deg, dtype=float))
+    if not len(q):
+        return []
+    tmax = np.max(np.abs([_core.gravity_torque(robot, row, False)[0] for row in q]), axis=0)
+    top = float(np.max(tmax))
+    share = _core.IdentifyOptions().min_torque_share
+    return [j for j in loaded if top > 0 and tmax[j - 1] >= share * top]
+
+
 def _needs_column(kind: _core.EffectKind) -> str:
     """The measurement-set key of the column an effect kind reads ('' when none)."""
     return "dir" if kind.needs == "dir" else kind.needs

@@ -32,7 +32,7 @@ from ..stats import stepwise as engine
 from .._core import Robot
 from .candidates import (MAX_MAP_ORDER as MAX_MAP_ORDER, Candidate as Candidate, JointCompliance as JointCompliance,
                          applicable_joints as applicable_joints, candidates as candidates, check_data as check_data,
-                         expand as expand)
+                         expand as expand, loaded_joints)
 from .fitting import FitOptions, folds as grouped_folds, point_errors, subset
 from .linearisation import evaluate as evaluate, equations, prior_rows as _prior_rows
 from ..stats.robust_scores import loss_threshold, robust_noise, robust_weights
@@ -241,6 +241,7 @@ class SerialProblem:
         self.point_dims = 3
         #: a residual below this (mm per coordinate) is the computation's, not the data's: noise-free data
         self.resolution = 1e-6
+        self._loaded: Optional[int] = None  # how many compliances the model's masses let the core fit (size())
 
     def spec(self, effects: Sequence[Candidate]) -> Spec:
         pen = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]
@@ -322,22 +323,29 @@ class SerialProblem:
         return [block == b for b in range(VARIANT_BLOCKS)]
 
     def size(self, effect: Candidate) -> int:
-        """How many parameters an effect adds (none of them with a prior by default)."""
+        """How many free parameters an effect adds (none of them with a prior by default): joint
+        compliance with the model's masses on the joints these rows load (the core holds the compliance
+        of a joint below its share min_torque_share of the largest gravity torque)."""
         if isinstance(effect, JointCompliance):
             layout = _core.PointModel(self.robot, 1, fit_gravity=effect.gravity == "fit").layout
+            if effect.gravity == "masses":
+                if self._loaded is None:
+                    self._loaded = len(loaded_joints(self.robot, self.data["q_deg"], layout.loaded))
+                return self._loaded
             return sum(p.kind in ("compliance", "gravity_moment") for p in layout.parameters)
         return int(effect.size)
 
     def admits(self, effects: Sequence[Candidate], cand: Candidate) -> bool:
-        """Whether the model with ``cand`` added keeps no more parameters without a prior than the data
-        have points (the core refuses such a fit): the starting fit's and every added effect's."""
+        """Whether the core fits the model with ``cand`` added (its rule, fit_setup's free_parameters:
+        no more free parameters without a prior, frames held as unseen included, than the data have
+        points): the starting fit's and every added effect's."""
         if not self.fits:
             return True
         start_effects, res = self.fits[0]
         free = np.asarray(res.fixed) == 0
-        unconstrained = int(np.sum(free & ~np.isfinite(np.asarray(res.prior_sd))))
+        unconstrained = int(np.sum(free & ~np.isfinite(np.asarray(res.prior_sd)))) + int(np.sum(res.held_unseen))
         added = sum(self.size(e) for e in list(effects)[len(start_effects):]) + self.size(cand)
-        return unconstrained + added < len(self.data["pose"])
+        return unconstrained + added <= len(self.data["pose"])
 
     def score_folds(self, cand: Candidate) -> Optional[list[BoolArray]]:
         """The folds on which a candidate must also gain (besides the configurations'): for a periodic

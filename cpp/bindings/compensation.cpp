@@ -89,7 +89,9 @@ NativeOptions native_options(const std::vector<double>& program_tool, const std:
       std::optional<double> temp, const std::vector<double>&initial, bool keep
 #define KINCAL_COMP_OPTIONS options(comp, instr, fd, delta, eps, it, cs, residual, temp, initial, keep)
 
-void define_compensation(py::module_& m) {
+namespace {
+
+void define_compensation_poses(py::module_& m) {
   m.def("parse_initial_direction", &parse_initial_direction, py::arg("text"),
         "--initial-direction's text as signs (+1 or -1, one for all joints or one each; empty: none)");
   m.def(
@@ -136,6 +138,9 @@ void define_compensation(py::module_& m) {
       py::arg("chunk_bytes") = kProgramChunkBytes,
       "Compensates a pose program file (CSV or G-code) into a joint program file, atomically, a chunk of "
       "chunk_bytes at a time; keep_poses=False: the result without per-pose arrays (bounded memory)");
+}
+
+void define_compensation_programs(py::module_& m) {
   m.def(
       "compensate_to_controller",
       [](const Robot& r, const std::vector<std::string>& in, const std::string& out, KINCAL_COMP_PARAMS,
@@ -225,6 +230,9 @@ void define_compensation(py::module_& m) {
       "G-code program written as CSV or G-code joints is read and written a chunk of chunk_bytes at a time; with "
       "keep_poses=False its result has no per-pose arrays (poses, iterations_min/max/total and residual_max say "
       "what the summary needs), so that a program of any length is compensated in bounded memory");
+}
+
+void define_compensation_stream(py::module_& m) {
   m.def(
       "stream_lines",
       [](const Robot& r, const std::vector<std::string>& lines, bool instr, std::optional<double> temp,
@@ -238,4 +246,12 @@ void define_compensation(py::module_& m) {
       py::arg("robot"), py::arg("lines"), py::arg("instrument") = false, py::arg("temperature_c") = py::none(),
       py::arg("initial_direction") = std::vector<double>{}, py::arg("residual") = "rotation_vector",
       "The streaming corrector on a list of lines (as kincal-compensate --stream)");
+}
+
+}  // namespace
+
+void define_compensation(py::module_& m) {
+  define_compensation_poses(m);
+  define_compensation_programs(m);
+  define_compensation_stream(m);
 }

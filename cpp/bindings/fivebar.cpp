@@ -61,7 +61,9 @@ std::vector<FiveBarPoint> points_from(const py::dict& d) {
 
 }  // namespace
 
-void define_fivebar(py::module_& m) {
+namespace {
+
+void define_fivebar_mechanism(py::module_& m) {
   py::class_<FiveBar>(m, "FiveBar", "The hidden robot: a 5-bar with concurrent fixed joints (lengths in mm)")
       .def(py::init([](double a, double b, double c, double d, int assembly, int working1, int working2) {
              return FiveBar{a, b, c, d, assembly, working1, working2};
@@ -141,6 +143,9 @@ void define_fivebar(py::module_& m) {
         return rows_of(fivebar_commands(f, e, pts, [](size_t i) { return "row " + std::to_string(i + 1); }));
       },
       py::arg("model"), py::arg("matrix"), py::arg("xy"), "joint commands (deg) for desired points, in order");
+}
+
+void define_fivebar_files(py::module_& m) {
   m.def(
       "fivebar_command_file",
       [](const FiveBar& f, const ErrorMatrix* e, const std::string& path) {
@@ -215,4 +220,11 @@ void define_fivebar(py::module_& m) {
         return points_to(sixbar_campaign(s, f, e, t, noise, seed));
       },
       py::arg("truth"), py::arg("model"), py::arg("matrix"), py::arg("targets"), py::arg("noise_mm"), py::arg("seed"));
+}
+
+}  // namespace
+
+void define_fivebar(py::module_& m) {
+  define_fivebar_mechanism(m);
+  define_fivebar_files(m);
 }

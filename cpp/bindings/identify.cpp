@@ -156,9 +156,8 @@ IdentifyOptions core_options(IdentifyOptions o, const Model& model) {
   return o;
 }
 
-}  // namespace
 
-void define_identify(py::module_& m) {
+void define_identify_functions(py::module_& m) {
   m.def("default_prior_sd", &default_prior_sd,
         "The priors' default standard deviations by kind, in the core's units (mm, rad): the one home of "
         "these defaults");
@@ -223,7 +222,9 @@ void define_identify(py::module_& m) {
       .def_readonly("index", &Parameter::index, "position in the parameter vector")
       .def_readonly("effect", &Parameter::effect, "the effect it belongs to (None for the others)")
       .def("__repr__", [](const Parameter& p) { return "<Parameter " + std::to_string(p.index) + " " + p.name + ">"; });
+}
 
+void define_param_layout(py::module_& m) {
   py::class_<ParamLayout> layout(m, "ParamLayout", "Layout of the identification parameter vector");
   // its sizes, and the offsets of the parts of the vector in their order
   const std::tuple<const char*, int ParamLayout::*, const char*> sizes_and_offsets[] = {
@@ -273,7 +274,9 @@ void define_identify(py::module_& m) {
           py::arg("kind"), py::arg("joint") = -1,
           "indices of the parameters of a kind (and of one joint, from 1, when joint >= 0)")
       .def("__len__", [](const ParamLayout& L) { return L.size; });
+}
 
+void define_identify_options(py::module_& m) {
   const IdentifyOptions def;
   py::class_<IdentifyOptions>(m, "IdentifyOptions", "Options of identify()")
       .def(py::init([](bool compliance, const std::string& loss, double loss_scale_mm, int max_iterations,
@@ -346,7 +349,9 @@ void define_identify(py::module_& m) {
       .def_readwrite("penalties", &IdentifyOptions::penalties,
                      "ridge penalties (parameter name, weight in mm per unit of the parameter), e.g. a joint_map's\n"
                      "smoothness penalty (assign a whole list)");
+}
 
+void define_identify_result(py::module_& m) {
   py::class_<PyIdentifyResult>(m, "IdentifyResult", "What identify() found")
       .def_property_readonly("robot", [](const PyIdentifyResult& r) { return r.robot; },
                              "nominal + calibrated (with the identified effects)")
@@ -441,7 +446,9 @@ void define_identify(py::module_& m) {
             return self.attr(key.c_str());
           },
           py::arg("key"), "the attribute of that name (the dict access of earlier versions)");
+}
 
+void define_identify_call(py::module_& m) {
   m.def(
       "identify",
       [](const Robot& robot, const py::dict& d, const IdentifyOptions& options, py::object progress,
@@ -460,5 +467,14 @@ void define_identify(py::module_& m) {
       "Identify from measurements, starting from the nominal model (or from the calibrated one: then\n"
       "the parameters are corrections to it, e.g. to refit only the base frame and targets). progress:\n"
       "called with (iteration, cost).");
+}
 
+}  // namespace
+
+void define_identify(py::module_& m) {
+  define_identify_functions(m);
+  define_param_layout(m);
+  define_identify_options(m);
+  define_identify_result(m);
+  define_identify_call(m);
 }

@@ -45,7 +45,9 @@ void check_context_arrays(const Model& m, const RowMatrix& q, const std::optiona
 
 }  // namespace
 
-void define_kinematics(py::module_& m) {
+namespace {
+
+void define_kinematics_frames(py::module_& m) {
   m.def(
       "abc_to_rotation", [](const Eigen::Vector3d& abc) { return Eigen::Matrix3d(abc_to_rotation(abc)); },
       py::arg("abc_deg"), "Rotation matrix of KUKA ABC angles (deg): Rz(a) Ry(b) Rx(c)");
@@ -121,6 +123,9 @@ void define_kinematics(py::module_& m) {
       py::arg("robot"), py::arg("q_deg"), py::arg("calibrated") = true, py::arg("dir") = py::none(),
       py::arg("temperature_c") = py::none(),
       "6 x dof geometric Jacobian at the tool point (mm/rad over rad/rad), base frame");
+}
+
+void define_kinematics_solvers(py::module_& m) {
   m.def(
       "gravity_torque",
       [](const Robot& r, const Eigen::VectorXd& q_deg, bool calibrated) {
@@ -184,4 +189,11 @@ void define_kinematics(py::module_& m) {
       },
       py::arg("robot"), py::arg("pose"), py::arg("ref_deg"),
       "Index in ik_all(robot, pose, ref_deg) of the solution within the limits nearest ref_deg; None when none");
+}
+
+}  // namespace
+
+void define_kinematics(py::module_& m) {
+  define_kinematics_frames(m);
+  define_kinematics_solvers(m);
 }

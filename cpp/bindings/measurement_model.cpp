@@ -25,7 +25,18 @@ std::vector<std::string> setup_names_or_model(const std::optional<std::vector<st
 
 }  // namespace
 
-void define_measurement_model(py::module_& m) {
+namespace {
+
+// Python's PointModel: the robot's model (kept alive), the layout's options and the measurement
+// model built from them; residuals() builds one for the data's payloads
+struct PyPointModel {
+  std::shared_ptr<const Model> model;
+  LayoutOptions options;
+  PointModel pm;
+};
+
+
+void define_probe_stations(py::module_& m) {
   py::class_<StationValue>(m, "StationValue", "A probe station as identified (instrument frame of its rows' setup)")
       .def_readonly("name", &StationValue::name)
       .def_property_readonly("kind", [](const StationValue& v) { return to_string(v.kind); },
@@ -64,13 +75,9 @@ void define_measurement_model(py::module_& m) {
       py::arg("truth"), py::arg("options"),
       "A probe campaign on the calibrated (true) model of a robot: every row's ball centre on its\n"
       "constraint, the noise along it; the artifact's terms under 'artifact'");
-  // Python's PointModel: the robot's model (kept alive), the layout's options and the measurement
-  // model built from them; residuals() builds one for the data's payloads
-  struct PyPointModel {
-    std::shared_ptr<const Model> model;
-    LayoutOptions options;
-    PointModel pm;
-  };
+}
+
+void define_point_model(py::module_& m) {
   py::class_<PyPointModel>(m, "PointModel", "The identification residuals and their analytic Jacobian")
       .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
                        bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
@@ -141,4 +148,11 @@ void define_measurement_model(py::module_& m) {
           "The rows' residuals (residual_size per row, unused equations 0) and with `artifact` the\n"
           "artifact's terms after them (mm: a length's error, an angle's on a 1 m lever); the Jacobian\n"
           "of the layout's parameters, or of `columns` (their indices) only");
+}
+
+}  // namespace
+
+void define_measurement_model(py::module_& m) {
+  define_probe_stations(m);
+  define_point_model(m);
 }

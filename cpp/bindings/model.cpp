@@ -13,40 +13,12 @@
 
 using namespace kincal;
 
-void define_model(py::module_& m) {
-  py::class_<Robot>(m, "Robot", "A robot: nominal geometry and calibrated geometry (immutable)")
-      .def_static("load", &load_robot, py::arg("name_or_path"), "A built-in name or a model JSON file")
-      .def_static("from_json", &robot_from_json, py::arg("text"), py::arg("source") = "<json>")
-      .def("to_json", [](const Robot& r) { return robot_to_json(r); })
-      .def("with_joint_convention", [](const Robot& r, const std::string& source, const std::string& convention) {
-             return with_joint_convention(r, source, convention);
-           }, py::arg("source"), py::arg("convention"),
-           "The robot read from source numbered as its controller numbers the joints (fanuc; '': the model's own); "
-           "a model JSON carries its own")
-      .def_property_readonly("dof", [](const Robot& r) { return r.nominal->dof(); })
-      .def_property_readonly("identified", &Robot::identified)
-      .def_property_readonly("name", [](const Robot& r) { return r.nominal->spec().name; })
-      .def_property_readonly("compliance_count", [](const Robot& r) { return r.nominal->compliance_count(); })
-      .def_property_readonly("geometric_parameter_count", [](const Robot& r) { return 4 * r.nominal->dof() + 6; })
-      .def_property_readonly("closed_form_ik",
-                             [](const Robot& r) { return r.ik().structure().spherical_wrist_parallel_23; })
-      .def_property_readonly("ik_reason", [](const Robot& r) { return r.ik().structure().reason; })
-      .def_property_readonly("home_deg", [](const Robot& r) { return r.nominal->spec().home_deg; })
-      .def_property_readonly("limits_deg",
-                             [](const Robot& r) {
-                               std::vector<std::pair<double, double>> l;
-                               for (const auto& j : r.nominal->spec().joints) l.emplace_back(j.lower_deg, j.upper_deg);
-                               return l;
-                             })
-      .def_property_readonly(
-          "effects",
-          [](const Robot& r) {
-            py::list l;
-            for (const auto& ev : r.calibrated->spec().effects) l.append(py::make_tuple(ev.effect, ev.p));
-            return l;
-          },
-          "the calibrated model's effects besides compliance: (Effect, values in core units)")
-      .def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated->spec().t_ref_c; })
+namespace {
+
+// What a robot's calibrated model carries besides its geometry (placements, tool frame, the angles
+// its fit saw, effects' data needs), and the robots made from one with those changed.
+void define_robot_calibration(py::class_<Robot>& robot) {
+  robot.def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated->spec().t_ref_c; })
       .def_property_readonly(
           "placements",
           [](const Robot& r) {
@@ -120,6 +92,44 @@ void define_model(py::module_& m) {
           py::arg("seed"), py::arg("sigma_mm") = 1.0, py::arg("sigma_deg") = 0.05, py::arg("compliance") = 0.0,
           py::arg("base_in_instrument") = py::none(),
           "A robot whose calibrated model has simulated manufacturing errors (for simulations and demos)");
+}
+
+}  // namespace
+
+void define_model(py::module_& m) {
+  py::class_<Robot> robot(m, "Robot", "A robot: nominal geometry and calibrated geometry (immutable)");
+  robot.def_static("load", &load_robot, py::arg("name_or_path"), "A built-in name or a model JSON file")
+      .def_static("from_json", &robot_from_json, py::arg("text"), py::arg("source") = "<json>")
+      .def("to_json", [](const Robot& r) { return robot_to_json(r); })
+      .def("with_joint_convention", [](const Robot& r, const std::string& source, const std::string& convention) {
+             return with_joint_convention(r, source, convention);
+           }, py::arg("source"), py::arg("convention"),
+           "The robot read from source numbered as its controller numbers the joints (fanuc; '': the model's own); "
+           "a model JSON carries its own")
+      .def_property_readonly("dof", [](const Robot& r) { return r.nominal->dof(); })
+      .def_property_readonly("identified", &Robot::identified)
+      .def_property_readonly("name", [](const Robot& r) { return r.nominal->spec().name; })
+      .def_property_readonly("compliance_count", [](const Robot& r) { return r.nominal->compliance_count(); })
+      .def_property_readonly("geometric_parameter_count", [](const Robot& r) { return 4 * r.nominal->dof() + 6; })
+      .def_property_readonly("closed_form_ik",
+                             [](const Robot& r) { return r.ik().structure().spherical_wrist_parallel_23; })
+      .def_property_readonly("ik_reason", [](const Robot& r) { return r.ik().structure().reason; })
+      .def_property_readonly("home_deg", [](const Robot& r) { return r.nominal->spec().home_deg; })
+      .def_property_readonly("limits_deg",
+                             [](const Robot& r) {
+                               std::vector<std::pair<double, double>> l;
+                               for (const auto& j : r.nominal->spec().joints) l.emplace_back(j.lower_deg, j.upper_deg);
+                               return l;
+                             })
+      .def_property_readonly(
+          "effects",
+          [](const Robot& r) {
+            py::list l;
+            for (const auto& ev : r.calibrated->spec().effects) l.append(py::make_tuple(ev.effect, ev.p));
+            return l;
+          },
+          "the calibrated model's effects besides compliance: (Effect, values in core units)");
+  define_robot_calibration(robot);
   m.def("builtin_names", &builtin_names);
 
   py::class_<Extrapolation>(m, "Extrapolation",

@@ -160,29 +160,36 @@ std::string run_time_option(const std::string& options) {
   return "";
 }
 
-}  // namespace
+struct LsUse {  // a motion to a P[n]
+  int n, line;
+  bool joint;        // a J motion
+  std::string text;  // the statement
+};
 
-NativeProgram read_ls_program(const std::string& path) {
-  NativeProgram p;
-  p.format = ControllerFormat::FanucLs;
-  add_program_file(p, path);
-  const auto& lines = p.lines[0];
+struct LsStatement {  // a /MN statement: its lines (the first numbered, the others continuation lines ": ...")
+  std::vector<int> lines;  // 0-based
+  bool done = false;
+};
+
+struct LsSections {  // what the /MN and /POS sections hold
+  std::vector<LsStatement> statements;
+  std::map<int, LsPos> pos;
+};
+
+struct LsMotions {  // what the motions name
+  std::vector<LsUse> uses;
+  std::vector<int> motion_pos;        // per motion, its position's number (-1: none)
+  std::vector<std::string> named_in;  // the statements (their code), for P[n] named elsewhere
+};
+
+/// The file's sections: /PROG ... /END with /MN's statements and /POS's positions (file:line errors).
+LsSections read_ls_sections(const std::vector<std::string>& lines, const std::string& path) {
+  LsSections out;
+  auto& statements = out.statements;
+  auto& pos = out.pos;
   enum Section { None, Head, Mn, Pos, End } sec = None;
   int prog_line = 0, open_pos = 0, open_n = 0, gp_first = 0, gp_last = 0;
   bool other_group = false;  // the open position has a group other than GP1
-  std::map<int, LsPos> pos;
-  struct Use {
-    int n, line;
-    bool joint;        // a J motion
-    std::string text;  // the statement
-  };
-  std::vector<Use> uses;
-  // the /MN statements: their lines (the first numbered, the others continuation lines ": ...")
-  struct Statement {
-    std::vector<int> lines;  // 0-based
-    bool done = false;
-  };
-  std::vector<Statement> statements;
   static const std::regex numbered(R"(^\s*(\d+)\s*:)"), unnumbered(R"(^\s*:)");
   static const std::regex pos_open(R"(^\s*P\[\s*(\d+)\s*(:[^\]]*)?\]\s*\{\s*$)"), pos_close(R"(^\s*\};\s*$)");
   static const std::regex group(R"(^\s*GP(\d+)\s*:)");
@@ -255,12 +262,16 @@ NativeProgram read_ls_program(const std::string& path) {
   }
   if (!prog_line) throw InputError(path + ": no /PROG in the file");
   if (sec != End) throw InputError(where(path, prog_line) + ": /PROG is not closed by /END (end of file)");
+  return out;
+}
 
-  // the motions, in the order of the file
+/// The motions of the statements, in the order of the file, into p.motions (those whose target is
+/// known only at run time into p.unresolved), and the positions they use.
+LsMotions read_ls_motions(const LsSections& sc, const std::vector<std::string>& lines, const std::string& path,
+                          NativeProgram& p) {
+  LsMotions out;
   static const std::regex motion(R"(^\s*\d*\s*:\s*([JLCA])\s)");
-  std::vector<int> motion_pos;                           // per motion, its position's number (-1: none)
-  std::vector<std::string> named_in;                     // the statements (their code), for P[n] named elsewhere
-  for (const Statement& st : statements) {
+  for (const LsStatement& st : sc.statements) {
     std::vector<std::string> code;  // each line of the statement without '\r'
     for (const int l : st.lines) {
       std::string s = lines[static_cast<size_t>(l)];
@@ -274,7 +285,7 @@ NativeProgram read_ls_program(const std::string& path) {
     for (const std::string& c : code) body += c.substr(c.find(':') + 1) + " ";
     const size_t b = body.find_first_not_of(" \t");
     if (b == std::string::npos || body[b] == '!' || body.compare(b, 2, "//") == 0) continue;  // a comment
-    named_in.push_back(without_register_comments(body));
+    out.named_in.push_back(without_register_comments(body));
     std::smatch m;
     if (!std::regex_search(code[0], m, motion)) continue;
     if (!st.done) throw InputError(at + ": the motion does not end with ';'");
@@ -320,7 +331,7 @@ NativeProgram read_ls_program(const std::string& path) {
       if (pt.line == 0)
         for (size_t k = 1; k < st.lines.size(); ++k) whole += "\n" + lines[static_cast<size_t>(st.lines[k])];
       p.motions.push_back(motion_around(whole, pl, kind, pt.ref.begin, pt.ref.end - pt.ref.begin));
-      motion_pos.push_back(-1);
+      out.motion_pos.push_back(-1);
       std::string why = run_time;
       if (pt.ref.text.compare(0, 3, "PR[") == 0) why = pt.ref.text + ": a position register, known at run time";
       else if (!pt.ref.is_p) why = pt.ref.text + ": an indirect position, chosen at run time";
@@ -328,16 +339,22 @@ NativeProgram read_ls_program(const std::string& path) {
         p.unresolved.push_back({where(path, pl), text, why});
         continue;
       }
-      uses.push_back({pt.ref.n, pl, letter == 'J', text});
-      motion_pos.back() = pt.ref.n;
+      out.uses.push_back({pt.ref.n, pl, letter == 'J', text});
+      out.motion_pos.back() = pt.ref.n;
     }
   }
+  return out;
+}
+
+/// The Cartesian positions the motions use, into p.targets (an untaught one's motions unresolved).
+void read_ls_targets(const LsSections& sc, const LsMotions& mo, const std::vector<std::string>& lines,
+                     const std::string& path, NativeProgram& p) {
   std::map<int, bool> done;
   std::map<int, int> motions, joint_motions;  // per position, the motions to it and how many are J
-  for (const Use& u : uses) ++motions[u.n], joint_motions[u.n] += u.joint;
-  for (const Use& u : uses) {
-    const auto it = pos.find(u.n);
-    if (it == pos.end())
+  for (const LsUse& u : mo.uses) ++motions[u.n], joint_motions[u.n] += u.joint;
+  for (const LsUse& u : mo.uses) {
+    const auto it = sc.pos.find(u.n);
+    if (it == sc.pos.end())
       throw InputError(where(path, u.line) + ": P[" + std::to_string(u.n) + "] is used but not declared in /POS");
     const LsPos& lp = it->second;
     if (lp.untaught) {  // each motion to it unresolved (the controller stops there too)
@@ -364,15 +381,28 @@ NativeProgram read_ls_program(const std::string& path) {
     t.taught = taught;
     t.external = lp.external;
     for (size_t k = 0; k < p.motions.size(); ++k)
-      if (motion_pos[k] == u.n) p.motions[k].target = static_cast<int>(p.targets.size());
+      if (mo.motion_pos[k] == u.n) p.motions[k].target = static_cast<int>(p.targets.size());
     // every motion to it a J, and no other statement names it (a P[n] or P[n:comment])
     const std::regex named(R"(\bP\[\s*)" + std::to_string(u.n) + R"(\s*\])");
     int mentions = 0;
-    for (const std::string& l : named_in)
+    for (const std::string& l : mo.named_in)
       mentions += static_cast<int>(std::distance(std::sregex_iterator(l.begin(), l.end(), named), std::sregex_iterator()));
     t.joint_motion = joint_motions[u.n] == motions[u.n] && mentions == motions[u.n];
     p.targets.push_back(t);
   }
+}
+
+
+}  // namespace
+
+NativeProgram read_ls_program(const std::string& path) {
+  NativeProgram p;
+  p.format = ControllerFormat::FanucLs;
+  add_program_file(p, path);
+  const auto& lines = p.lines[0];
+  const LsSections sections = read_ls_sections(lines, path);
+  const LsMotions motions = read_ls_motions(sections, lines, path, p);
+  read_ls_targets(sections, motions, lines, path, p);
   return p;
 }
 

@@ -83,22 +83,24 @@ std::string why_computed(const std::string& a) {
   return "'" + a + "': an expression computed at run time";
 }
 
-}  // namespace
+struct UrAssign {
+  int line = 0, count = 0;
+  size_t begin = 0, end = 0;
+  bool literal = false, joints = false;
+  bool from_pose = false;  // an assignment computes joints from a pose (get_inverse_kin)
+  std::string value;  // as written (the last assignment)
+};
 
-NativeProgram read_urscript_program(const std::string& path) {
-  NativeProgram p;
-  p.format = ControllerFormat::UrScript;
-  add_program_file(p, path);
-  const auto& lines = p.lines[0];
-  struct Assign {
-    int line = 0, count = 0;
-    size_t begin = 0, end = 0;
-    bool literal = false, joints = false;
-    bool from_pose = false;  // an assignment computes joints from a pose (get_inverse_kin)
-    std::string value;  // as written (the last assignment)
-  };
-  std::map<std::string, Assign> vars;
-  std::map<std::string, std::string> params;        // a function's parameter: the function
+struct UrNames {  // what the program assigns, and the functions' parameters
+  std::map<std::string, UrAssign> vars;
+  std::map<std::string, std::string> params;  // a function's parameter: the function
+};
+
+/// The variables the program assigns and the functions' parameters; its blocks closed (file:line errors).
+UrNames read_urscript_names(const std::vector<std::string>& lines, const std::string& path) {
+  UrNames out;
+  auto& vars = out.vars;
+  auto& params = out.params;
   std::vector<std::pair<std::string, int>> blocks;  // opener and line
   static const std::regex opener(R"(^\s*(def|thread|if|while|for)\b.*:\s*$)"), closer(R"(^\s*end\s*$)");
   static const std::regex def(R"(^\s*def\s+([A-Za-z_]\w*)\s*\(([^)]*)\)\s*:\s*$)");
@@ -116,7 +118,7 @@ NativeProgram read_urscript_program(const std::string& path) {
       if (blocks.empty()) throw InputError(where(path, ln) + ": 'end' without def, thread, if, while or for");
       blocks.pop_back();
     } else if (std::regex_match(code, m, assign) && code.find("==") == std::string::npos) {
-      Assign& a = vars[m[1].str()];
+      UrAssign& a = vars[m[1].str()];
       ++a.count;
       a.line = ln;
       a.value = m[2].str();
@@ -129,6 +131,82 @@ NativeProgram read_urscript_program(const std::string& path) {
   }
   if (!blocks.empty())
     throw InputError(where(path, blocks.back().second) + ": '" + blocks.back().first + "' is not closed by 'end' (end of file)");
+  return out;
+}
+
+/// A motion's target argument ``a`` (at a_at in its line ln; its motion the last of p.motions): a
+/// pose written there or a variable assigned once with one, into p.targets; a value known at run time
+/// into p.unresolved; joints kept.
+void add_urscript_target(NativeProgram& p, const UrNames& names, std::map<std::string, size_t>& used,
+                         const std::vector<std::string>& lines, const std::string& path, const std::string& a,
+                         size_t a_at, int ln, const std::string& statement, bool movej) {
+  const std::string at = where(path, ln);
+  if (a[0] == '[') return;  // joints: kept
+  if (is_pose_literal(a)) {
+    if (has_computed_value(a)) {
+      p.unresolved.push_back({at, statement, "'" + a + "': a pose with a value computed at run time"});
+      return;
+    }
+    NativeTarget t;
+    t.line = ln;
+    t.begin = a_at;
+    t.end = t.begin + a.size();
+    t.pose = parse_pose(a, at);
+    t.joint_motion = movej;
+    p.motions.back().target = static_cast<int>(p.targets.size());
+    p.targets.push_back(t);
+    return;
+  }
+  if (!std::regex_match(a, std::regex(R"([A-Za-z_]\w*)"))) {
+    p.unresolved.push_back({at, statement, why_computed(a)});
+    return;
+  }
+  const auto v = names.vars.find(a);
+  if (v == names.vars.end()) {
+    const auto f = names.params.find(a);
+    if (f == names.params.end()) throw InputError(at + ": target '" + a + "' is not assigned in the program");
+    p.unresolved.push_back({at, statement, "'" + a + "': a parameter of " + f->second + "(), known at run time"});
+    return;
+  }
+  if (v->second.joints && v->second.count == 1) return;  // a joint list: kept
+  if (v->second.count != 1) {
+    p.unresolved.push_back({at, statement, "'" + a + "' is assigned " + std::to_string(v->second.count) +
+                                               " times: its value at this motion is known at run time"});
+    return;
+  }
+  if (!v->second.literal) {
+    const std::string& val = v->second.value;
+    p.unresolved.push_back({at, statement, "'" + a + "' is assigned " +
+                                               (is_pose_literal(val) ? "'" + val + "': a pose with a value computed at run time"
+                                                                     : why_computed(val))});
+    return;
+  }
+  if (used.count(a)) {
+    p.targets[used[a]].joint_motion &= movej;
+    p.motions.back().target = static_cast<int>(used[a]);
+    return;
+  }
+  p.motions.back().target = static_cast<int>(p.targets.size());
+  used[a] = p.targets.size();
+  NativeTarget t;
+  t.line = v->second.line;
+  t.begin = v->second.begin;
+  t.end = v->second.end;
+  t.name = a;
+  const std::string& l = lines[static_cast<size_t>(t.line - 1)];
+  t.pose = parse_pose(l.substr(t.begin, t.end - t.begin), where(path, t.line));
+  t.joint_motion = movej;
+  p.targets.push_back(t);
+}
+
+}  // namespace
+
+NativeProgram read_urscript_program(const std::string& path) {
+  NativeProgram p;
+  p.format = ControllerFormat::UrScript;
+  add_program_file(p, path);
+  const auto& lines = p.lines[0];
+  const UrNames names = read_urscript_names(lines, path);
   // the motions and how many points each takes (its first arguments); servoj, speedj, speedl: no Cartesian target
   static const std::regex move(R"(\b(movej|movel|movep|movec|servoc|servoj|speedj|speedl)\s*\()");
   std::map<std::string, size_t> used;
@@ -151,10 +229,10 @@ NativeProgram read_urscript_program(const std::string& path) {
         const std::string& a = args[0];
         p.motions.push_back(motion_around(code, ln, 'O', code.find(a, open), a.size()));
         // servoj to joints computed from a pose: a Cartesian target kincal cannot reach
-        const auto v = vars.find(a);
+        const auto v = names.vars.find(a);
         if (name == "servoj" && a.find("get_inverse_kin") != std::string::npos)
           p.unresolved.push_back({at, statement, why_computed(a)});
-        else if (name == "servoj" && v != vars.end() && v->second.from_pose)
+        else if (name == "servoj" && v != names.vars.end() && v->second.from_pose)
           p.unresolved.push_back({at, statement, "'" + a + "' is assigned get_inverse_kin(..): joints computed from a pose at run time"});
         continue;
       }
@@ -165,62 +243,7 @@ NativeProgram read_urscript_program(const std::string& path) {
         const size_t a_at = code.find(a, from);
         from = a_at + a.size();
         p.motions.push_back(motion_around(code, ln, kind, a_at, a.size()));
-        if (a[0] == '[') continue;  // joints: kept
-        if (is_pose_literal(a)) {
-          if (has_computed_value(a)) {
-            p.unresolved.push_back({at, statement, "'" + a + "': a pose with a value computed at run time"});
-            continue;
-          }
-          NativeTarget t;
-          t.line = ln;
-          t.begin = a_at;
-          t.end = t.begin + a.size();
-          t.pose = parse_pose(a, at);
-          t.joint_motion = movej;
-          p.motions.back().target = static_cast<int>(p.targets.size());
-          p.targets.push_back(t);
-          continue;
-        }
-        if (!std::regex_match(a, std::regex(R"([A-Za-z_]\w*)"))) {
-          p.unresolved.push_back({at, statement, why_computed(a)});
-          continue;
-        }
-        const auto v = vars.find(a);
-        if (v == vars.end()) {
-          const auto f = params.find(a);
-          if (f == params.end()) throw InputError(at + ": target '" + a + "' is not assigned in the program");
-          p.unresolved.push_back({at, statement, "'" + a + "': a parameter of " + f->second + "(), known at run time"});
-          continue;
-        }
-        if (v->second.joints && v->second.count == 1) continue;  // a joint list: kept
-        if (v->second.count != 1) {
-          p.unresolved.push_back({at, statement, "'" + a + "' is assigned " + std::to_string(v->second.count) +
-                                                     " times: its value at this motion is known at run time"});
-          continue;
-        }
-        if (!v->second.literal) {
-          const std::string& val = v->second.value;
-          p.unresolved.push_back({at, statement, "'" + a + "' is assigned " +
-                                                     (is_pose_literal(val) ? "'" + val + "': a pose with a value computed at run time"
-                                                                           : why_computed(val))});
-          continue;
-        }
-        if (used.count(a)) {
-          p.targets[used[a]].joint_motion &= movej;
-          p.motions.back().target = static_cast<int>(used[a]);
-          continue;
-        }
-        p.motions.back().target = static_cast<int>(p.targets.size());
-        used[a] = p.targets.size();
-        NativeTarget t;
-        t.line = v->second.line;
-        t.begin = v->second.begin;
-        t.end = v->second.end;
-        t.name = a;
-        const std::string& l = lines[static_cast<size_t>(t.line - 1)];
-        t.pose = parse_pose(l.substr(t.begin, t.end - t.begin), where(path, t.line));
-        t.joint_motion = movej;
-        p.targets.push_back(t);
+        add_urscript_target(p, names, used, lines, path, a, a_at, ln, statement, movej);
       }
     }
   }

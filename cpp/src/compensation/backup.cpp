@@ -127,24 +127,27 @@ void parallel_for(size_t n, int threads, const std::function<void(size_t)>& f) {
   });
 }
 
-}  // namespace
+struct ReadProgram {  // a program file read alone, or why it cannot be
+  NativeProgram p;
+  std::string error;
+};
 
-bool is_folder(const std::string& path) {
-  std::error_code ec;
-  return fs::is_directory(path, ec);
-}
+struct BackupContexts {  // the declarations each program reads its targets from
+  std::map<std::string, std::string> scope;                                 // program file -> its scope
+  std::map<std::string, std::shared_ptr<const Declarations>> declarations;  // scope -> its declarations
+  std::shared_ptr<const Declarations> of(const std::string& path) const {
+    const auto s = scope.find(path);
+    const auto it = s == scope.end() ? declarations.end() : declarations.find(s->second);
+    return it == declarations.end() ? nullptr : it->second;
+  }
+};
 
-BackupResult compensate_backup(const Robot& robot, const std::vector<std::string>& inputs, const std::string& out_dir,
-                               const ProgramOptions& opt, const WriterOptions& w, const NativeOptions& native,
-                               const BackupOptions& b) {
-  if (inputs.empty()) throw InputError("--program: no input");
-  const std::vector<Input> files = files_of(inputs, out_dir);
-  std::map<std::string, std::string> rel_of;  // input path -> output path under out_dir
-  std::set<std::string> paths;
-  for (const Input& f : files) rel_of[f.path] = (fs::path(out_dir) / f.rel).string(), paths.insert(f.path);
-  // the declarations: KRL per controller (every data list under it), RAPID per task; plus --declarations
+// the declarations: KRL per controller (every data list under it), RAPID per task; plus --declarations
+BackupContexts backup_declarations(const std::vector<Input>& files, const BackupOptions& b) {
+  BackupContexts out;
+  auto& scope = out.scope;
+  auto& contexts = out.declarations;
   std::map<std::string, std::vector<std::string>> decl_files;  // scope -> files
-  std::map<std::string, std::string> scope;                     // program file -> its scope
   for (const Input& f : files) {
     const ControllerFormat l = language_of(f.path);
     if (l != ControllerFormat::Krl && l != ControllerFormat::Rapid) continue;
@@ -159,7 +162,6 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
     else if (l == ControllerFormat::Rapid) extra_rapid.push_back(d);
     else throw InputError("--declarations " + d + ": a KRL .dat or a RAPID module (.mod, .modx, .sys)");
   }
-  std::map<std::string, std::shared_ptr<const Declarations>> contexts;
   for (auto& [key, list] : decl_files) {
     const bool krl = key.rfind("krl:", 0) == 0;
     std::vector<std::string> all = krl ? extra_krl : extra_rapid;  // --declarations first: they win
@@ -167,36 +169,13 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
     contexts[key] = std::make_shared<const Declarations>(
         read_declarations(all, krl ? ControllerFormat::Krl : ControllerFormat::Rapid));
   }
-  const auto context_of = [&](const std::string& path) -> std::shared_ptr<const Declarations> {
-    const auto s = scope.find(path);
-    const auto it = s == scope.end() ? contexts.end() : contexts.find(s->second);
-    return it == contexts.end() ? nullptr : it->second;
-  };
-  // the programs: each program file alone first
-  std::vector<std::string> programs;
-  for (const Input& f : files) {
-    const ControllerFormat l = language_of(f.path);
-    if (l == ControllerFormat::Csv) continue;
-    if (l == ControllerFormat::Krl && ext_of(f.path) == ".dat") continue;  // read with its .src, or a data list
-    programs.push_back(f.path);
-  }
-  struct Read {
-    NativeProgram p;
-    std::string error;
-  };
-  std::vector<Read> alone(programs.size());
-  const auto read = [&](const std::vector<std::string>& ps) {
-    const auto ctx = context_of(ps[0]);
-    return read_native_programs(ps, language_of(ps[0]), ctx ? *ctx : Declarations());
-  };
-  parallel_for(programs.size(), b.threads, [&](size_t i) {
-    try {
-      alone[i].p = read({programs[i]});
-    } catch (const std::exception& e) {
-      alone[i].error = e.what();
-    }
-  });
-  // programs that write the same file (targets declared in a shared module) are read and written as one
+  return out;
+}
+
+// programs that write the same file (targets declared in a shared module) are read and written as one:
+// the groups of programs (indices), in the order of their first program
+std::vector<std::vector<size_t>> joined_programs(const std::vector<std::string>& programs,
+                                                 const std::vector<ReadProgram>& alone) {
   std::map<std::string, size_t> owner;
   UnionFind uf(programs.size());
   for (size_t i = 0; i < programs.size(); ++i)
@@ -206,50 +185,21 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
     }
   std::map<size_t, std::vector<size_t>> groups;
   for (size_t i = 0; i < programs.size(); ++i) groups[uf.find(i)].push_back(i);
-  BackupResult r;
   std::vector<std::vector<size_t>> jobs;
   for (auto& [root, members] : groups) jobs.push_back(members);
   std::sort(jobs.begin(), jobs.end(), [&](const auto& x, const auto& y) { return programs[x[0]] < programs[y[0]]; });
-  r.programs.resize(jobs.size());
-  std::vector<char> copy_unchanged(jobs.size(), 0);
-  std::vector<std::vector<std::string>> job_files(jobs.size());  // per job: the files it read (and writes)
-  std::mutex progress_mutex;
-  size_t done = 0;
-  parallel_for(jobs.size(), b.threads, [&](size_t j) {
-    BackupProgram& out = r.programs[j];
-    for (const size_t i : jobs[j]) out.inputs.push_back(programs[i]);
-    try {
-      for (const size_t i : jobs[j])
-        if (!alone[i].error.empty()) throw InputError(alone[i].error);
-      const NativeProgram p = jobs[j].size() == 1 ? std::move(alone[jobs[j][0]].p) : read(out.inputs);
-      job_files[j] = p.paths;
-      if (p.targets.empty() && (p.unresolved.empty() || native.skip_unresolved)) {
-        copy_unchanged[j] = 1;  // joints only, or nothing to move: the file as it is
-        for (const auto& u : p.unresolved)
-          out.result.result.warnings.push_back(u.where + ": " + u.why + ", passed through unchanged: " + u.text);
-      } else {
-        for (const std::string& f : p.paths)
-          if (!rel_of.count(f))
-            throw InputError(f + ": targets of " + out.inputs[0] + " are declared here, outside the backup: kincal "
-                             "writes only the backup's files");
-        for (const std::string& f : p.paths) fs::create_directories(fs::path(rel_of.at(f)).parent_path());
-        WriterOptions wj = w;
-        wj.format = p.format;
-        out.result = compensate_native_program(robot, p, [&](const std::string& f) { return rel_of.at(f); }, opt, wj, native);
-      }
-    } catch (const std::exception& e) {
-      out.error = e.what();
-    }
-    if (b.progress) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      b.progress(++done, jobs.size());
-    }
-  });
-  // a written program owns every file it wrote; a failed one its own files (its programs, a KRL program's .dat),
-  // which get no output (an earlier run's is removed); every other file is copied unchanged: files no written
-  // program wrote (data lists and modules a failed program shares), programs with nothing to compensate
+  return jobs;
+}
+
+// a written program owns every file it wrote; a failed one its own files (its programs, a KRL program's .dat),
+// which get no output (an earlier run's is removed); every other file is copied unchanged: files no written
+// program wrote (data lists and modules a failed program shares), programs with nothing to compensate
+void settle_backup_files(BackupResult& r, const std::vector<Input>& files,
+                         const std::map<std::string, std::string>& rel_of, const std::set<std::string>& paths,
+                         const std::vector<char>& copy_unchanged,
+                         const std::vector<std::vector<std::string>>& job_files) {
   std::set<std::string> owned;
-  for (size_t j = 0; j < jobs.size(); ++j) {
+  for (size_t j = 0; j < copy_unchanged.size(); ++j) {
     if (copy_unchanged[j]) continue;
     if (r.programs[j].error.empty()) {
       owned.insert(job_files[j].begin(), job_files[j].end());
@@ -286,6 +236,82 @@ BackupResult compensate_backup(const Robot& robot, const std::vector<std::string
     }
     r.copied.push_back(to);
   }
+}
+
+}  // namespace
+
+bool is_folder(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
+BackupResult compensate_backup(const Robot& robot, const std::vector<std::string>& inputs, const std::string& out_dir,
+                               const ProgramOptions& opt, const WriterOptions& w, const NativeOptions& native,
+                               const BackupOptions& b) {
+  if (inputs.empty()) throw InputError("--program: no input");
+  const std::vector<Input> files = files_of(inputs, out_dir);
+  std::map<std::string, std::string> rel_of;  // input path -> output path under out_dir
+  std::set<std::string> paths;
+  for (const Input& f : files) rel_of[f.path] = (fs::path(out_dir) / f.rel).string(), paths.insert(f.path);
+  const BackupContexts ctx = backup_declarations(files, b);
+  // the programs: each program file alone first
+  std::vector<std::string> programs;
+  for (const Input& f : files) {
+    const ControllerFormat l = language_of(f.path);
+    if (l == ControllerFormat::Csv) continue;
+    if (l == ControllerFormat::Krl && ext_of(f.path) == ".dat") continue;  // read with its .src, or a data list
+    programs.push_back(f.path);
+  }
+  std::vector<ReadProgram> alone(programs.size());
+  const auto read = [&](const std::vector<std::string>& ps) {
+    const auto decl = ctx.of(ps[0]);
+    return read_native_programs(ps, language_of(ps[0]), decl ? *decl : Declarations());
+  };
+  parallel_for(programs.size(), b.threads, [&](size_t i) {
+    try {
+      alone[i].p = read({programs[i]});
+    } catch (const std::exception& e) {
+      alone[i].error = e.what();
+    }
+  });
+  BackupResult r;
+  const std::vector<std::vector<size_t>> jobs = joined_programs(programs, alone);
+  r.programs.resize(jobs.size());
+  std::vector<char> copy_unchanged(jobs.size(), 0);
+  std::vector<std::vector<std::string>> job_files(jobs.size());  // per job: the files it read (and writes)
+  std::mutex progress_mutex;
+  size_t done = 0;
+  parallel_for(jobs.size(), b.threads, [&](size_t j) {
+    BackupProgram& out = r.programs[j];
+    for (const size_t i : jobs[j]) out.inputs.push_back(programs[i]);
+    try {
+      for (const size_t i : jobs[j])
+        if (!alone[i].error.empty()) throw InputError(alone[i].error);
+      const NativeProgram p = jobs[j].size() == 1 ? std::move(alone[jobs[j][0]].p) : read(out.inputs);
+      job_files[j] = p.paths;
+      if (p.targets.empty() && (p.unresolved.empty() || native.skip_unresolved)) {
+        copy_unchanged[j] = 1;  // joints only, or nothing to move: the file as it is
+        for (const auto& u : p.unresolved)
+          out.result.result.warnings.push_back(u.where + ": " + u.why + ", passed through unchanged: " + u.text);
+      } else {
+        for (const std::string& f : p.paths)
+          if (!rel_of.count(f))
+            throw InputError(f + ": targets of " + out.inputs[0] + " are declared here, outside the backup: kincal "
+                             "writes only the backup's files");
+        for (const std::string& f : p.paths) fs::create_directories(fs::path(rel_of.at(f)).parent_path());
+        WriterOptions wj = w;
+        wj.format = p.format;
+        out.result = compensate_native_program(robot, p, [&](const std::string& f) { return rel_of.at(f); }, opt, wj, native);
+      }
+    } catch (const std::exception& e) {
+      out.error = e.what();
+    }
+    if (b.progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      b.progress(++done, jobs.size());
+    }
+  });
+  settle_backup_files(r, files, rel_of, paths, copy_unchanged, job_files);
   return r;
 }
 

@@ -82,6 +82,101 @@ ProgramResult compensate_program_whole(const Robot& robot, const std::string& in
 
 }  // namespace
 
+namespace {
+
+// One pass over the file, pose after pose from the directions dir0: into out when given; first_motion:
+// the direction of each joint's first motion (motion_directions' first row). An error of a pose (its
+// temperature missing, its compensation failing) waits for the rest of the file, whose broken lines
+// come first, as when the program was read before it was compensated.
+struct ProgramFile {  // a pose program file and how it is compensated
+  const Robot& robot;
+  const ProgramOptions& opt;
+  const std::string& in_path;
+  bool needs_dir, needs_t;
+  std::vector<Extrapolation> periodic;  // the joints whose periodic effects were fitted on a range of angles
+};
+
+ProgramResult program_pass(const ProgramFile& f, const Vec6& dir0, JointProgramOutput* out, Vec6* first_motion) {
+  PoseProgramReader rd(f.in_path, f.opt.chunk_bytes);
+  ProgramResult res;
+  ProgramCursor cur(f.robot, f.opt, dir0);
+  std::string pending;  // the first error of the compensation
+  bool pending_temperature = false;
+  std::vector<Extrapolation> outside = f.periodic;
+  std::vector<int> outside_line(f.periodic.size(), 0);
+  Vec6 prev = Vec6::Zero();
+  bool moved[6] = {false, false, false, false, false, false};
+  if (first_motion) first_motion->setOnes();
+  ProgramLine l;
+  while (rd.next(l)) {
+    if (!l.has_pose) {
+      if (out && pending.empty()) out->line(l, prev);
+      continue;
+    }
+    const double t = std::isfinite(l.temperature_c) ? l.temperature_c : f.opt.temperature_c;
+    if (f.needs_t && !std::isfinite(t)) {  // (compensate_poses checks every pose before the first is solved)
+      if (!pending_temperature) pending = where(f.in_path, l.line) + ": " + kNeedsTemperature;
+      pending_temperature = true;
+      continue;
+    }
+    if (!pending.empty()) continue;
+    cur.ctx.temperature_c = t;
+    cur.reference.reset();
+    PoseSolution s;
+    try {
+      s = next_pose(f.robot, f.opt, l.pose, cur);
+    } catch (const InputError& e) {
+      pending = e.what();
+      continue;
+    }
+    if (!s.ok()) {
+      pending = where(f.in_path, l.line) + ": " + s.error;
+      continue;
+    }
+    if (s.branch_changed()) {
+      const std::string w = where(f.in_path, l.line) + ": " + branch_change_message(s.error);
+      if (f.opt.keep_branch) {
+        pending = w + " (--keep-branch)";
+        continue;
+      }
+      res.warnings.push_back(w);
+    }
+    if (f.opt.keep_poses && out) {
+      res.q_deg.push_back(s.q_deg);
+      res.dir.push_back(f.needs_dir ? Vec6(cur.ctx.dir) : Vec6::Zero());
+      res.iterations.push_back(s.iterations);
+      res.residual.push_back(s.residual);
+    }
+    for (size_t k = 0; k < outside.size(); ++k) {
+      Extrapolation& e = outside[k];
+      if (!outside_range(s.q_deg[e.joint - 1], e.fitted)) continue;
+      if (e.rows == 0) e.first = res.poses, outside_line[k] = l.line;
+      ++e.rows;
+    }
+    if (first_motion && res.poses > 0)
+      for (int j = 0; j < 6; ++j) {
+        const double delta = s.q_deg[j] - prev[j];
+        if (!moved[j] && std::abs(delta) > kStillDeg) (*first_motion)[j] = delta > 0 ? 1.0 : -1.0, moved[j] = true;
+      }
+    count_pose(res, s);
+    prev = s.q_deg;
+    if (out) {
+      Vec6 qc = s.q_deg;  // the controller's numbers
+      joints_to_controller(f.robot.nominal->spec(), qc.data(), 6);
+      out->line(l, qc);
+    }
+  }
+  if (!pending.empty()) throw InputError(pending);
+  // the poses that take a joint's periodic effects outside the angles they were fitted on
+  for (size_t k = 0; k < outside.size(); ++k)
+    if (outside[k].rows > 0)
+      res.warnings.push_back(where(f.in_path, outside_line[k]) + ": " +
+                             extrapolation_message(outside[k], res.poses, "poses compensated"));
+  return res;
+}
+
+}  // namespace
+
 ProgramResult compensate_program_file(const Robot& robot, const std::string& in_path, const std::string& out_path,
                                       const ProgramOptions& opt, std::optional<ProgramFormat> out_format) {
   const ProgramFormat format = out_format ? *out_format : program_format(out_path);
@@ -94,87 +189,9 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
   if (opt.compensate)
     for (const Extrapolation& e : periodic_joints(cal.spec()))
       if (e.joint <= 6) periodic.push_back(e);
-  // One pass over the file, pose after pose from the directions dir0: into out when given; first_motion:
-  // the direction of each joint's first motion (motion_directions' first row). An error of a pose (its
-  // temperature missing, its compensation failing) waits for the rest of the file, whose broken lines
-  // come first, as when the program was read before it was compensated.
+  ProgramFile f{robot, opt, in_path, needs_dir, needs_t, periodic};
   auto pass = [&](const Vec6& dir0, JointProgramOutput* out, Vec6* first_motion) {
-    PoseProgramReader rd(in_path, opt.chunk_bytes);
-    ProgramResult res;
-    ProgramCursor cur(robot, opt, dir0);
-    std::string pending;  // the first error of the compensation
-    bool pending_temperature = false;
-    std::vector<Extrapolation> outside = periodic;
-    std::vector<int> outside_line(periodic.size(), 0);
-    Vec6 prev = Vec6::Zero();
-    bool moved[6] = {false, false, false, false, false, false};
-    if (first_motion) first_motion->setOnes();
-    ProgramLine l;
-    while (rd.next(l)) {
-      if (!l.has_pose) {
-        if (out && pending.empty()) out->line(l, prev);
-        continue;
-      }
-      const double t = std::isfinite(l.temperature_c) ? l.temperature_c : opt.temperature_c;
-      if (needs_t && !std::isfinite(t)) {  // (compensate_poses checks every pose before the first is solved)
-        if (!pending_temperature) pending = where(in_path, l.line) + ": " + kNeedsTemperature;
-        pending_temperature = true;
-        continue;
-      }
-      if (!pending.empty()) continue;
-      cur.ctx.temperature_c = t;
-      cur.reference.reset();
-      PoseSolution s;
-      try {
-        s = next_pose(robot, opt, l.pose, cur);
-      } catch (const InputError& e) {
-        pending = e.what();
-        continue;
-      }
-      if (!s.ok()) {
-        pending = where(in_path, l.line) + ": " + s.error;
-        continue;
-      }
-      if (s.branch_changed()) {
-        const std::string w = where(in_path, l.line) + ": " + branch_change_message(s.error);
-        if (opt.keep_branch) {
-          pending = w + " (--keep-branch)";
-          continue;
-        }
-        res.warnings.push_back(w);
-      }
-      if (opt.keep_poses && out) {
-        res.q_deg.push_back(s.q_deg);
-        res.dir.push_back(needs_dir ? Vec6(cur.ctx.dir) : Vec6::Zero());
-        res.iterations.push_back(s.iterations);
-        res.residual.push_back(s.residual);
-      }
-      for (size_t k = 0; k < outside.size(); ++k) {
-        Extrapolation& e = outside[k];
-        if (!outside_range(s.q_deg[e.joint - 1], e.fitted)) continue;
-        if (e.rows == 0) e.first = res.poses, outside_line[k] = l.line;
-        ++e.rows;
-      }
-      if (first_motion && res.poses > 0)
-        for (int j = 0; j < 6; ++j) {
-          const double delta = s.q_deg[j] - prev[j];
-          if (!moved[j] && std::abs(delta) > kStillDeg) (*first_motion)[j] = delta > 0 ? 1.0 : -1.0, moved[j] = true;
-        }
-      count_pose(res, s);
-      prev = s.q_deg;
-      if (out) {
-        Vec6 qc = s.q_deg;  // the controller's numbers
-        joints_to_controller(robot.nominal->spec(), qc.data(), 6);
-        out->line(l, qc);
-      }
-    }
-    if (!pending.empty()) throw InputError(pending);
-    // the poses that take a joint's periodic effects outside the angles they were fitted on
-    for (size_t k = 0; k < outside.size(); ++k)
-      if (outside[k].rows > 0)
-        res.warnings.push_back(where(in_path, outside_line[k]) + ": " +
-                               extrapolation_message(outside[k], res.poses, "poses compensated"));
-    return res;
+    return program_pass(f, dir0, out, first_motion);
   };
   auto write = [&](const Vec6& dir0) {
     AtomicFileWriter file(out_path, opt.chunk_bytes);

@@ -75,6 +75,32 @@ void PointEval::gravity_state(const Model& model, const Measurement& m, GravityS
   }
 }
 
+namespace {
+
+/// What add_torque_terms' torque changes are dotted with at one pose. The effect on the point
+/// (instrument frame) of a torque change dtau (N mm) on every loaded joint is the sum of
+/// rb K_j jp_j dtau_j (kp; kw for the rotation); every torque change is linear in the motion (go, gv)
+/// of line i and (dom, dv) of the links beyond it, dotted with B_j = g x wc_j,
+/// C_j = wc_j x (arm_j x g), A_j = C_j + arm_j x B_j and OB_j = oc_j x B_j.
+struct TorqueBasis {
+  std::array<Vec3, kMaxJoints> kp, kw, A, B, C, OB;
+  using Vecs = std::array<Vec3, kMaxJoints>;
+  TorqueBasis(const Model& model, const Vecs& wc, const Vecs& oc, const Vecs& arm, const std::vector<int>& loaded,
+              const Vecs& jp, const Vecs& jw, const Mat3& rb, bool rotation) {
+    const Vec3& g = model.gravity();
+    for (int j : loaded) {
+      kp[j] = rb * jp[j] * model.compliance(j);
+      if (rotation) kw[j] = rb * jw[j] * model.compliance(j);
+      B[j] = g.cross(wc[j]);
+      C[j] = wc[j].cross(arm[j].cross(g));
+      A[j] = C[j] + arm[j].cross(B[j]);
+      OB[j] = oc[j].cross(B[j]);
+    }
+  }
+};
+
+}  // namespace
+
 void PointEval::add_torque_terms(const Model& model, const GravityState& gs, const std::array<Vec3, kMaxJoints>& jp,
                                   const std::array<Vec3, kMaxJoints>& jw, const Mat3& rb, double* jac,
                                   double* jac_rot) const {
@@ -89,8 +115,6 @@ void PointEval::add_torque_terms(const Model& model, const GravityState& gs, con
   const auto& S = gs.S;
   const auto& M = gs.M;
   const auto& wc = gs.wc;
-  const auto& oc = gs.oc;
-  const auto& arm = gs.arm;
   const Vec3& cp = gs.cp;
   const double mp = gs.mp;
   const Vec3& g = model.gravity();
@@ -98,13 +122,8 @@ void PointEval::add_torque_terms(const Model& model, const GravityState& gs, con
     omo = gr[k] * om;
     vo = gr[k] * v + gt[k].cross(omo);
   };
-  // effect on the point (instrument frame) of a torque change dtau (N mm) on every loaded joint:
-  // the sum of rb K_j jp_j dtau_j, those vectors formed once per pose
-  std::array<Vec3, kMaxJoints> kp, kw;
-  for (int j : layout_.loaded) {
-    kp[j] = rb * jp[j] * model.compliance(j);
-    if (jac_rot) kw[j] = rb * jw[j] * model.compliance(j);
-  }
+  const TorqueBasis tb(model, gs.wc, gs.oc, gs.arm, layout_.loaded, jp, jw, rb, jac_rot != nullptr);
+  const auto &kp = tb.kp, &kw = tb.kw, &A = tb.A, &B = tb.B, &C = tb.C, &OB = tb.OB;
   auto apply = [&](int col, const std::array<double, kMaxJoints>& dtau) {
     Vec3 dx = Vec3::Zero(), dw = Vec3::Zero();
     for (int j : layout_.loaded) {
@@ -114,16 +133,6 @@ void PointEval::add_torque_terms(const Model& model, const GravityState& gs, con
     J.col(col) += dx;
     if (jac_rot) W.col(col) += dw;
   };
-  // Every torque change below is linear in the motion (go, gv) of line i and (dom, dv) of the links
-  // beyond it; the vectors it is dotted with depend on the pose only and are formed once:
-  // B_j = g x wc_j, C_j = wc_j x (arm_j x g), A_j = C_j + arm_j x B_j.
-  std::array<Vec3, kMaxJoints> A, B, C, OB;
-  for (int j : layout_.loaded) {
-    B[j] = g.cross(wc[j]);
-    C[j] = wc[j].cross(arm[j].cross(g));
-    A[j] = C[j] + arm[j].cross(B[j]);
-    OB[j] = oc[j].cross(B[j]);
-  }
   for (int i = 0; i < n; ++i) {
     const Vec3 wraw = nominal_.axis(i) + x_[4 * i] * u_[i] + x_[4 * i + 1] * v_[i];
     const double nn = wraw.norm();

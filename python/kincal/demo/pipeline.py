@@ -161,6 +161,47 @@ def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagno
             "held_out_rms_mm": res.validation["after_rms_mm"]}
 
 
+def _summary(res: ident.Identification, diag: dict[str, Any], diagnosed: ident.Identification, iso: dict[str, Any],
+             axes: dict[Any, Any], spheres: dict[str, Any], com: dict[str, Any], fres: dict[str, dict[str, Any]],
+             hb: list[float], table_fits: dict[str, dict[str, Any]], poses: int,
+             errors: tuple[FloatArray, FloatArray, FloatArray],
+             angles: tuple[FloatArray, FloatArray, FloatArray]) -> dict[str, Any]:
+    """summary.json's figures (the seconds and the files added by run())."""
+    err_unc, err_com, err_dia = errors
+    ori_unc, ori_com, ori_dia = angles
+    return {
+        "robot": "kr500 (simulated truth: seed 7; hidden backlash of -0.01 deg on joint 2)",
+        "poses": int(poses),
+        "identification": {"held_out_rms_before_mm": res.validation["before_rms_mm"],
+                           "held_out_rms_after_mm": res.validation["after_rms_mm"]},
+        "diagnosis": [{"effect": s["effect"], "joint": s["joint"], "rms_before_mm": s["rms_before_mm"],
+                       "rms_after_mm": s["rms_after_mm"]} for s in diag["steps"]],
+        "position_error_uncompensated_mm": {"mean": float(err_unc.mean()), "max": float(err_unc.max())},
+        "position_error_compensated_mm": {"mean": float(err_com.mean()), "max": float(err_com.max())},
+        "position_error_compensated_diagnosed_mm": {"mean": float(err_dia.mean()), "max": float(err_dia.max())},
+        "orientation_error_uncompensated_deg": {"mean": float(ori_unc.mean()), "max": float(ori_unc.max())},
+        "orientation_error_compensated_deg": {"mean": float(ori_com.mean()), "max": float(ori_com.max())},
+        "orientation_error_compensated_diagnosed_deg": {"mean": float(ori_dia.mean()), "max": float(ori_dia.max())},
+        "iso9283": {"cube_edge_mm": iso["plan"]["edge_mm"], "cycles": accuracy_demo.CYCLES,
+                    "repeatability_sigma_mm": accuracy_demo.REPEATABILITY_MM,
+                    "programs": {k: {"AP_P_mm": {p["point"]: p["AP_P_mm"] for p in v["report"]["points"]},
+                                     "RP_l_mm": {p["point"]: p["RP_l_mm"] for p in v["report"]["points"]},
+                                     "AD_mm": v["report"]["AD_mm"], "RD_mm": v["report"]["RD_mm"]}
+                                 for k, v in iso["programs"].items()}},
+        "fivebar_vdi3441_um": {f"{m} {a}": {k: r["vdi3441"][k] * 1000
+                                            for k in ("P", "P_per_m", "Pa", "Ps", "U", "Ps_mean", "U_mean")}
+                               for (m, a), r in axes.items()},
+        "diagnosed_model_effects": diagnosed.effect_labels(),
+        "without_tracker": spheres,
+        "newton_iterations": {"max": int(np.max(com["iterations"]))},
+        "feed_violations": {k: len(v["violations"]) for k, v in fres.items()},
+        "time_optimal_s": {k: v["time_optimal"]["time_s"] for k, v in fres.items()},
+        "fivebar_max_error_mm": {"nominal": hb[0], "fit": hb[1], "fit_and_matrix": hb[2]},
+        "table1": {k: {"points": v["points"], "a": v["a"], "b": v["b"], "c": v["c"], "d": v["d"],
+                       "max_error_mm": v["max_error_mm"]} for k, v in table_fits.items()},
+    }
+
+
 def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -221,37 +262,8 @@ def run(out: Path, say: Callable[[int, int, str], None]) -> dict[str, Any]:
     spheres = _spheres(out, robot, truth, res.robot, diagnosed.robot)
 
     say(9, n_steps, "report")
-    summary = {
-        "robot": "kr500 (simulated truth: seed 7; hidden backlash of -0.01 deg on joint 2)",
-        "poses": int(len(poses)),
-        "identification": {"held_out_rms_before_mm": res.validation["before_rms_mm"],
-                           "held_out_rms_after_mm": res.validation["after_rms_mm"]},
-        "diagnosis": [{"effect": s["effect"], "joint": s["joint"], "rms_before_mm": s["rms_before_mm"],
-                       "rms_after_mm": s["rms_after_mm"]} for s in diag["steps"]],
-        "position_error_uncompensated_mm": {"mean": float(err_unc.mean()), "max": float(err_unc.max())},
-        "position_error_compensated_mm": {"mean": float(err_com.mean()), "max": float(err_com.max())},
-        "position_error_compensated_diagnosed_mm": {"mean": float(err_dia.mean()), "max": float(err_dia.max())},
-        "orientation_error_uncompensated_deg": {"mean": float(ori_unc.mean()), "max": float(ori_unc.max())},
-        "orientation_error_compensated_deg": {"mean": float(ori_com.mean()), "max": float(ori_com.max())},
-        "orientation_error_compensated_diagnosed_deg": {"mean": float(ori_dia.mean()), "max": float(ori_dia.max())},
-        "iso9283": {"cube_edge_mm": iso["plan"]["edge_mm"], "cycles": accuracy_demo.CYCLES,
-                    "repeatability_sigma_mm": accuracy_demo.REPEATABILITY_MM,
-                    "programs": {k: {"AP_P_mm": {p["point"]: p["AP_P_mm"] for p in v["report"]["points"]},
-                                     "RP_l_mm": {p["point"]: p["RP_l_mm"] for p in v["report"]["points"]},
-                                     "AD_mm": v["report"]["AD_mm"], "RD_mm": v["report"]["RD_mm"]}
-                                 for k, v in iso["programs"].items()}},
-        "fivebar_vdi3441_um": {f"{m} {a}": {k: r["vdi3441"][k] * 1000
-                                            for k in ("P", "P_per_m", "Pa", "Ps", "U", "Ps_mean", "U_mean")}
-                               for (m, a), r in axes.items()},
-        "diagnosed_model_effects": diagnosed.effect_labels(),
-        "without_tracker": spheres,
-        "newton_iterations": {"max": int(np.max(com["iterations"]))},
-        "feed_violations": {k: len(v["violations"]) for k, v in fres.items()},
-        "time_optimal_s": {k: v["time_optimal"]["time_s"] for k, v in fres.items()},
-        "fivebar_max_error_mm": {"nominal": hb[0], "fit": hb[1], "fit_and_matrix": hb[2]},
-        "table1": {k: {"points": v["points"], "a": v["a"], "b": v["b"], "c": v["c"], "d": v["d"],
-                       "max_error_mm": v["max_error_mm"]} for k, v in table_fits.items()},
-    }
+    summary = _summary(res, diag, diagnosed, iso, axes, spheres, com, fres, hb, table_fits, len(poses),
+                       (err_unc, err_com, err_dia), (ori_unc, ori_com, ori_dia))
     summary["seconds"] = time.perf_counter() - t0
     sections = {"iso": accuracy_demo.iso9283_section(iso, (
         f"the truth being deterministic, its repeatability is simulated as a Gaussian scatter of "
@@ -280,15 +292,9 @@ def _line_figure(plt: Any, path: Path, err_unc: FloatArray, err_com: FloatArray,
     plt.close(fig)
 
 
-def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary: dict[str, Any], err_unc: FloatArray,
-            err_com: FloatArray, err_dia: FloatArray, fres: dict[str, dict[str, Any]],
-            table_fits: dict[str, dict[str, Any]], sections: dict[str, str]) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    _line_figure(plt, out / "line_errors.png", err_unc, err_com, err_dia)
-
+def _tables(res: ident.Identification, diag: dict[str, Any], summary: dict[str, Any], fres: dict[str, dict[str, Any]],
+            table_fits: dict[str, dict[str, Any]]) -> dict[str, str]:
+    """The report's tables and figure rows, as HTML."""
     v = res.validation
     ident_rows = [["fitted poses", f"{res.fit['nominal_rms_mm']:.3f}", f"{res.fit['rms_mm']:.3f}",
                    f"{res.fit['nominal_max_mm']:.3f}", f"{res.fit['max_mm']:.3f}"],
@@ -303,7 +309,6 @@ def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary:
     t1_rows = [[k, " ".join(map(str, v["points"])) if isinstance(v["points"], list) else v["points"],
                 f"{v['a']:.3f}", f"{v['b']:.3f}", f"{v['c']:.3f}", f"{v['d']:.3f}",
                 *(f"{v['largest_mm'][d] * 1000:.1f}" for d in ("desired", "measured"))] for k, v in table_fits.items()]
-    hb = summary["fivebar_max_error_mm"]
     t1_html = ("<p>Table I of the Kiper paper, ranked as the paper does for the polynomial and least-squares methods:</p>"
                + report.table(["method", "points", "a", "b", "c", "d", "largest error to the desired points (um)",
                                "to the measured points (um)"], t1_rows, numeric=True, labelled=True)
@@ -317,6 +322,25 @@ def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary:
         ["the tracker's diagnosed (section 3, the backlash included)", f"{wt['tracker_diagnosed_mm']:.4f}"],
         [f"the spheres' (the plan promised {wt['predicted_mm']:.4f})", f"{wt['spheres_mm']:.4f}"]],
         numeric=True, labelled=True)
+    return {"ident": report.table(["", "RMS before", "RMS after", "max before", "max after"], ident_rows),
+            "diag": report.table(["step", "effect", "joint", "F", "CV RMS before (um)", "after (um)"], diag_rows),
+            "feed": report.table(["program", "s total (rad)", "violations", "time-optimal traversal (s)",
+                                  "at constant feed (s)"], feed_rows),
+            "t1": t1_html, "feed_imgs": feed_imgs, "spheres": spheres_table}
+
+
+def _report(out: Path, res: ident.Identification, diag: dict[str, Any], summary: dict[str, Any], err_unc: FloatArray,
+            err_com: FloatArray, err_dia: FloatArray, fres: dict[str, dict[str, Any]],
+            table_fits: dict[str, dict[str, Any]], sections: dict[str, str]) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    _line_figure(plt, out / "line_errors.png", err_unc, err_com, err_dia)
+
+    tables = _tables(res, diag, summary, fres, table_fits)
+    hb = summary["fivebar_max_error_mm"]
+    wt = summary["without_tracker"]
     body = f"""<h1>kincal demo</h1>
 <p>The whole pipeline on built-in examples, in {summary['seconds']:.0f} s. Every number here comes from this
 run; the inputs and outputs are in this folder (listed at the end).</p>
@@ -332,12 +356,12 @@ truth in <code>truth.json</code>).</p>
 <p>Geometry (30 parameters) and joint compliance (5), the tracker frame and the reflector offsets, by Ceres
 with an analytic Jacobian (<code>model.json</code>, full summary in <code>identify.txt</code>). Position
 error in mm, nominal model (with the measured tracker frame) against the identified one:</p>
-{report.table(["", "RMS before", "RMS after", "max before", "max after"], ident_rows)}
+{tables["ident"]}
 <p>Condition number {res.fit['condition_number']:.3g}; {sum(res.fit['fixed'])} parameters are held because the
 data cannot determine them (redundant with others), named in <code>identify.txt</code>.</p>
 
 <h2>3. Diagnosis: what is the model missing?</h2>
-{report.table(["step", "effect", "joint", "F", "CV RMS before (um)", "after (um)"], diag_rows)}
+{tables["diag"]}
 <p>{report.esc(diag['verdict'])} (cross-validated RMS {diag['final_rms_mm'] * 1000:.1f} um). The hidden effect was
 backlash on joint 2. Full report: <a href="diagnosis/report.html">diagnosis/report.html</a>.</p>
 {report.figure("diagnosis/gap.png", "gap")}
@@ -368,11 +392,11 @@ the rotation between the commanded and the attained tool orientation):</p>
 <h2>6. Derivative analysis</h2>
 <p>Both programs against the kr500's velocity, acceleration and jerk limits at a rate of s of
 {feedmod.DEFAULT_FEED} rad/s (<code>feed/feed.json</code>, one figure per axis in <code>feed/</code>):</p>
-{report.table(["program", "s total (rad)", "violations", "time-optimal traversal (s)", "at constant feed (s)"], feed_rows)}
-{feed_imgs}
+{tables["feed"]}
+{tables["feed_imgs"]}
 
 <h2>7. The five-bar hidden robot</h2>
-{t1_html}
+{tables["t1"]}
 <p>On the simulated over-constrained 6-bar: nominal lengths miss by up to {hb['nominal'] * 1000:.0f} um, the fitted
 hidden robot by {hb['fit'] * 1000:.0f} um, fit plus the 5 mm error matrix by {hb['fit_and_matrix'] * 1000:.1f} um
 (400 points off the grid, 1 um instrument; target 30 um).</p>
@@ -387,7 +411,7 @@ true robot with 0.005 mm of noise (<code>spheres.csv</code>, <code>spheres-artif
 with the effects the data choose ({report.esc(", ".join(wt["effects"]) or "geometry alone")})
 into <code>spheres_model.json</code>. The ball centre over 200 random configurations, RMS after the best
 rigid transform (the spheres do not see the base frame), in mm:</p>
-{spheres_table}
+{tables["spheres"]}
 
 <h2>Files</h2>
 <p>{", ".join(f'<a href="{report.esc(f)}">{report.esc(f)}</a>' for f in

@@ -63,18 +63,21 @@ KDL::Frame to_kdl(const Eigen::Isometry3d& t) {
                     KDL::Vector(p[0], p[1], p[2]));
 }
 
-}  // namespace
+using Figures = std::vector<std::pair<std::string, double>>;
 
-std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed, int threads) {
-  std::vector<std::pair<std::string, double>> out;
-  const Model nom(kr500_spec());
-  const Model cal(perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.0));
-  const Model calc(perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.003));
+struct BenchPoses {  // random configurations inside the limits, more than 1 degree from the wrist singularity
+  std::vector<VecQ> qs;                     // rad
+  std::vector<Pose6> poses;                 // their poses on the nominal robot
+  std::vector<Vec6> qref;                   // deg
+  std::vector<Eigen::Isometry3d> targets;   // the poses as transforms
+};
+
+BenchPoses random_poses(const Model& nom, int n, unsigned seed) {
+  BenchPoses b;
+  auto& qs = b.qs;
+  auto& poses = b.poses;
+  auto& qref = b.qref;
   std::mt19937_64 rng(seed);
-  // random configurations inside the limits, more than 1 degree from the wrist singularity
-  std::vector<VecQ> qs;
-  std::vector<Pose6> poses;
-  std::vector<Vec6> qref;
   while (static_cast<int>(qs.size()) < n) {
     VecQ q(6);
     for (int j = 0; j < 6; ++j) {
@@ -87,8 +90,16 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
     qs.push_back(qr);
     poses.push_back(iso_to_pose(fk(nom, qr)));
   }
-  out.emplace_back("poses", n);
+  for (const auto& p : poses) b.targets.push_back(pose_to_iso(p));
+  return b;
+}
 
+// FK, the Jacobian and the IK against KDL's FK and Jacobian
+void bench_kinematics(Figures& out, const Model& nom, const BenchPoses& b) {
+  const int n = static_cast<int>(b.qs.size());
+  const auto& qs = b.qs;
+  const auto& targets = b.targets;
+  const auto& qref = b.qref;
   // FK
   out.emplace_back("fk_ns", time_ns(n, [&](int i) { g_sink = g_sink + fk(nom, qs[i]).translation()[0]; }));
   KDL::ChainFkSolverPos_recursive kfk(nom.kdl_chain());
@@ -113,88 +124,110 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
                      g_sink = g_sink + kj(0, 0);
                    }));
   // IK, all solutions
-  std::vector<Eigen::Isometry3d> targets;
-  for (const auto& p : poses) targets.push_back(pose_to_iso(p));
   const IkSolver ik(nom);  // built once, as a Robot holds it
   out.emplace_back("ik_all_ns", time_ns(n, [&](int i) {
                      const IkSolutions s = ik.solve(targets[i], IkOptions(qref[i]));
                      g_sink = g_sink + s.count;
                    }));
-  // opw_kinematics (the peer a user of an ortho-parallel robot would pick) on the same targets: the
-  // kr500's parameters in its convention (zero with the arm upright; axes 1, 4, 6 reversed), the
-  // flange it solves for placed by the fixed transform from our tool frame, its 8 solutions mapped
-  // back to our angles. A pose counts as matched when one of them is our reference configuration.
-  {
-    opw_kinematics::Parameters<double> op;
-    op.a1 = 500;
-    op.a2 = -55;
-    op.b = 0;
-    op.c1 = 1045;
-    op.c2 = 1300;
-    op.c3 = 1025;
-    op.c4 = 290;
-    op.offsets = {0, -kPi / 2, 0, 0, 0, 0};
-    op.sign_corrections = {-1, 1, 1, -1, 1, -1};
-    // its flange at our zero: theta = q * sign - offset
-    std::array<double, 6> z{};
-    const Eigen::Isometry3d f0 = opw_kinematics::forward(op, z);
-    const Eigen::Isometry3d x = fk(nom, VecQ::Zero(6)).inverse() * f0;
-    std::vector<Eigen::Isometry3d> flange;
-    for (const auto& t : targets) flange.push_back(t * x);
-    int matched = 0;
-    for (int i = 0; i < n; ++i) {
-      const auto sols = opw_kinematics::inverse(op, flange[i]);
-      for (const auto& s : sols) {
-        double worst = 0;
-        for (int j = 0; j < 6; ++j) {
-          const double d = std::remainder(s[j] - qs[i][j], 2 * kPi);
-          worst = std::max(worst, std::isfinite(d) ? std::abs(d) : 1e9);
-        }
-        if (worst < 1e-9) {
-          ++matched;
-          break;
-        }
+}
+
+// opw_kinematics (the peer a user of an ortho-parallel robot would pick) on the same targets: the
+// kr500's parameters in its convention (zero with the arm upright; axes 1, 4, 6 reversed), the
+// flange it solves for placed by the fixed transform from our tool frame, its 8 solutions mapped
+// back to our angles. A pose counts as matched when one of them is our reference configuration.
+void bench_opw(Figures& out, const Model& nom, const BenchPoses& b) {
+  const int n = static_cast<int>(b.qs.size());
+  const auto& qs = b.qs;
+  const auto& targets = b.targets;
+  const auto& qref = b.qref;
+  opw_kinematics::Parameters<double> op;
+  op.a1 = 500;
+  op.a2 = -55;
+  op.b = 0;
+  op.c1 = 1045;
+  op.c2 = 1300;
+  op.c3 = 1025;
+  op.c4 = 290;
+  op.offsets = {0, -kPi / 2, 0, 0, 0, 0};
+  op.sign_corrections = {-1, 1, 1, -1, 1, -1};
+  // its flange at our zero: theta = q * sign - offset
+  std::array<double, 6> z{};
+  const Eigen::Isometry3d f0 = opw_kinematics::forward(op, z);
+  const Eigen::Isometry3d x = fk(nom, VecQ::Zero(6)).inverse() * f0;
+  std::vector<Eigen::Isometry3d> flange;
+  for (const auto& t : targets) flange.push_back(t * x);
+  int matched = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto sols = opw_kinematics::inverse(op, flange[i]);
+    for (const auto& s : sols) {
+      double worst = 0;
+      for (int j = 0; j < 6; ++j) {
+        const double d = std::remainder(s[j] - qs[i][j], 2 * kPi);
+        worst = std::max(worst, std::isfinite(d) ? std::abs(d) : 1e9);
+      }
+      if (worst < 1e-9) {
+        ++matched;
+        break;
       }
     }
-    out.emplace_back("opw_ik_ns", time_ns(n, [&](int i) {
-                       const auto s = opw_kinematics::inverse(op, flange[i]);
-                       g_sink = g_sink + s[0][0];
-                     }));
-    out.emplace_back("opw_matched_fraction", static_cast<double>(matched) / n);
-    // the same with what our solve also delivers: degrees, each angle the whole turn nearest the
-    // reference within the limits, flagged (a plain loop, as a user of opw_kinematics would write it)
-    std::array<double, 6> lo, hi;
-    for (int j = 0; j < 6; ++j) {
-      lo[j] = nom.spec().joints[j].lower_deg;
-      hi[j] = nom.spec().joints[j].upper_deg;
-    }
-    out.emplace_back("opw_ik_limits_ns", time_ns(n, [&](int i) {
-                       const auto s = opw_kinematics::inverse(op, flange[i]);
-                       int inside = 0;
-                       double first = 0;
-                       for (const auto& sol : s) {
-                         bool ok = std::isfinite(sol[0]);
-                         for (int j = 0; j < 6 && ok; ++j) {
-                           const double q = std::remainder(sol[j] * (180 / kPi), 360.0);
-                           double best = q;
-                           bool found = false;
-                           for (int k = -2; k <= 2; ++k) {
-                             const double c = q + 360.0 * k;
-                             if (c < lo[j] || c > hi[j]) continue;
-                             if (!found || std::abs(c - qref[i][j]) < std::abs(best - qref[i][j])) best = c;
-                             found = true;
-                           }
-                           ok = found;
-                           if (j == 0) first = best;
-                         }
-                         inside += ok;
-                       }
-                       g_sink = g_sink + inside + first;
-                     }));
   }
+  out.emplace_back("opw_ik_ns", time_ns(n, [&](int i) {
+                     const auto s = opw_kinematics::inverse(op, flange[i]);
+                     g_sink = g_sink + s[0][0];
+                   }));
+  out.emplace_back("opw_matched_fraction", static_cast<double>(matched) / n);
+  // the same with what our solve also delivers: degrees, each angle the whole turn nearest the
+  // reference within the limits, flagged (a plain loop, as a user of opw_kinematics would write it)
+  std::array<double, 6> lo, hi;
+  for (int j = 0; j < 6; ++j) {
+    lo[j] = nom.spec().joints[j].lower_deg;
+    hi[j] = nom.spec().joints[j].upper_deg;
+  }
+  out.emplace_back("opw_ik_limits_ns", time_ns(n, [&](int i) {
+                     const auto s = opw_kinematics::inverse(op, flange[i]);
+                     int inside = 0;
+                     double first = 0;
+                     for (const auto& sol : s) {
+                       bool ok = std::isfinite(sol[0]);
+                       for (int j = 0; j < 6 && ok; ++j) {
+                         const double q = std::remainder(sol[j] * (180 / kPi), 360.0);
+                         double best = q;
+                         bool found = false;
+                         for (int k = -2; k <= 2; ++k) {
+                           const double c = q + 360.0 * k;
+                           if (c < lo[j] || c > hi[j]) continue;
+                           if (!found || std::abs(c - qref[i][j]) < std::abs(best - qref[i][j])) best = c;
+                           found = true;
+                         }
+                         ok = found;
+                         if (j == 0) first = best;
+                       }
+                       inside += ok;
+                     }
+                     g_sink = g_sink + inside + first;
+                   }));
+}
+
+struct NewtonFigures {  // what the compensation benchmarks share
+  std::vector<Vec6> start;  // the nominal IK solution nearest each reference (deg)
+  int not_converged = 0;
+  long iterations = 0;
+};
+
+NewtonFigures bench_compensation(Figures& out, const Model& nom, const Model& cal, const Model& calc,
+                                 const BenchPoses& b) {
+  const int n = static_cast<int>(b.qs.size());
+  const auto& poses = b.poses;
+  const auto& qref = b.qref;
+  const auto& targets = b.targets;
+  const IkSolver ik(nom);
+  NewtonFigures nf;
+  auto& start = nf.start;
+  auto& not_converged = nf.not_converged;
+  auto& iterations = nf.iterations;
   // Compensation (the and the paper's): Newton on the calibrated model from the nominal IK
   // solution nearest the reference, the start KDL's NR gets below
-  std::vector<Vec6> start(n);
+  start.resize(n);
   for (int i = 0; i < n; ++i) {
     const IkSolutions s = ik.solve(targets[i], IkOptions(qref[i]));
     const int k = s.nearest(qref[i].data());
@@ -202,8 +235,6 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
   }
   CompensationOptions an, fd;
   fd.finite_difference = true;
-  int not_converged = 0;
-  long iterations = 0;
   out.emplace_back("compensate_ns", time_ns(n, [&](int i) {
                      const auto r = compensate(cal, poses[i], start[i], an);
                      not_converged += r.status != CompStatus::Converged;
@@ -238,6 +269,17 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
                      const auto r = compensate(cal, poses[i], start[i], fd);
                      g_sink = g_sink + r.q_deg[0];
                    }, 5));
+  return nf;
+}
+
+// the program path, KDL's Newton-Raphson and the batch throughput on all cores
+void bench_program(Figures& out, const Model& cal, const NewtonFigures& nf, const BenchPoses& b, int threads) {
+  const int n = static_cast<int>(b.qs.size());
+  const auto& poses = b.poses;
+  const auto& qref = b.qref;
+  const auto& targets = b.targets;
+  const auto& start = nf.start;
+  const CompensationOptions an;
   // The whole per-pose path of `kincal compensate` (compensation/program.hpp solve_pose): nominal IK of the branch
   // nearest the reference, the corrected start (a second IK), Newton, the joint-limit check
   auto nomp = std::make_shared<Model>(kr500_spec());
@@ -292,10 +334,13 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
   out.emplace_back("batch_poses_per_s", throughput([&](int i) { return compensate(cal, poses[i], start[i], an).q_deg[0]; }));
   out.emplace_back("batch_program_poses_per_s", throughput([&](int i) { return program_pose(rob, i).q_deg[0]; }));
   out.emplace_back("batch_threads", nt);
-  out.emplace_back("compensate_not_converged", not_converged / 15.0);
-  out.emplace_back("compensate_mean_iterations", iterations / (15.0 * n));
+  out.emplace_back("compensate_not_converged", nf.not_converged / 15.0);
+  out.emplace_back("compensate_mean_iterations", nf.iterations / (15.0 * n));
   out.emplace_back("program_failures", program_failed / 15.0);
   out.emplace_back("kdl_nr_failures", kdl_failed / 3.0);
+}
+
+void add_ratios(Figures& out) {
   auto get = [&](const char* k) {
     for (auto& p : out)
       if (p.first == k) return p.second;
@@ -306,39 +351,57 @@ std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed,
   out.emplace_back("ik_ratio_to_opw", get("ik_all_ns") / get("opw_ik_ns"));
   out.emplace_back("ik_ratio_to_opw_limits", get("ik_all_ns") / get("opw_ik_limits_ns"));
   out.emplace_back("compensate_speedup_vs_kdl_nr", get("kdl_nr_ns") / get("compensate_ns"));
-  // five-bar corrector (hidden-robot IK, bilinear lookup, Jacobian correction): every sample timed
-  // alone (clock reads included), on a 5 mm error matrix over the paper's 100 x 150 mm workspace
-  {
-    std::vector<FiveBarPoint> grid;
-    std::mt19937_64 g(seed);
-    std::normal_distribution<double> nd(0, 0.05);
-    for (int iy = 0; iy <= 30; ++iy)
-      for (int ix = 0; ix <= 20; ++ix) {
-        FiveBarPoint p;
-        p.desired = Vec2(162.132 + 5 * ix, -75 + 5 * iy);
-        p.measured = p.desired + Vec2(nd(g), nd(g));
-        grid.push_back(p);
-      }
-    const ErrorMatrix em = ErrorMatrix::from_points(grid, "bench");
-    FiveBarCorrector corr(FiveBar{149.9, 150.05, 149.95, 150.1, +1, +1, -1}, &em);
-    const int m = 200000;
-    std::vector<double> lat(m);
-    std::uniform_real_distribution<double> ux(162.132, 262.132), uy(-75, 75);
-    std::vector<Vec2> pts(m);
-    for (auto& p : pts) p = Vec2(ux(g), uy(g));
-    double t1, t2;
-    for (int i = 0; i < m; ++i) {
-      const auto a = Clock::now();
-      corr.command(pts[i], t1, t2);
-      const auto b = Clock::now();
-      g_sink = g_sink + t1;
-      lat[i] = std::chrono::duration<double, std::nano>(b - a).count();
+}
+
+// five-bar corrector (hidden-robot IK, bilinear lookup, Jacobian correction): every sample timed
+// alone (clock reads included), on a 5 mm error matrix over the paper's 100 x 150 mm workspace
+void bench_fivebar(Figures& out, unsigned seed) {
+  std::vector<FiveBarPoint> grid;
+  std::mt19937_64 g(seed);
+  std::normal_distribution<double> nd(0, 0.05);
+  for (int iy = 0; iy <= 30; ++iy)
+    for (int ix = 0; ix <= 20; ++ix) {
+      FiveBarPoint p;
+      p.desired = Vec2(162.132 + 5 * ix, -75 + 5 * iy);
+      p.measured = p.desired + Vec2(nd(g), nd(g));
+      grid.push_back(p);
     }
-    std::sort(lat.begin(), lat.end());
-    out.emplace_back("fivebar_command_median_ns", lat[m / 2]);
-    out.emplace_back("fivebar_command_p99_ns", lat[static_cast<size_t>(0.99 * m)]);
-    out.emplace_back("fivebar_command_max_ns", lat.back());
+  const ErrorMatrix em = ErrorMatrix::from_points(grid, "bench");
+  FiveBarCorrector corr(FiveBar{149.9, 150.05, 149.95, 150.1, +1, +1, -1}, &em);
+  const int m = 200000;
+  std::vector<double> lat(m);
+  std::uniform_real_distribution<double> ux(162.132, 262.132), uy(-75, 75);
+  std::vector<Vec2> pts(m);
+  for (auto& p : pts) p = Vec2(ux(g), uy(g));
+  double t1, t2;
+  for (int i = 0; i < m; ++i) {
+    const auto a = Clock::now();
+    corr.command(pts[i], t1, t2);
+    const auto b = Clock::now();
+    g_sink = g_sink + t1;
+    lat[i] = std::chrono::duration<double, std::nano>(b - a).count();
   }
+  std::sort(lat.begin(), lat.end());
+  out.emplace_back("fivebar_command_median_ns", lat[m / 2]);
+  out.emplace_back("fivebar_command_p99_ns", lat[static_cast<size_t>(0.99 * m)]);
+  out.emplace_back("fivebar_command_max_ns", lat.back());
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> run_benchmarks(int n, unsigned seed, int threads) {
+  Figures out;
+  const Model nom(kr500_spec());
+  const Model cal(perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.0));
+  const Model calc(perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.003));
+  const BenchPoses b = random_poses(nom, n, seed);
+  out.emplace_back("poses", n);
+  bench_kinematics(out, nom, b);
+  bench_opw(out, nom, b);
+  const NewtonFigures nf = bench_compensation(out, nom, cal, calc, b);
+  bench_program(out, cal, nf, b, threads);
+  add_ratios(out);
+  bench_fivebar(out, seed);
   return out;
 }
 

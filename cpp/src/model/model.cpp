@@ -34,38 +34,48 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
   if (n_ < 1 || n_ > kMaxJoints)
     throw InputError(who + "a serial chain needs 1 to " + std::to_string(kMaxJoints) + " revolute joints, got " +
                      std::to_string(n_));
-  // Effects: joint_compliance entries set the joints' compliance; the others are checked and kept
-  {
-    std::vector<EffectValue> rest;
-    for (const EffectValue& ev : spec_.effects) {
-      check_effect(ev.effect, n_, who);
-      if (static_cast<int>(ev.p.size()) != ev.effect.size())
-        throw InputError(who + ev.effect.label() + ": " + std::to_string(ev.p.size()) + " values for " +
-                         std::to_string(ev.effect.size()) + " parameters");
-      for (double v : ev.p)
-        if (!std::isfinite(v)) throw InputError(who + ev.effect.label() + ": a value is NaN or infinite");
-      for (const EffectValue& o : rest)
-        if (o.effect.name == ev.effect.name && o.effect.joint == ev.effect.joint)
-          throw InputError(who + ev.effect.label() + " is given twice");
-      const EffectKind& kind = ev.effect.kind();
-      if (kind.gravity_loaded_only) {  // joint_compliance: the joint's own compliance
-        spec_.joints[ev.effect.joint].compliance_deg_per_knm = ev.p[0];
-        continue;
-      }
-      rest.push_back(ev);
-      if (kind.scales_lengths()) {
-        thermal_alpha_ = ev.p[0];
-      } else if (kind.of_instrument()) {
-        drift_ = static_cast<int>(rest.size()) - 1;  // carried for the measurement, never applied
-      } else {
-        joint_effects_.push_back(ev);
-        needs_dir_ = needs_dir_ || kind.reads_dir();
-      }
+  take_effects(who);
+  check_values(who);
+  find_loaded_joints(who);
+  compile_links();
+  build_kdl_chain();
+}
+
+// Effects: joint_compliance entries set the joints' compliance; the others are checked and kept
+void Model::take_effects(const std::string& who) {
+  std::vector<EffectValue> rest;
+  for (const EffectValue& ev : spec_.effects) {
+    check_effect(ev.effect, n_, who);
+    if (static_cast<int>(ev.p.size()) != ev.effect.size())
+      throw InputError(who + ev.effect.label() + ": " + std::to_string(ev.p.size()) + " values for " +
+                       std::to_string(ev.effect.size()) + " parameters");
+    for (double v : ev.p)
+      if (!std::isfinite(v)) throw InputError(who + ev.effect.label() + ": a value is NaN or infinite");
+    for (const EffectValue& o : rest)
+      if (o.effect.name == ev.effect.name && o.effect.joint == ev.effect.joint)
+        throw InputError(who + ev.effect.label() + " is given twice");
+    const EffectKind& kind = ev.effect.kind();
+    if (kind.gravity_loaded_only) {  // joint_compliance: the joint's own compliance
+      spec_.joints[ev.effect.joint].compliance_deg_per_knm = ev.p[0];
+      continue;
     }
-    spec_.effects = rest;
-    if (!std::isfinite(spec_.t_ref_c)) throw InputError(who + "the reference temperature is NaN or infinite");
-    if (!std::isfinite(spec_.t_mean_s)) throw InputError(who + "the drift's reference time is NaN or infinite");
+    rest.push_back(ev);
+    if (kind.scales_lengths()) {
+      thermal_alpha_ = ev.p[0];
+    } else if (kind.of_instrument()) {
+      drift_ = static_cast<int>(rest.size()) - 1;  // carried for the measurement, never applied
+    } else {
+      joint_effects_.push_back(ev);
+      needs_dir_ = needs_dir_ || kind.reads_dir();
+    }
   }
+  spec_.effects = rest;
+  if (!std::isfinite(spec_.t_ref_c)) throw InputError(who + "the reference temperature is NaN or infinite");
+  if (!std::isfinite(spec_.t_mean_s)) throw InputError(who + "the drift's reference time is NaN or infinite");
+}
+
+// The setups, joints, tool, payload, gravity and base: finite, consistent; the joints' axes and points
+void Model::check_values(const std::string& who) {
   for (size_t i = 0; i < spec_.setups.size(); ++i) {
     const SetupFrame& f = spec_.setups[i];
     if (f.name.empty()) throw InputError(who + "setup " + std::to_string(i + 1) + " has no name");
@@ -97,8 +107,10 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
   tool_ = pose_to_iso(spec_.tool);
   base_in_instrument_ = pose_to_iso(spec_.base_in_instrument);
   g_ = spec_.gravity;
+}
 
-  // Gravity-loaded joints: all but a leading run of joints whose axes stay along gravity.
+// Gravity-loaded joints: all but a leading run of joints whose axes stay along gravity.
+void Model::find_loaded_joints(const std::string& who) {
   bool upstream_vertical = g_.norm() > 0;
   for (int j = 0; j < n_; ++j) {
     upstream_vertical = upstream_vertical && parallel(w_[j], g_.normalized(), 1e-9);
@@ -108,12 +120,14 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
                        " has a compliance but its axis is along gravity (no gravity torque)");
     has_compliance_ = has_compliance_ || spec_.joints[j].compliance_deg_per_knm != 0;
   }
+}
 
-  // Compiled evaluator: a local frame F_j along every axis, T(q) = C0 Rz(q1) L1 Rz(q2) L2 ... Rz(qn) Ln
-  // with constant L_j = F_j^T F_{j+1} (L_n to the tool); then every link rotation but the last written
-  // as Rz(theta) Rx(alpha) Rz(phi) and the Rz merged into the joints: Rz(q_j) Trans(t_j) Rz(theta_j)
-  // = Rz(q_j + theta_j) Trans(Rz(-theta_j) t_j), and Rz(phi_j) Rz(q_{j+1}) = Rz(q_{j+1} + phi_j).
-  // The local frame of joint j becomes F_j Rz(theta_j), in which its link data are written.
+// Compiled evaluator: a local frame F_j along every axis, T(q) = C0 Rz(q1) L1 Rz(q2) L2 ... Rz(qn) Ln
+// with constant L_j = F_j^T F_{j+1} (L_n to the tool); then every link rotation but the last written
+// as Rz(theta) Rx(alpha) Rz(phi) and the Rz merged into the joints: Rz(q_j) Trans(t_j) Rz(theta_j)
+// = Rz(q_j + theta_j) Trans(Rz(-theta_j) t_j), and Rz(phi_j) Rz(q_{j+1}) = Rz(q_{j+1} + phi_j).
+// The local frame of joint j becomes F_j Rz(theta_j), in which its link data are written.
+void Model::compile_links() {
   std::array<Mat3, kMaxJoints> fr;
   fr.fill(Mat3::Identity());
   for (int j = 0; j < n_; ++j) fr[j] = frame_along(w_[j]);
@@ -155,8 +169,10 @@ Model::Model(ModelSpec spec) : spec_(std::move(spec)) {
       l.mc += spec_.payload_kg * (fr[j].transpose() * (pc - p_[j]));  // theta = 0 on the last joint
     }
   }
+}
 
-  // The KDL chain: one segment per joint with identity tip (POE form), then the fixed tool.
+// The KDL chain: one segment per joint with identity tip (POE form), then the fixed tool.
+void Model::build_kdl_chain() {
   chain_ = std::make_unique<KDL::Chain>();
   for (int j = 0; j < n_; ++j) {
     const Vec3& p = p_[j];

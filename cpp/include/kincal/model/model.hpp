@@ -134,6 +134,13 @@ class Model {
   double compliance(int j) const { return k_[j]; }
 
  private:
+  // the constructor's steps, in order
+  void take_effects(const std::string& who);
+  void check_values(const std::string& who);
+  void find_loaded_joints(const std::string& who);
+  void compile_links();
+  void build_kdl_chain();
+
   ModelSpec spec_;
   int n_ = 0;
   std::unique_ptr<KDL::Chain> chain_;

@@ -128,8 +128,11 @@ def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finit
     if temperature_c is not None:
         temps = np.broadcast_to(np.asarray(temperature_c, dtype=float), (len(p),)).copy()
     init = [] if initial_direction is None else [float(v) for v in np.atleast_1d(initial_direction)]
-    return _core.compensate_poses(robot, p, compensate, frame == "instrument", finite_difference, delta, epsilon,
-                                  max_iterations, corrected_start, residual, None, init, keep_branch, temps)
+    options = _core.ProgramOptions(compensate=compensate, instrument=frame == "instrument",
+                                   finite_difference=finite_difference, delta=delta, epsilon=epsilon,
+                                   max_iterations=max_iterations, corrected_start=corrected_start, residual=residual,
+                                   initial_direction=init, keep_branch=keep_branch)
+    return _core.compensate_poses(robot, p, options, temps)
 
 
 def line_program(start: Sequence[float] = (2000.0, -740.0, 500.0), direction: Sequence[float] = (0.0, 1.0, 0.0),

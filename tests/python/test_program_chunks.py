@@ -129,13 +129,14 @@ def test_small_chunks_through_the_binding(tmp_path, calibrated):
         _write(src, poses)
         for chunk in (1, 50, 4096):
             out = tmp_path / ("o" + src.suffix)
-            got = _core.compensate_program(robot, str(src), str(out), temperature_c=21.0, chunk_bytes=chunk)
+            got = _core.compensate_program(robot, str(src), str(out),
+                                           _core.ProgramOptions(temperature_c=21.0, chunk_bytes=chunk))
             assert out.read_text() == _joint_program(res["q_deg"], src.suffix, src.suffix)
             assert np.array_equal(got["q_deg"], res["q_deg"]) and np.array_equal(got["dir"], res["dir"])
             assert got["warnings"] == _located(res["warnings"], src)
             assert got["poses"] == 400 and got["iterations_max"] == max(res["iterations"])
-            lean = _core.compensate_program(robot, str(src), str(out), temperature_c=21.0, chunk_bytes=chunk,
-                                            keep_poses=False)
+            lean = _core.compensate_program(robot, str(src), str(out),
+                                            _core.ProgramOptions(temperature_c=21.0, chunk_bytes=chunk, keep_poses=False))
             assert len(lean["q_deg"]) == 0 and lean["poses"] == 400
             assert (lean["iterations_min"], lean["iterations_max"], lean["iterations_total"], lean["residual_max"]) == (
                 min(res["iterations"]), max(res["iterations"]), sum(res["iterations"]), max(res["residual"]))

@@ -86,7 +86,8 @@ def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[s
     result has its count and extremes only (`poses`, `iterations_min`, ...; no per-pose arrays): a CSV or
     G-code program of any length is compensated in bounded memory."""
     warn_nominal_tcp(robot, args.model, "kincal compensate")
-    return _core.compensate_to_controller(robot, [str(p) for p in args.program], str(args.out), **comp_kwargs,
+    options = _core.ProgramOptions(**comp_kwargs, keep_poses=False)
+    return _core.compensate_to_controller(robot, [str(p) for p in args.program], str(args.out), options,
                                           format=args.format, targets=args.targets, name=args.name,
                                           speed=args.speed, zone=args.zone,
                                           max_targets_per_file=args.max_targets_per_file,
@@ -96,7 +97,7 @@ def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[s
                                           uframes=args.uframe, utools=args.utool,
                                           declarations=[str(d) for d in args.declarations],
                                           allow_branch_change=args.allow_branch_change, tracks=args.track,
-                                          threads=args.jobs, progress=progress, keep_poses=False)
+                                          threads=args.jobs, progress=progress)
 
 
 def summary(res: dict[str, Any]) -> list[str]:

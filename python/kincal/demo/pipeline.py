@@ -77,12 +77,13 @@ def _line(out: Path, b_fit: Robot, identified: Robot, diagnosed: Robot, truth: R
     poses = fk(b_fit, compensate(b_fit, base_line, compensate=False)["q_deg"], frame="instrument")
     w(str(out / "line.csv"), format_rows(["x", "y", "z", "a", "b", "c"], poses))
     w(str(out / "line.gcode"), _gcode(poses))
-    unc = _core.compensate_program(b_fit, str(out / "line.gcode"), str(out / "uncompensated.gcode"), compensate=False,
-                                   instrument=True)
-    com = _core.compensate_program(identified, str(out / "line.gcode"), str(out / "compensated.gcode"), instrument=True)
-    _core.compensate_program(identified, str(out / "line.csv"), str(out / "compensated.csv"), instrument=True)
+    tracker = _core.ProgramOptions(instrument=True)  # the line is in the tracker's frame
+    unc = _core.compensate_program(b_fit, str(out / "line.gcode"), str(out / "uncompensated.gcode"),
+                                   _core.ProgramOptions(compensate=False, instrument=True))
+    com = _core.compensate_program(identified, str(out / "line.gcode"), str(out / "compensated.gcode"), tracker)
+    _core.compensate_program(identified, str(out / "line.csv"), str(out / "compensated.csv"), tracker)
     com_d = _core.compensate_program(diagnosed, str(out / "line.gcode"), str(out / "compensated_diagnosed.gcode"),
-                                     instrument=True)
+                                     tracker)
     q_unc, q_com, q_dia = np.asarray(unc["q_deg"]), np.asarray(com["q_deg"]), np.asarray(com_d["q_deg"])
     # what the true robot does with each program: geometry, compliance and the backlash of joint 2,
     # which acts with the direction each axis arrives from (the sign of its commanded motion)

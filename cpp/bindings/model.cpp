@@ -30,6 +30,21 @@ void define_robot_calibration(py::class_<Robot>& robot) {
           },
           "the instrument placements the calibrated model knows: (name, xyz_mm, abc_deg) per setup; one\n"
           "named '' (its base_in_instrument) without setups. fk and compensate use the first.")
+      .def_property_readonly("nominal_spec", [](const Robot& r) { return r.nominal->spec(); })
+      .def_property_readonly("calibrated_spec", [](const Robot& r) { return r.calibrated->spec(); })
+      .def(
+          "with_tool",
+          [](const Robot& r, const Vec3& xyz_mm, const Vec3& abc_deg, const std::string& tcp) {
+            ModelSpec s = r.calibrated->spec();
+            s.tool = Pose6{xyz_mm, abc_deg};
+            s.tcp = tcp;
+            return Robot{r.nominal, std::make_shared<Model>(s)};
+          },
+          py::arg("xyz_mm"), py::arg("abc_deg"), py::arg("tcp"),
+          "The robot whose calibrated model has this tool frame, its origin recorded as tcp ('measured', "
+          "'tool-targets', 'nominal')")
+      .def("nominal_only", [](const Robot& r) { return Robot{r.nominal, r.nominal}; },
+           "The robot with its nominal model as its calibrated one (not identified)")
       .def_property_readonly("t_mean_s", [](const Robot& r) { return r.calibrated->spec().t_mean_s; },
                              "the drift's reference time (s), when the model carries a drift")
       .def(
@@ -94,9 +109,41 @@ void define_robot_calibration(py::class_<Robot>& robot) {
           "A robot whose calibrated model has simulated manufacturing errors (for simulations and demos)");
 }
 
+// A model's definition as Python reads it (read-only: a Robot's with_... methods make changed ones).
+void define_specs(py::module_& m) {
+  py::class_<Pose6>(m, "Pose6", "A frame: its origin (mm) and KUKA ABC angles (deg)")
+      .def_property_readonly("xyz_mm", [](const Pose6& p) { return Vec3(p.xyz); })
+      .def_property_readonly("abc_deg", [](const Pose6& p) { return Vec3(p.abc); });
+  py::class_<JointSpec>(m, "JointSpec", "One joint of a model (base frame, zero configuration; read-only)")
+      .def_readonly("name", &JointSpec::name)
+      .def_property_readonly("point_mm", [](const JointSpec& j) { return Vec3(j.point); }, "a point of the axis")
+      .def_property_readonly("axis", [](const JointSpec& j) { return Vec3(j.axis); })
+      .def_readonly("lower_deg", &JointSpec::lower_deg)
+      .def_readonly("upper_deg", &JointSpec::upper_deg)
+      .def_readonly("max_velocity_deg_s", &JointSpec::max_velocity_deg_s, "0: unknown")
+      .def_readonly("max_acceleration_deg_s2", &JointSpec::max_acceleration_deg_s2, "0: unknown")
+      .def_readonly("max_jerk_deg_s3", &JointSpec::max_jerk_deg_s3, "0: unknown")
+      .def_readonly("mass_kg", &JointSpec::mass_kg, "the link this joint moves")
+      .def_property_readonly("com_mm", [](const JointSpec& j) { return Vec3(j.com); }, "its centre of mass")
+      .def_readonly("compliance_deg_per_knm", &JointSpec::compliance_deg_per_knm);
+  py::class_<ModelSpec>(m, "ModelSpec", "What defines one robot geometry (read-only)")
+      .def_readonly("name", &ModelSpec::name)
+      .def_readonly("joints", &ModelSpec::joints)
+      .def_readonly("tool", &ModelSpec::tool, "the tool (TCP) frame in the base frame at zero configuration")
+      .def_readonly("payload_kg", &ModelSpec::payload_kg)
+      .def_property_readonly("payload_com_mm", [](const ModelSpec& s) { return Vec3(s.payload_com); },
+                             "in the tool frame")
+      .def_property_readonly("gravity", [](const ModelSpec& s) { return Vec3(s.gravity); }, "base frame, m/s^2")
+      .def_readonly("base_in_instrument", &ModelSpec::base_in_instrument)
+      .def_readonly("home_deg", &ModelSpec::home_deg)
+      .def_readonly("joint_convention", &ModelSpec::joint_convention)
+      .def_readonly("tcp", &ModelSpec::tcp, "where the tool frame comes from ('' when not recorded)");
+}
+
 }  // namespace
 
 void define_model(py::module_& m) {
+  define_specs(m);
   py::class_<Robot> robot(m, "Robot", "A robot: nominal geometry and calibrated geometry (immutable)");
   robot.def_static("load", &load_robot, py::arg("name_or_path"), "A built-in name or a model JSON file")
       .def_static("from_json", &robot_from_json, py::arg("text"), py::arg("source") = "<json>")

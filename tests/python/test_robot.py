@@ -99,20 +99,20 @@ def test_jacobian_matches_finite_differences(calibrated):
 
 
 def test_python_abc_helpers_are_exact_at_the_pole():
-    """The tool frame placed by --tool-targets and the URDF writer take ABC angles from the core: at
-    b = 90 - 1e-10 deg with every entry rounded by 2e-15 (as a kinematic chain leaves it) the angles
-    give back the rotation within 1e-5 deg (a Python copy without the pole's branch was 177 deg off)."""
+    """The tool frame placed by --tool-targets (the core's rotation_to_abc) and the URDF writer take ABC
+    angles from the core: at b = 90 - 1e-10 deg with every entry rounded by 2e-15 (as a kinematic chain
+    leaves it) the angles give back the rotation within 1e-5 deg (a Python copy without the pole's
+    branch was 177 deg off)."""
     import numpy as np
 
     from kincal import _core
-    from kincal.calibration import tool_frame
     from kincal.io import urdf
 
     rng = np.random.default_rng(3)
     for _ in range(20):
         r = _core.abc_to_rotation(np.array([rng.uniform(-179, 179), 90 - 1e-10, rng.uniform(-179, 179)]))
         r = r + rng.uniform(-2e-15, 2e-15, (3, 3))
-        for abc in (tool_frame._abc_of(r), urdf._abc(r)):
+        for abc in (_core.rotation_to_abc(r), urdf._abc(r)):
             back = _core.abc_to_rotation(np.array(abc))
             angle = np.degrees(np.arccos(np.clip((np.trace(r.T @ back) - 1) / 2, -1, 1)))
             assert angle < 1e-5, abc

@@ -163,9 +163,7 @@ def point_errors(res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
 
 def masses(robot: Robot) -> bool:
     """Whether the robot's model has link masses (--gravity auto then uses them)."""
-    import json
-
-    return any(j["mass_kg"] > 0 for j in json.loads(robot.to_json())["nominal"]["joints"])
+    return any(j.mass_kg > 0 for j in robot.nominal_spec.joints)
 
 
 def gravity_fitted(robot: Robot, gravity: str) -> bool:

@@ -30,7 +30,6 @@ candidates of each station (random touches), what the plan gains over touching a
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Union
@@ -38,7 +37,6 @@ from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Un
 import numpy as np
 
 from .. import _core
-from ..io import strict_json
 from .._core import Robot
 from . import identify as ident
 from . import simulation as sim
@@ -293,11 +291,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
 def _nominal(robot: Robot) -> Robot:
     """The robot with its nominal model as its calibrated one (the plan linearises at the nominal
     model, where identify starts; a model file from an earlier calibration carries both)."""
-    if not robot.identified:
-        return robot
-    doc = json.loads(robot.to_json())
-    return Robot.from_json(strict_json.dumps({k: v for k, v in doc.items() if k not in ("calibrated", "identification")}),
-                           "the nominal model")
+    return robot.nominal_only() if robot.identified else robot
 
 
 def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> dict[str, Any]:

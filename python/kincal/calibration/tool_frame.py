@@ -4,14 +4,12 @@ records of where its TCP comes from (the model file's top-level "tcp": "measured
 
 from __future__ import annotations
 
-import json
 import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .. import _core
-from ..io import strict_json
 from .._core import Robot
 
 if TYPE_CHECKING:
@@ -32,20 +30,11 @@ def tool_from_targets(robot: Robot, targets: FloatArray, known: FloatArray) -> R
     # identified t_k (tool frame M) = T known_k: then M' = M T puts known_k at the same points
     fit = _core.rigid_fit(known, ident_t)  # Horn; a translation for one or two targets, or collinear ones
     r, t = fit[:3, :3], fit[:3, 3]
-    doc = json.loads(robot.to_json())
-    tool = doc["calibrated"]["tool"]
-    m_r = _core.abc_to_rotation(np.asarray(tool["abc_deg"], dtype=float))
-    m_t = np.asarray(tool["xyz_mm"], dtype=float)
+    tool = robot.calibrated_spec.tool
+    m_r = _core.abc_to_rotation(np.asarray(tool.abc_deg, dtype=float))
+    m_t = np.asarray(tool.xyz_mm, dtype=float)
     new_r, new_t = m_r @ r, m_t + m_r @ t
-    tool["xyz_mm"] = new_t.tolist()
-    tool["abc_deg"] = _abc_of(new_r)
-    doc["tcp"] = "tool-targets"
-    return Robot.from_json(strict_json.dumps(doc), "<identified>")
-
-
-def _abc_of(r: FloatArray) -> list[float]:
-    """KUKA ABC (deg) of a rotation matrix, R = Rz(a) Ry(b) Rx(c) (the core's, exact at the pole)."""
-    return [float(v) for v in _core.rotation_to_abc(np.asarray(r, dtype=float))]
+    return robot.with_tool(new_t, _core.rotation_to_abc(new_r), "tool-targets")
 
 
 #: the summary's line on the TCP, by the model's "tcp"

@@ -21,7 +21,6 @@ it).
 from __future__ import annotations
 
 import functools
-import json
 import math
 import textwrap
 from pathlib import Path
@@ -180,10 +179,10 @@ def json_ready(result: dict[str, Any]) -> dict[str, Any]:
 
 def robot_limits(robot: Robot) -> tuple[list[float], list[float], list[float]]:
     """Velocity, acceleration and jerk limits (deg/s, /s^2, /s^3) of a robot's model."""
-    joints = json.loads(robot.to_json())["nominal"]["joints"]
-    v = [jt["max_velocity_deg_s"] for jt in joints]
-    a = [jt["max_acceleration_deg_s2"] for jt in joints]
-    j = [jt["max_jerk_deg_s3"] for jt in joints]
+    joints = robot.nominal_spec.joints
+    v = [jt.max_velocity_deg_s for jt in joints]
+    a = [jt.max_acceleration_deg_s2 for jt in joints]
+    j = [jt.max_jerk_deg_s3 for jt in joints]
     return v, a, j
 
 

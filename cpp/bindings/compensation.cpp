@@ -84,7 +84,8 @@ namespace {
 
 void define_program_options(py::module_& m) {
   const ProgramOptions def;
-  py::class_<ProgramOptions>(m, "ProgramOptions", "How a program is compensated (read-only; make a new one to change it)")
+  py::class_<ProgramOptions>(m, "ProgramOptions",
+                             "How a program is compensated (read-only; make a new one to change it)")
       .def(py::init([](bool comp, bool instr, bool fd, double delta, double eps, int it, bool cs,
                        const std::string& residual, std::optional<double> temp, const std::vector<double>& initial,
                        bool keep, bool keep_poses, size_t chunk_bytes) {
@@ -253,7 +254,8 @@ void define_compensation_programs(py::module_& m) {
       "file, or several files and folders (a controller backup: out is a folder with the same tree; the result lists "
       "each program with its error or files, the files copied, and how many failed; progress(done, all)). A CSV or "
       "G-code program written as CSV or G-code joints is read and written a chunk of options.chunk_bytes at a time; "
-      "with options.keep_poses=False its result has no per-pose arrays (poses, iterations_min/max/total and residual_max say "
+      "with options.keep_poses=False its result has no per-pose arrays (poses, iterations_min/max/total and "
+      "residual_max say "
       "what the summary needs), so that a program of any length is compensated in bounded memory");
 }
 

@@ -326,7 +326,8 @@ int main(int argc, char** argv) {
     if (program.empty() || a.out.empty()) throw kincal::InputError("--program and --out are needed (or --stream)");
     const kincal::WriterOptions w = writer_options(a);
     const kincal::NativeOptions n = native_options(a);
-    if (a.programs.size() > 1 || kincal::is_folder(program)) return run_backup(robot, a, opt, w, n);  // a controller backup
+    if (a.programs.size() > 1 || kincal::is_folder(program))  // a controller backup
+      return run_backup(robot, a, opt, w, n);
     return run_program(robot, a, program, opt, w, n);
   } catch (const kincal::InputError& e) {
     std::fprintf(stderr, "kincal-compensate: error: %s\n", e.what());

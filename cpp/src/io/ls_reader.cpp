@@ -392,7 +392,6 @@ void read_ls_targets(const LsSections& sc, const LsMotions& mo, const std::vecto
   }
 }
 
-
 }  // namespace
 
 NativeProgram read_ls_program(const std::string& path) {

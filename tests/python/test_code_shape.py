@@ -2,8 +2,8 @@
 tests over 500 lines (python/kincal, cpp/, benchmarks' own sources), no function over 100 lines
 (Python: every def, methods and nested ones included, from its `def` line to its last; C++: every
 function defined at namespace level, from the line its declaration starts on to its closing brace at
-column 0, the style every file here follows; lambdas and member functions defined inside a class
-count with their enclosing function or class)."""
+column 0, the style every file here follows; a lambda counts with its enclosing function, and member
+functions defined inside a class or struct body are not measured)."""
 
 from __future__ import annotations
 

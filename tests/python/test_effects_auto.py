@@ -187,5 +187,5 @@ def test_the_choice_offers_compliance_exactly_where_the_core_fits_it(robots):
             res = problem.fits[0][1]
             free = (np.asarray(res.fixed) == 0) & ~np.isfinite(np.asarray(res.prior_sd))
             refused += not fits
-            edge += fits and int(free.sum()) + problem.size(jc) == n
+            edge += fits and int(free.sum()) + int(np.sum(res.held_unseen)) + problem.size(jc) == n
     assert refused and edge, (refused, edge)

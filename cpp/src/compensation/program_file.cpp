@@ -80,14 +80,6 @@ ProgramResult compensate_program_whole(const Robot& robot, const std::string& in
   return res;
 }
 
-}  // namespace
-
-namespace {
-
-// One pass over the file, pose after pose from the directions dir0: into out when given; first_motion:
-// the direction of each joint's first motion (motion_directions' first row). An error of a pose (its
-// temperature missing, its compensation failing) waits for the rest of the file, whose broken lines
-// come first, as when the program was read before it was compensated.
 struct ProgramFile {  // a pose program file and how it is compensated
   const Robot& robot;
   const ProgramOptions& opt;
@@ -96,6 +88,10 @@ struct ProgramFile {  // a pose program file and how it is compensated
   std::vector<Extrapolation> periodic;  // the joints whose periodic effects were fitted on a range of angles
 };
 
+// One pass over the file, pose after pose from the directions dir0: into out when given; first_motion:
+// the direction of each joint's first motion (motion_directions' first row). An error of a pose (its
+// temperature missing, its compensation failing) waits for the rest of the file, whose broken lines
+// come first, as when the program was read before it was compensated.
 ProgramResult program_pass(const ProgramFile& f, const Vec6& dir0, JointProgramOutput* out, Vec6* first_motion) {
   PoseProgramReader rd(f.in_path, f.opt.chunk_bytes);
   ProgramResult res;

@@ -156,40 +156,40 @@ namespace {
 // name and value (added to the end of the declaration's last line, so that no line number moves)
 void add_target_copies(const NativeProgram& p, const std::vector<Pose6>& pose, const std::vector<ControllerTarget>& t,
                        const std::vector<bool>& joints, std::vector<std::vector<std::string>>& lines) {
-for (size_t k = 0; k < p.targets.size(); ++k) {
-  const NativeTarget& nt = p.targets[k];
-  if (nt.copy_of < 0) continue;
-  const NativeTarget& orig = p.targets[static_cast<size_t>(nt.copy_of)];
-  const auto& f = p.lines[static_cast<size_t>(orig.file)];
-  const int last = std::max(orig.line, orig.last_line);
-  std::string decl;
-  for (int l = orig.line; l <= last; ++l) decl += f[static_cast<size_t>(l - 1)] + (l < last ? "\n" : "");
-  const size_t end = decl.size() - f[static_cast<size_t>(last - 1)].size() + orig.end;
-  const std::string old = decl.substr(orig.begin, end - orig.begin);
-  const bool as_joints = k < joints.size() && joints[k];
-  std::string now;
-  if (p.format == ControllerFormat::Krl)
-    now = as_joints ? krl_axis(old, t[k].q_deg)
-                    : krl_aggregate(old, pose[k], t[k], upper_case(decl.substr(0, orig.begin)).find("FRAME") != std::string::npos);
-  else if (p.format == ControllerFormat::Rapid)
-    now = as_joints ? rapid_jointtarget(old, t[k].q_deg) : rapid_robtarget(old, pose[k], t[k]);
-  else
-    throw InputError(where(p.paths[static_cast<size_t>(orig.file)], orig.line) + ": a copy of a " +
-                     format_name(p.format) + " target is not written");
-  decl.replace(orig.begin, end - orig.begin, now);
-  // the name: its first whole word before the value
-  const std::string head = upper_case(decl.substr(0, orig.begin)), name = upper_case(orig.name);
-  size_t at = std::string::npos;
-  for (size_t i = head.find(name); i != std::string::npos; i = head.find(name, i + 1)) {
-    const auto word = [&](size_t c) { return c < head.size() && (std::isalnum(static_cast<unsigned char>(head[c])) || head[c] == '_'); };
-    if ((i == 0 || !word(i - 1)) && !word(i + name.size())) { at = i; break; }
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    const NativeTarget& nt = p.targets[k];
+    if (nt.copy_of < 0) continue;
+    const NativeTarget& orig = p.targets[static_cast<size_t>(nt.copy_of)];
+    const auto& f = p.lines[static_cast<size_t>(orig.file)];
+    const int last = std::max(orig.line, orig.last_line);
+    std::string decl;
+    for (int l = orig.line; l <= last; ++l) decl += f[static_cast<size_t>(l - 1)] + (l < last ? "\n" : "");
+    const size_t end = decl.size() - f[static_cast<size_t>(last - 1)].size() + orig.end;
+    const std::string old = decl.substr(orig.begin, end - orig.begin);
+    const bool as_joints = k < joints.size() && joints[k];
+    std::string now;
+    if (p.format == ControllerFormat::Krl)
+      now = as_joints ? krl_axis(old, t[k].q_deg)
+                      : krl_aggregate(old, pose[k], t[k], upper_case(decl.substr(0, orig.begin)).find("FRAME") != std::string::npos);
+    else if (p.format == ControllerFormat::Rapid)
+      now = as_joints ? rapid_jointtarget(old, t[k].q_deg) : rapid_robtarget(old, pose[k], t[k]);
+    else
+      throw InputError(where(p.paths[static_cast<size_t>(orig.file)], orig.line) + ": a copy of a " +
+                       format_name(p.format) + " target is not written");
+    decl.replace(orig.begin, end - orig.begin, now);
+    // the name: its first whole word before the value
+    const std::string head = upper_case(decl.substr(0, orig.begin)), name = upper_case(orig.name);
+    size_t at = std::string::npos;
+    for (size_t i = head.find(name); i != std::string::npos; i = head.find(name, i + 1)) {
+      const auto word = [&](size_t c) { return c < head.size() && (std::isalnum(static_cast<unsigned char>(head[c])) || head[c] == '_'); };
+      if ((i == 0 || !word(i - 1)) && !word(i + name.size())) { at = i; break; }
+    }
+    if (at == std::string::npos)
+      throw InputError(where(p.paths[static_cast<size_t>(orig.file)], orig.line) + ": " + orig.name +
+                       "'s declaration does not name it");
+    decl.replace(at, name.size(), nt.name);
+    lines[static_cast<size_t>(orig.file)][static_cast<size_t>(last - 1)] += "\n" + decl;
   }
-  if (at == std::string::npos)
-    throw InputError(where(p.paths[static_cast<size_t>(orig.file)], orig.line) + ": " + orig.name +
-                     "'s declaration does not name it");
-  decl.replace(at, name.size(), nt.name);
-  lines[static_cast<size_t>(orig.file)][static_cast<size_t>(last - 1)] += "\n" + decl;
-}
 }
 
 }  // namespace

@@ -336,9 +336,11 @@ class SerialProblem:
         return int(effect.size)
 
     def admits(self, effects: Sequence[Candidate], cand: Candidate) -> bool:
-        """Whether the core fits the model with ``cand`` added (its rule, fit_setup's free_parameters:
-        no more free parameters without a prior, frames held as unseen included, than the data have
-        points): the starting fit's and every added effect's."""
+        """Whether the core fits the model with ``cand`` added, by its rule for a fit with priors
+        (fit_setup's free_parameters: no more free parameters without a prior, frames held as unseen
+        included, than the data have rows): the starting fit's and every added effect's. Without any
+        prior the core counts equations against every free parameter instead, and this rule is the
+        stricter of the two."""
         if not self.fits:
             return True
         start_effects, res = self.fits[0]

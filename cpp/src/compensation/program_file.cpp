@@ -185,14 +185,11 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
   if (opt.compensate)
     for (const Extrapolation& e : periodic_joints(cal.spec()))
       if (e.joint <= 6) periodic.push_back(e);
-  ProgramFile f{robot, opt, in_path, needs_dir, needs_t, periodic};
-  auto pass = [&](const Vec6& dir0, JointProgramOutput* out, Vec6* first_motion) {
-    return program_pass(f, dir0, out, first_motion);
-  };
+  const ProgramFile f{robot, opt, in_path, needs_dir, needs_t, std::move(periodic)};
   auto write = [&](const Vec6& dir0) {
     AtomicFileWriter file(out_path, opt.chunk_bytes);
     JointProgramOutput out(file, program_format(in_path), format);
-    ProgramResult res = pass(dir0, &out, nullptr);
+    ProgramResult res = program_pass(f, dir0, &out, nullptr);
     out.finish();
     return res;
   };
@@ -200,7 +197,7 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
   if (opt.initial_direction.empty()) {
     // the direction of the first motion: from a first pass that assumes +1, then the program again
     Vec6 first;
-    pass(Vec6::Ones(), nullptr, &first);
+    program_pass(f, Vec6::Ones(), nullptr, &first);
     return write(first);
   }
   Vec6 dir0;

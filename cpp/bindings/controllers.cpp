@@ -101,22 +101,22 @@ void define_controllers(py::module_& m) {
   m.def(
       "joints_to_controller",
       [](const Robot& r, Eigen::MatrixXd q) {
-        if (q.cols() != r.nominal->dof()) throw InputError("joints_to_controller: one column per joint");
+        if (q.cols() != r.nominal()->dof()) throw InputError("joints_to_controller: one column per joint");
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a = q;
-        for (Eigen::Index i = 0; i < a.rows(); ++i) joints_to_controller(r.nominal->spec(), a.row(i).data(), int(a.cols()));
+        for (Eigen::Index i = 0; i < a.rows(); ++i) joints_to_controller(r.nominal()->spec(), a.row(i).data(), int(a.cols()));
         return Eigen::MatrixXd(a);
       },
       py::arg("robot"), py::arg("q_deg"), "The model's joint angles (N x dof, deg) as the controller numbers them");
   m.def(
       "joints_from_controller",
       [](const Robot& r, Eigen::MatrixXd q) {
-        if (q.cols() != r.nominal->dof()) throw InputError("joints_from_controller: one column per joint");
+        if (q.cols() != r.nominal()->dof()) throw InputError("joints_from_controller: one column per joint");
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a = q;
-        for (Eigen::Index i = 0; i < a.rows(); ++i) joints_from_controller(r.nominal->spec(), a.row(i).data(), int(a.cols()));
+        for (Eigen::Index i = 0; i < a.rows(); ++i) joints_from_controller(r.nominal()->spec(), a.row(i).data(), int(a.cols()));
         return Eigen::MatrixXd(a);
       },
       py::arg("robot"), py::arg("q_deg"), "The controller's joint numbers (N x dof, deg) as the model's angles");
   m.def(
-      "joint_convention", [](const Robot& r) { return r.nominal->spec().joint_convention; }, py::arg("robot"),
+      "joint_convention", [](const Robot& r) { return r.nominal()->spec().joint_convention; }, py::arg("robot"),
       "The robot's joint convention: '' (the model's own angles) or 'fanuc'");
 }

@@ -172,7 +172,7 @@ void define_identify_functions(py::module_& m) {
         o.noise_mm = noise_mm, o.orientation_noise_deg = orientation_noise_deg;
         o.outlier_fraction = outlier_fraction, o.outlier_mm = outlier_mm;
         o.targets = targets_from(targets), o.effects = effect_values_from(effects), o.t_ref = t_ref;
-        return measurements_to_dict(simulate(*truth.calibrated, o), truth.calibrated->dof());
+        return measurements_to_dict(simulate(*truth.calibrated(), o), truth.calibrated()->dof());
       },
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
@@ -184,7 +184,7 @@ void define_identify_functions(py::module_& m) {
   m.def(
       "point_errors",
       [](const Robot& r, const RowMatrix& targets, const py::dict& d, const std::vector<StationValue>& stations) {
-        const auto e = point_errors(*r.calibrated, targets_from(targets), measurements_from_dict(d, r.calibrated->dof()),
+        const auto e = point_errors(*r.calibrated(), targets_from(targets), measurements_from_dict(d, r.calibrated()->dof()),
                                     stations);
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
@@ -195,7 +195,7 @@ void define_identify_functions(py::module_& m) {
   m.def(
       "check_effect_columns",
       [](const Robot& r, const py::dict& d, const std::vector<Effect>& effects) {
-        check_effect_columns(*r.nominal, measurements_from_dict(d, r.nominal->dof()), effects);
+        check_effect_columns(*r.nominal(), measurements_from_dict(d, r.nominal()->dof()), effects);
       },
       py::arg("robot"), py::arg("data"), py::arg("effects"),
       "ValueError (file:line of the first row without it) unless the data carry every column the effects\n"
@@ -203,7 +203,7 @@ void define_identify_functions(py::module_& m) {
   m.def(
       "orientation_errors",
       [](const Robot& r, const py::dict& d) {
-        const auto e = orientation_errors(*r.calibrated, measurements_from_dict(d, r.calibrated->dof()));
+        const auto e = orientation_errors(*r.calibrated(), measurements_from_dict(d, r.calibrated()->dof()));
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("data"),
@@ -453,13 +453,13 @@ void define_identify_call(py::module_& m) {
       "identify",
       [](const Robot& robot, const py::dict& d, const IdentifyOptions& options, py::object progress,
          bool from_calibrated) {
-        const Model& nominal = from_calibrated ? *robot.calibrated : *robot.nominal;
+        const Model& nominal = from_calibrated ? *robot.calibrated() : *robot.nominal();
         const MeasurementSet data = measurements_from_dict(d, nominal.dof());
         IdentifyOptions o = core_options(options, nominal);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
         PyIdentifyResult out{identify(nominal, data, o), Robot{}, Robot{}};
-        out.robot = Robot{robot.nominal, std::make_shared<const Model>(out.r.calibrated)};
-        out.nominal_fitted = Robot{robot.nominal, std::make_shared<const Model>(out.r.nominal_fitted)};
+        out.robot = Robot{robot.nominal(), std::make_shared<const Model>(out.r.calibrated)};
+        out.nominal_fitted = Robot{robot.nominal(), std::make_shared<const Model>(out.r.nominal_fitted)};
         return out;
       },
       py::arg("robot"), py::arg("data"), py::arg("options") = IdentifyOptions{}, py::arg("progress") = py::none(),

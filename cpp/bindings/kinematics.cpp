@@ -18,7 +18,7 @@ namespace {
 // The calibrated or nominal model of r, once the joint angles q (rows of dof columns) are checked
 // against it.
 const Model& checked_model(const Robot& r, bool calibrated, const RowMatrix& q) {
-  const Model& m = calibrated ? *r.calibrated : *r.nominal;
+  const Model& m = calibrated ? *r.calibrated() : *r.nominal();
   if (q.cols() != m.dof())
     throw InputError("joint angles have " + std::to_string(q.cols()) + " columns, the robot has " +
                      std::to_string(m.dof()) + " joints");
@@ -159,7 +159,7 @@ void define_kinematics_solvers(py::module_& m) {
       [](const Robot& r, const Vec6& pose, py::object ref) {
         const IkSolver& ik = r.ik();
         if (!ik.structure().spherical_wrist_parallel_23)
-          throw InputError("robot '" + r.nominal->spec().name + "' has no closed-form IK: " + ik.structure().reason);
+          throw InputError("robot '" + r.nominal()->spec().name + "' has no closed-form IK: " + ik.structure().reason);
         if (!pose.allFinite()) throw InputError("pose contains NaN or infinite values");
         std::vector<double> rv;
         if (!ref.is_none()) rv = ref.cast<std::vector<double>>();

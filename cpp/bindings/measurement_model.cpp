@@ -70,7 +70,7 @@ void define_probe_stations(py::module_& m) {
   m.def(
       "simulate_probe",
       [](const Robot& truth, const ProbeSimulationOptions& o) {
-        return measurements_to_dict(simulate_probe(*truth.calibrated, o), truth.calibrated->dof());
+        return measurements_to_dict(simulate_probe(*truth.calibrated(), o), truth.calibrated()->dof());
       },
       py::arg("truth"), py::arg("options"),
       "A probe campaign on the calibrated (true) model of a robot: every row's ball centre on its\n"
@@ -82,7 +82,7 @@ void define_point_model(py::module_& m) {
       .def(py::init([](const Robot& r, int n_targets, const std::vector<Effect>& effects, double t_ref,
                        bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
                        std::optional<double> t_mean_s, bool fit_gravity, const ParamLayout* stations_of) {
-             std::shared_ptr<const Model> m = from_calibrated ? r.calibrated : r.nominal;
+             std::shared_ptr<const Model> m = from_calibrated ? r.calibrated() : r.nominal();
              LayoutOptions o{n_targets, effects, t_ref, setup_names_or_model(setups, *m),
                              t_mean_s ? *t_mean_s : m->spec().t_mean_s, fit_gravity};
              if (stations_of) {

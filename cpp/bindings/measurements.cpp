@@ -248,7 +248,7 @@ void define_measurements(py::module_& m) {
       "read_measurements",
       [](const std::string& path, int dof, const Robot* robot) {
         MeasurementSet ms = read_measurements(path, dof);
-        if (robot) measurements_from_controller(ms, robot->nominal->spec());  // the controller's numbers
+        if (robot) measurements_from_controller(ms, robot->nominal()->spec());  // the controller's numbers
         return measurements_to_dict(ms, dof);
       },
       py::arg("path"), py::arg("dof"), py::arg("robot") = nullptr);

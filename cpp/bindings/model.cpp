@@ -18,77 +18,77 @@ namespace {
 // What a robot's calibrated model carries besides its geometry (placements, tool frame, the angles
 // its fit saw, effects' data needs), and the robots made from one with those changed.
 void define_robot_calibration(py::class_<Robot>& robot) {
-  robot.def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated->spec().t_ref_c; })
+  robot.def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated()->spec().t_ref_c; })
       .def_property_readonly(
           "placements",
           [](const Robot& r) {
             std::vector<std::tuple<std::string, Vec3, Vec3>> out;
-            const ModelSpec& s = r.calibrated->spec();
+            const ModelSpec& s = r.calibrated()->spec();
             if (s.setups.empty()) out.emplace_back("", s.base_in_instrument.xyz, s.base_in_instrument.abc);
             for (const SetupFrame& f : s.setups) out.emplace_back(f.name, f.base_in_instrument.xyz, f.base_in_instrument.abc);
             return out;
           },
           "the instrument placements the calibrated model knows: (name, xyz_mm, abc_deg) per setup; one\n"
           "named '' (its base_in_instrument) without setups. fk and compensate use the first.")
-      .def_property_readonly("nominal_spec", [](const Robot& r) { return r.nominal->spec(); })
-      .def_property_readonly("calibrated_spec", [](const Robot& r) { return r.calibrated->spec(); })
+      .def_property_readonly("nominal_spec", [](const Robot& r) { return r.nominal()->spec(); })
+      .def_property_readonly("calibrated_spec", [](const Robot& r) { return r.calibrated()->spec(); })
       .def(
           "with_tool",
           [](const Robot& r, const Vec3& xyz_mm, const Vec3& abc_deg, const std::string& tcp) {
-            ModelSpec s = r.calibrated->spec();
+            ModelSpec s = r.calibrated()->spec();
             s.tool = Pose6{xyz_mm, abc_deg};
             s.tcp = tcp;
-            return Robot{r.nominal, std::make_shared<Model>(s)};
+            return Robot{r.nominal(), std::make_shared<Model>(s)};
           },
           py::arg("xyz_mm"), py::arg("abc_deg"), py::arg("tcp"),
           "The robot whose calibrated model has this tool frame, its origin recorded as tcp ('measured', "
           "'tool-targets', 'nominal')")
-      .def("nominal_only", [](const Robot& r) { return Robot{r.nominal, r.nominal}; },
+      .def("nominal_only", [](const Robot& r) { return Robot{r.nominal(), r.nominal()}; },
            "The robot with its nominal model as its calibrated one (not identified)")
-      .def_property_readonly("t_mean_s", [](const Robot& r) { return r.calibrated->spec().t_mean_s; },
+      .def_property_readonly("t_mean_s", [](const Robot& r) { return r.calibrated()->spec().t_mean_s; },
                              "the drift's reference time (s), when the model carries a drift")
       .def(
           "with_placements",
           [](const Robot& r, const std::vector<std::tuple<std::string, Vec3, Vec3>>& setups) {
             if (setups.empty()) throw InputError("with_placements: at least one placement");
-            ModelSpec s = r.calibrated->spec();
+            ModelSpec s = r.calibrated()->spec();
             s.base_in_instrument = Pose6{std::get<1>(setups[0]), std::get<2>(setups[0])};
             s.setups.clear();
             if (setups.size() > 1)
               for (const auto& [name, xyz, abc] : setups) s.setups.push_back(SetupFrame{name, Pose6{xyz, abc}});
-            return Robot{r.nominal, std::make_shared<Model>(s)};
+            return Robot{r.nominal(), std::make_shared<Model>(s)};
           },
           py::arg("setups"),
           "The robot with its calibrated model seen from these placements: (name, xyz_mm, abc_deg) per\n"
           "setup, the first its base_in_instrument (one: no setups)")
-      .def_property_readonly("tcp", [](const Robot& r) { return r.calibrated->spec().tcp; },
+      .def_property_readonly("tcp", [](const Robot& r) { return r.calibrated()->spec().tcp; },
                              "where the calibrated model's tool frame comes from: 'measured' (6-D rows), "
                              "'tool-targets', 'nominal' (reflectors only), '' when not recorded")
       .def("tcp_warning", [](const Robot& r, const std::string& source) { return tcp_warning(r, source); },
            py::arg("source"),
            "The one warning line for a model whose TCP is nominal (not measured), naming source; '' otherwise")
-      .def_property_readonly("fitted_ranges_deg", [](const Robot& r) { return r.calibrated->spec().fitted_deg; },
+      .def_property_readonly("fitted_ranges_deg", [](const Robot& r) { return r.calibrated()->spec().fitted_deg; },
                              "per joint, the angles the identification saw ([lo, hi] deg); empty when unknown")
       .def(
           "with_fitted_ranges",
           [](const Robot& r, const std::vector<JointRange>& ranges) {
             if (!r.identified()) throw InputError("with_fitted_ranges: a nominal robot was fitted on nothing");
-            ModelSpec s = r.calibrated->spec();
-            if (!ranges.empty()) check_joint_ranges(ranges, r.calibrated->dof(), "with_fitted_ranges");
+            ModelSpec s = r.calibrated()->spec();
+            if (!ranges.empty()) check_joint_ranges(ranges, r.calibrated()->dof(), "with_fitted_ranges");
             s.fitted_deg = ranges;
-            return Robot{r.nominal, std::make_shared<Model>(s)};
+            return Robot{r.nominal(), std::make_shared<Model>(s)};
           },
           py::arg("ranges"), "The robot whose calibrated model records the angles its fit saw (joint_ranges())")
-      .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated->needs_dir(); },
+      .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated()->needs_dir(); },
                              "backlash: the direction of motion into each pose is needed")
-      .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated->needs_temperature(); },
+      .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated()->needs_temperature(); },
                              "thermal expansion: the temperature is needed")
       .def(
           "with_effects",
           [](const Robot& r, const std::vector<std::pair<Effect, std::vector<double>>>& effects, double t_ref) {
             std::vector<EffectValue> ev;
             for (const auto& [e, p] : effects) ev.push_back(EffectValue{e, p});
-            return Robot{r.nominal, std::make_shared<Model>(with_effects(r.calibrated->spec(), ev, t_ref))};
+            return Robot{r.nominal(), std::make_shared<Model>(with_effects(r.calibrated()->spec(), ev, t_ref))};
           },
           py::arg("effects"), py::arg("t_ref") = 20.0,
           "The robot with effects (Effect, values in core units) added to its calibrated model")
@@ -96,13 +96,13 @@ void define_robot_calibration(py::class_<Robot>& robot) {
           "with_calibrated",
           [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance,
              std::optional<std::array<double, 6>> instrument) {
-            ModelSpec s = perturbed_spec(r.nominal->spec(), seed, sigma_mm, sigma_deg, compliance);
+            ModelSpec s = perturbed_spec(r.nominal()->spec(), seed, sigma_mm, sigma_deg, compliance);
             if (instrument) {
               const auto& v = *instrument;
               s.base_in_instrument.xyz = Vec3(v[0], v[1], v[2]);
               s.base_in_instrument.abc = Vec3(v[3], v[4], v[5]);
             }
-            return Robot{r.nominal, std::make_shared<Model>(s)};
+            return Robot{r.nominal(), std::make_shared<Model>(s)};
           },
           py::arg("seed"), py::arg("sigma_mm") = 1.0, py::arg("sigma_deg") = 0.05, py::arg("compliance") = 0.0,
           py::arg("base_in_instrument") = py::none(),
@@ -153,26 +153,26 @@ void define_model(py::module_& m) {
            }, py::arg("source"), py::arg("convention"),
            "The robot read from source numbered as its controller numbers the joints (fanuc; '': the model's own); "
            "a model JSON carries its own")
-      .def_property_readonly("dof", [](const Robot& r) { return r.nominal->dof(); })
+      .def_property_readonly("dof", [](const Robot& r) { return r.nominal()->dof(); })
       .def_property_readonly("identified", &Robot::identified)
-      .def_property_readonly("name", [](const Robot& r) { return r.nominal->spec().name; })
-      .def_property_readonly("compliance_count", [](const Robot& r) { return r.nominal->compliance_count(); })
-      .def_property_readonly("geometric_parameter_count", [](const Robot& r) { return 4 * r.nominal->dof() + 6; })
+      .def_property_readonly("name", [](const Robot& r) { return r.nominal()->spec().name; })
+      .def_property_readonly("compliance_count", [](const Robot& r) { return r.nominal()->compliance_count(); })
+      .def_property_readonly("geometric_parameter_count", [](const Robot& r) { return 4 * r.nominal()->dof() + 6; })
       .def_property_readonly("closed_form_ik",
                              [](const Robot& r) { return r.ik().structure().spherical_wrist_parallel_23; })
       .def_property_readonly("ik_reason", [](const Robot& r) { return r.ik().structure().reason; })
-      .def_property_readonly("home_deg", [](const Robot& r) { return r.nominal->spec().home_deg; })
+      .def_property_readonly("home_deg", [](const Robot& r) { return r.nominal()->spec().home_deg; })
       .def_property_readonly("limits_deg",
                              [](const Robot& r) {
                                std::vector<std::pair<double, double>> l;
-                               for (const auto& j : r.nominal->spec().joints) l.emplace_back(j.lower_deg, j.upper_deg);
+                               for (const auto& j : r.nominal()->spec().joints) l.emplace_back(j.lower_deg, j.upper_deg);
                                return l;
                              })
       .def_property_readonly(
           "effects",
           [](const Robot& r) {
             py::list l;
-            for (const auto& ev : r.calibrated->spec().effects) l.append(py::make_tuple(ev.effect, ev.p));
+            for (const auto& ev : r.calibrated()->spec().effects) l.append(py::make_tuple(ev.effect, ev.p));
             return l;
           },
           "the calibrated model's effects besides compliance: (Effect, values in core units)");
@@ -205,10 +205,10 @@ void define_model(py::module_& m) {
   m.def(
       "extrapolated",
       [](const Robot& r, const RowMatrix& q_deg) {
-        if (q_deg.rows() > 0 && q_deg.cols() != r.calibrated->dof())
+        if (q_deg.rows() > 0 && q_deg.cols() != r.calibrated()->dof())
           throw InputError("extrapolated: " + std::to_string(q_deg.cols()) + " joint columns for a robot of " +
-                           std::to_string(r.calibrated->dof()));
-        return extrapolated(r.calibrated->spec(), q_deg.data(), q_deg.rows(), r.calibrated->dof());
+                           std::to_string(r.calibrated()->dof()));
+        return extrapolated(r.calibrated()->spec(), q_deg.data(), q_deg.rows(), r.calibrated()->dof());
       },
       py::arg("robot"), py::arg("q_deg"),
       "The joints whose periodic effects (transmission_error, joint_map) rows of joint angles (deg) take\n"

@@ -44,7 +44,7 @@ struct Truth {
 };
 
 Truth truth_of(const Robot& r, const Vec6& q) {
-  const Model& m = *r.nominal;
+  const Model& m = *r.nominal();
   Vec6 q0 = q;
   q0[0] = 0;  // the A1 system: axis 1 turned back
   const Vec3 wc0 = r.ik().structure().wrist_center;  // at the zero configuration
@@ -78,7 +78,7 @@ TEST(Branch, BranchDataAreTheControllersDefinitions) {
   std::mt19937_64 rng(test::test_seed(81));
   int checked = 0, behind = 0, down = 0, negative = 0;
   while (checked < test::count(2000)) {
-    const Vec6 q = test::random_q(*r.nominal, rng);
+    const Vec6 q = test::random_q(*r.nominal(), rng);
     const Truth t = truth_of(r, q);
     if (border_distance(q) < 1e-3 || std::abs(t.x_a1) < 1.0) continue;
     ++checked;
@@ -122,12 +122,12 @@ TEST(Branch, SelectionBringsBackTheTaughtConfiguration) {
   double worst = 0;
   int checked = 0;
   while (checked < test::count(500)) {
-    const Vec6 q = test::random_q(*r.nominal, rng);
-    if (border_distance(q) < 1e-3 || test::singularity_distance_deg(*r.nominal, q) < 2.0) continue;
+    const Vec6 q = test::random_q(*r.nominal(), rng);
+    if (border_distance(q) < 1e-3 || test::singularity_distance_deg(*r.nominal(), q) < 2.0) continue;
     ++checked;
     ControllerTarget t;
     t.q_deg = q;
-    t.pose = iso_to_pose(fk(*r.nominal, VecQ(q * kDeg)));
+    t.pose = iso_to_pose(fk(*r.nominal(), VecQ(q * kDeg)));
     set_branch_data(r, t);
     for (ControllerFormat f : kBranchFormats) {
       std::string why;
@@ -155,9 +155,9 @@ TEST(Branch, DifferenceNamesTheArmAndTheTurns) {
   Vec6 turned = q, flipped = q;
   turned[3] -= 360;
   flipped[3] += 180, flipped[4] = -flipped[4], flipped[5] += 180;
-  ASSERT_LT((fk(*r.nominal, VecQ(flipped * kDeg)).matrix() - fk(*r.nominal, VecQ(q * kDeg)).matrix()).norm(), 1e-9);
+  ASSERT_LT((fk(*r.nominal(), VecQ(flipped * kDeg)).matrix() - fk(*r.nominal(), VecQ(q * kDeg)).matrix()).norm(), 1e-9);
   // another elbow: the nominal solution of the pose with the elbow down
-  const IkSolutions all = r.ik().solve(fk(*r.nominal, VecQ(q * kDeg)), IkOptions(q));
+  const IkSolutions all = r.ik().solve(fk(*r.nominal(), VecQ(q * kDeg)), IkOptions(q));
   int other = -1;
   for (int k = 0; k < all.count; ++k)
     if (!truth_of(r, all.sol[k].q_deg).elbow_up && !truth_of(r, all.sol[k].q_deg).behind) other = k;
@@ -198,7 +198,7 @@ TEST(Branch, BorderToleranceUnwrapsAJointReadBackAcrossItsBorder) {
   EXPECT_EQ(t.abb_conf[0], 0);
   Vec6 read = q;
   read[0] = -2e-6;
-  t.pose = iso_to_pose(fk(*r.nominal, VecQ(read * kDeg)));
+  t.pose = iso_to_pose(fk(*r.nominal(), VecQ(read * kDeg)));
   std::string why;
   const auto krl_exact = select_branch(r, ControllerFormat::Krl, t, &why, 0);
   ASSERT_TRUE(krl_exact.has_value()) << why;
@@ -218,7 +218,7 @@ TEST(Branch, BorderToleranceUnwrapsAJointReadBackAcrossItsBorder) {
   set_branch_data(r, t6);
   Vec6 read6 = q6;
   read6[5] = 180 - 2e-6;  // turn 0 by the numbers
-  t6.pose = iso_to_pose(fk(*r.nominal, VecQ(read6 * kDeg)));
+  t6.pose = iso_to_pose(fk(*r.nominal(), VecQ(read6 * kDeg)));
   const auto fanuc = select_branch(r, ControllerFormat::FanucLs, t6, &why, 0);
   ASSERT_TRUE(fanuc.has_value()) << why;
   // the turn number is written after the letters: the selection adds its 360 deg to the wrapped angle
@@ -240,7 +240,7 @@ TEST(Branch, FanucBorderToleranceAtTheTurnBorder) {
   Vec6 read = q;
   read[3] = -180 - 2e-6;
   read[5] = 180 - 2e-6;
-  t.pose = iso_to_pose(fk(*r.nominal, VecQ(read * kDeg)));
+  t.pose = iso_to_pose(fk(*r.nominal(), VecQ(read * kDeg)));
   std::string why;
   const auto sel = select_branch(r, ControllerFormat::FanucLs, t, &why, 1e-4);
   ASSERT_TRUE(sel.has_value()) << why;

@@ -61,7 +61,7 @@ std::string line_csv(const std::string& name, int count, double step_mm) {
 
 /// Where the calibrated model's tool stands at q against a wanted pose: mm and deg.
 std::pair<double, double> miss(const Robot& r, const Vec6& q, const Eigen::Isometry3d& want) {
-  const Eigen::Isometry3d got = fk_compliant(*r.calibrated, VecQ(q * kDeg));
+  const Eigen::Isometry3d got = fk_compliant(*r.calibrated(), VecQ(q * kDeg));
   return {(got.translation() - want.translation()).norm(), test::rot_dist(got.linear(), want.linear()) / kDeg};
 }
 
@@ -162,7 +162,7 @@ TEST(ControllerProgram, NativeKrlProgramWithPerTargetFrames) {
     ControllerTarget b;
     b.q_deg = taught[k];
     set_branch_data(r, b);
-    const Eigen::Isometry3d tcp = fk(*r.nominal, VecQ(taught[k] * kDeg));
+    const Eigen::Isometry3d tcp = fk(*r.nominal(), VecQ(taught[k] * kDeg));
     const Eigen::Isometry3d base = k == 0 ? pb : pb * pose_to_iso(base1);
     const Eigen::Isometry3d tool = k == 0 ? Eigen::Isometry3d::Identity() : pose_to_iso(tool1);
     const Pose6 in_frame = iso_to_pose(base.inverse() * tcp * tool);
@@ -277,7 +277,7 @@ TEST(ControllerProgram, LsPositionTaughtOnItsTurnBorder) {
     t.q_deg = q;
     set_branch_data(r, t);
     ASSERT_EQ(t.fanuc_config, "N U T, 0, 0, 1");
-    const Pose6 p = iso_to_pose(fk(*r.nominal, VecQ(q * kDeg)));
+    const Pose6 p = iso_to_pose(fk(*r.nominal(), VecQ(q * kDeg)));
     const std::string in = tmp("border.ls", "/PROG  BORDER\n/ATTR\n/MN\n   1:  L P[1] 200mm/sec FINE    ;\n/POS\n"
                                "P[1]{\n   GP1:\n"
                                "\tUF : 0, UT : 1,\t\tCONFIG : '" + t.fanuc_config + "',\n\tX = " + fmt(p.xyz[0], 4) +

@@ -188,7 +188,7 @@ TEST(ControllerWriters, JointTargetsReadBack) {
 TEST(ControllerWriters, FilteredTargetsReadBackWithTheirBranchData) {
   KINCAL_SEED_TRACE(72, 9);
   const Robot robot = test::kr500_calibrated();
-  const std::vector<Vec6> q = random_joints(*robot.nominal, 72, 6);
+  const std::vector<Vec6> q = random_joints(*robot.nominal(), 72, 6);
   for (ControllerFormat f : kFormats) {
     SCOPED_TRACE(format_name(f));
     WriterOptions w;

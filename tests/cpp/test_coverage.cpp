@@ -72,8 +72,8 @@ TEST(Coverage, ModelJsonCarriesTheRangesAndRejectsBadOnes) {
   const std::string text = robot_to_json(r);
   EXPECT_NE(text.find("fitted_joint_ranges_deg"), std::string::npos);
   const Robot back = robot_from_json(text, "m.json");
-  EXPECT_EQ(back.calibrated->spec().fitted_deg, s.fitted_deg);
-  EXPECT_TRUE(back.nominal->spec().fitted_deg.empty());  // the nominal model was fitted on nothing
+  EXPECT_EQ(back.calibrated()->spec().fitted_deg, s.fitted_deg);
+  EXPECT_TRUE(back.nominal()->spec().fitted_deg.empty());  // the nominal model was fitted on nothing
   auto bad = [&](const std::string& from, const std::string& to) {
     std::string t = text;
     const size_t at = t.find(from);

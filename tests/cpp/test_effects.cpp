@@ -105,19 +105,19 @@ TEST(Effects, ModelJsonVersion2RoundTripAndVersion1Reads) {
   const std::string text = robot_to_json(Robot{nom, cal});
   EXPECT_NE(text.find("\"version\": 2"), std::string::npos);
   const Robot back = robot_from_json(text, "t.json");
-  ASSERT_EQ(back.calibrated->spec().effects.size(), cal->spec().effects.size());
+  ASSERT_EQ(back.calibrated()->spec().effects.size(), cal->spec().effects.size());
   for (size_t i = 0; i < cal->spec().effects.size(); ++i) {
-    EXPECT_TRUE(back.calibrated->spec().effects[i].effect == cal->spec().effects[i].effect);
+    EXPECT_TRUE(back.calibrated()->spec().effects[i].effect == cal->spec().effects[i].effect);
     for (size_t k = 0; k < cal->spec().effects[i].p.size(); ++k)
-      EXPECT_NEAR(back.calibrated->spec().effects[i].p[k], cal->spec().effects[i].p[k], 1e-18);
+      EXPECT_NEAR(back.calibrated()->spec().effects[i].p[k], cal->spec().effects[i].p[k], 1e-18);
   }
   for (int j = 0; j < 6; ++j)
-    EXPECT_EQ(back.calibrated->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
+    EXPECT_EQ(back.calibrated()->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
   // a version 1 file (no effects, no reference temperature) still reads
   std::string v1 = robot_to_json(Robot{nom, std::make_shared<Model>(perturbed_spec(kr500_spec(), test::test_seed(3)))});
   v1.replace(v1.find("\"version\": 2"), 12, "\"version\": 1");
   const Robot r1 = robot_from_json(v1, "v1.json");
-  EXPECT_TRUE(r1.calibrated->spec().effects.empty());
+  EXPECT_TRUE(r1.calibrated()->spec().effects.empty());
   // joint_map is written with its order and read back from it; without it, an error naming where
   EXPECT_NE(text.find("\"order\": 5"), std::string::npos);
   std::string no_order = text;

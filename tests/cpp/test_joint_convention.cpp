@@ -92,9 +92,9 @@ TEST(JointConvention, IdentifiedLikeModelJsonReloads) {
   const Robot r{std::make_shared<Model>(nom), std::make_shared<Model>(cal)};
   const std::string text = robot_to_json(r);
   const Robot back = robot_from_json(text, "fan.json");
-  EXPECT_EQ(back.nominal->spec().joint_convention, "fanuc");
-  EXPECT_EQ(back.calibrated->spec().joint_convention, "fanuc");
-  EXPECT_EQ(j3_coupling(back.calibrated->spec()), 1);
+  EXPECT_EQ(back.nominal()->spec().joint_convention, "fanuc");
+  EXPECT_EQ(back.calibrated()->spec().joint_convention, "fanuc");
+  EXPECT_EQ(j3_coupling(back.calibrated()->spec()), 1);
   EXPECT_EQ(robot_to_json(back), text);
 }
 

@@ -32,11 +32,11 @@ TEST(Model, JsonRoundTripIsExact) {
   EXPECT_EQ(robot_to_json(back), a);
   ASSERT_TRUE(back.identified());
   for (int j = 0; j < 6; ++j) {
-    EXPECT_EQ(back.calibrated->spec().joints[j].point, cal->spec().joints[j].point);  // bit-exact
-    EXPECT_EQ(back.calibrated->spec().joints[j].axis, cal->spec().joints[j].axis);
-    EXPECT_EQ(back.calibrated->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
+    EXPECT_EQ(back.calibrated()->spec().joints[j].point, cal->spec().joints[j].point);  // bit-exact
+    EXPECT_EQ(back.calibrated()->spec().joints[j].axis, cal->spec().joints[j].axis);
+    EXPECT_EQ(back.calibrated()->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
   }
-  EXPECT_EQ(back.calibrated->spec().tool.abc, cal->spec().tool.abc);
+  EXPECT_EQ(back.calibrated()->spec().tool.abc, cal->spec().tool.abc);
 }
 
 TEST(Model, TcpKeyRoundTripsAndWarnsOnlyWhenNominal) {
@@ -50,7 +50,7 @@ TEST(Model, TcpKeyRoundTripsAndWarnsOnlyWhenNominal) {
     const std::string a = robot_to_json(Robot{nom, std::make_shared<Model>(s)});
     EXPECT_NE(a.find("\"tcp\": \"" + tcp + "\""), std::string::npos);
     const Robot back = robot_from_json(a, "m.json");
-    EXPECT_EQ(back.calibrated->spec().tcp, tcp);
+    EXPECT_EQ(back.calibrated()->spec().tcp, tcp);
     EXPECT_EQ(robot_to_json(back), a);
     EXPECT_EQ(tcp_warning(back, "m.json").empty(), tcp != "nominal");
   }

@@ -127,7 +127,7 @@ std::string whole(const Robot& r, const std::string& in, ProgramFormat out, cons
   for (int l : prog.pose_line) where_of.push_back(where(in, l));
   res = compensate_poses(r, prog.poses, where_of, opt, prog.temperature_c);
   std::vector<Vec6> qc = res.q_deg;
-  for (Vec6& q : qc) joints_to_controller(r.nominal->spec(), q.data(), 6);
+  for (Vec6& q : qc) joints_to_controller(r.nominal()->spec(), q.data(), 6);
   return format_joint_program(prog, qc, out);
 }
 
@@ -143,7 +143,7 @@ std::string whole_error(const Robot& r, const std::string& in, const ProgramOpti
 TEST(ProgramChunks, OutputEqualsTheProgramReadWholeAtEveryChunkSize) {
   KINCAL_SEED_TRACE(8, 9);
   const Robot plain = test::kr500_calibrated(), every = every_effect_robot();
-  ASSERT_TRUE(every.calibrated->needs_dir());
+  ASSERT_TRUE(every.calibrated()->needs_dir());
   const Path path(120);
   struct Program {
     std::string name, text;

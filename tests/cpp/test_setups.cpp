@@ -221,12 +221,12 @@ TEST(Setups, DriftIsCarriedInertAndPlacementsRoundTrip) {
   // JSON: the setups and the drift's reference time come back
   auto nom = std::make_shared<Model>(kr500_spec());
   const Robot back = robot_from_json(robot_to_json(Robot{nom, std::make_shared<Model>(carried)}), "m.json");
-  ASSERT_EQ(back.calibrated->spec().setups.size(), 2u);
-  EXPECT_EQ(back.calibrated->spec().setups[1].name, "B");
-  EXPECT_LT((back.calibrated->spec().setups[1].base_in_instrument.xyz - second_placement().xyz).norm(), 1e-12);
-  EXPECT_EQ(back.calibrated->spec().t_mean_s, 5400);
-  ASSERT_NE(back.calibrated->drift(), nullptr);
-  for (int k = 0; k < 6; ++k) EXPECT_NEAR(back.calibrated->drift()->p[k], v[k], 1e-18);
+  ASSERT_EQ(back.calibrated()->spec().setups.size(), 2u);
+  EXPECT_EQ(back.calibrated()->spec().setups[1].name, "B");
+  EXPECT_LT((back.calibrated()->spec().setups[1].base_in_instrument.xyz - second_placement().xyz).norm(), 1e-12);
+  EXPECT_EQ(back.calibrated()->spec().t_mean_s, 5400);
+  ASSERT_NE(back.calibrated()->drift(), nullptr);
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(back.calibrated()->drift()->p[k], v[k], 1e-18);
 }
 
 TEST(Setups, HiddenDriftIsRecoveredWithinItsUncertainty) {

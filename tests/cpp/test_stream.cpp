@@ -133,7 +133,7 @@ TEST(Io, SolvePoseAllocatesNothingOnTheNearestBranch) {
   for (int i = 0; i < 50; ++i) {
     Vec6 qi = q;
     qi[0] += 0.5 * i, qi[2] -= 0.2 * i;
-    poses.push_back(iso_to_pose(fk_compliant(*r.calibrated, VecQ(qi * kDeg))));
+    poses.push_back(iso_to_pose(fk_compliant(*r.calibrated(), VecQ(qi * kDeg))));
   }
   const ProgramOptions opt;
   ASSERT_EQ(solve_pose(r, opt, poses[0], q).status, PoseStatus::Solved);

@@ -64,7 +64,7 @@ double lin_path_deviation(const Robot& r, const std::vector<Vec6>& q, const Vec3
   double worst = 0;
   Vec6 ref = q[0];
   for (size_t i = 0; i + 1 < q.size(); ++i) {
-    const Eigen::Isometry3d ta = fk(*r.nominal, VecQ(q[i] * kDeg)), tb = fk(*r.nominal, VecQ(q[i + 1] * kDeg));
+    const Eigen::Isometry3d ta = fk(*r.nominal(), VecQ(q[i] * kDeg)), tb = fk(*r.nominal(), VecQ(q[i + 1] * kDeg));
     const Eigen::Quaterniond qa(ta.linear()), qb(tb.linear());
     for (int k = 1; k <= 20; ++k) {
       const double s = k / 21.0;
@@ -76,7 +76,7 @@ double lin_path_deviation(const Robot& r, const std::vector<Vec6>& q, const Vec3
       EXPECT_GE(n, 0);
       if (n < 0) return 1e9;
       ref = sol.sol[static_cast<size_t>(n)].q_deg;
-      worst = std::max(worst, distance_to_segment(fk_compliant(*r.calibrated, VecQ(ref * kDeg)).translation(), a, b));
+      worst = std::max(worst, distance_to_segment(fk_compliant(*r.calibrated(), VecQ(ref * kDeg)).translation(), a, b));
     }
   }
   return worst;
@@ -120,8 +120,8 @@ TEST(Tolerance, JointTargetsKeepTheRealPathWithinTheTolerance) {
     ++next;
   }
   EXPECT_EQ(next, 5);
-  const double before = joint_path_deviation(*r.calibrated, plain.q_deg, a, b);
-  const double after = joint_path_deviation(*r.calibrated, t.result.q_deg, a, b);
+  const double before = joint_path_deviation(*r.calibrated(), plain.q_deg, a, b);
+  const double after = joint_path_deviation(*r.calibrated(), t.result.q_deg, a, b);
   std::printf("joint targets: %.4f mm before (library %.4f), %.4f mm after (library %.4f), %d inserted\n", before,
               t.before_mm, after, t.after_mm, t.inserted);
   EXPECT_GT(before, 10 * kTol);  // the sparse targets alone leave the line (else the test shows nothing)

@@ -87,7 +87,7 @@ bool branch_matches(const Robot& robot, ControllerFormat f, const Vec6& q, const
 }  // namespace
 
 ArmClass arm_class(const Robot& robot, const Vec6& q) {
-  const Model& m = *robot.nominal;
+  const Model& m = *robot.nominal();
   const IkStructure& st = robot.ik().structure();
   if (!st.spherical_wrist_parallel_23)
     throw InputError("filtered targets with branch data need a robot whose axes 2 and 3 are parallel and whose wrist "

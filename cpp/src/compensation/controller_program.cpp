@@ -28,7 +28,7 @@ std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::
     ControllerTarget& t = out[i];
     t.q_deg = q[i];
     if (kind != TargetKind::Filtered) continue;  // (the model's angles until the end)
-    t.pose = iso_to_pose(fk(*robot.nominal, VecQ(q[i] * kDeg)));
+    t.pose = iso_to_pose(fk(*robot.nominal(), VecQ(q[i] * kDeg)));
     if (!branches) continue;
     set_branch_data(robot, t);
     std::string why;
@@ -43,7 +43,7 @@ std::vector<ControllerTarget> controller_targets(const Robot& robot, const std::
       throw InputError(at + buf);
     }
   }
-  for (ControllerTarget& t : out) joints_to_controller(robot.nominal->spec(), t.q_deg.data(), 6);  // as written
+  for (ControllerTarget& t : out) joints_to_controller(robot.nominal()->spec(), t.q_deg.data(), 6);  // as written
   return out;
 }
 
@@ -484,7 +484,7 @@ ControllerProgramResult compensate_to_controller(const Robot& robot, const std::
   std::vector<OutputFile> files;
   if (joint_file) {
     std::vector<Vec6> qc = r.result.q_deg;  // the controller's numbers
-    for (Vec6& q : qc) joints_to_controller(robot.nominal->spec(), q.data(), 6);
+    for (Vec6& q : qc) joints_to_controller(robot.nominal()->spec(), q.data(), 6);
     files.push_back({out_path, format_joint_program(prog, qc,
                                                     w.format == ControllerFormat::Csv ? ProgramFormat::Csv
                                                                                       : ProgramFormat::Gcode)});

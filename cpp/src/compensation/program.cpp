@@ -61,8 +61,8 @@ PoseSolution accept(const Model& m, const CompensationResult& r) {
 PoseSolution compensate_from(const Robot& robot, const ProgramOptions& opt, const Pose6& pose,
                              const Eigen::Isometry3d& target, Vec6 q0, bool approximate_start,
                              const EffectContext& ctx) {
-  const Model& nom = *robot.nominal;
-  const Model& cal = *robot.calibrated;
+  const Model& nom = *robot.nominal();
+  const Model& cal = *robot.calibrated();
   if (opt.corrected_start && robot.identified()) {
     // one fixed-point step: the nominal IK of the target corrected by the model difference at q0,
     // e = FK_nom(q0)^-1 FK_cal(q0), where FK_nom(q0) is the target itself unless q0 only came near it
@@ -135,7 +135,7 @@ PoseSolution solve_closed_form(const Robot& robot, const ProgramOptions& opt, co
 // reference, then a numerical IK from the reference, home and seeded starts.
 PoseSolution solve_numeric(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, const Vec6& ref,
                            const EffectContext& ctx) {
-  const Model& target_model = opt.compensate ? *robot.calibrated : *robot.nominal;
+  const Model& target_model = opt.compensate ? *robot.calibrated() : *robot.nominal();
   const EffectContext none;
   const EffectContext& c = opt.compensate ? ctx : none;
   CompensationResult r = compensate(target_model, pose, ref, opt.comp, c);
@@ -168,9 +168,9 @@ void count_pose(ProgramResult& res, const PoseSolution& s) {
 
 PoseSolution solve_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose_in, const Vec6& ref,
                         const EffectContext& ctx) {
-  if (robot.nominal->dof() != 6) return failed("programs need a 6-joint robot");
+  if (robot.nominal()->dof() != 6) return failed("programs need a 6-joint robot");
   Pose6 pose = pose_in;
-  if (opt.instrument_frame) pose = iso_to_pose(robot.calibrated->base_in_instrument().inverse() * pose_to_iso(pose_in));
+  if (opt.instrument_frame) pose = iso_to_pose(robot.calibrated()->base_in_instrument().inverse() * pose_to_iso(pose_in));
   if (robot.ik().structure().spherical_wrist_parallel_23) return solve_closed_form(robot, opt, pose, ref, ctx);
   return solve_numeric(robot, opt, pose, ref, ctx);
 }
@@ -229,15 +229,15 @@ std::vector<double> parse_initial_direction(const std::string& text) {
 }
 
 ProgramCursor::ProgramCursor(const Robot& robot, const ProgramOptions& opt, const Vec6& dir0)
-    : prev(home_of(*robot.nominal)) {
-  if (opt.compensate && robot.calibrated->needs_dir()) ctx.dir = dir0;
+    : prev(home_of(*robot.nominal())) {
+  if (opt.compensate && robot.calibrated()->needs_dir()) ctx.dir = dir0;
 }
 
 PoseSolution next_pose(const Robot& robot, const ProgramOptions& opt, const Pose6& pose, ProgramCursor& cur) {
   const Vec6 ref = cur.reference ? *cur.reference : cur.prev;
   PoseSolution s = solve_pose(robot, opt, pose, ref, cur.ctx);
   if (!s.ok()) return s;
-  if (!cur.first && opt.compensate && robot.calibrated->needs_dir()) {
+  if (!cur.first && opt.compensate && robot.calibrated()->needs_dir()) {
     VecQ turned = cur.ctx.dir;
     bool any = false;
     for (int j = 0; j < 6; ++j) {
@@ -276,7 +276,7 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
                                const std::vector<std::string>& where_of, const ProgramOptions& opt,
                                const std::vector<double>& temperature_c,
                                const std::vector<std::optional<Vec6>>& references) {
-  const Model& cal = *robot.calibrated;
+  const Model& cal = *robot.calibrated();
   auto where_i = [&](size_t i) { return i < where_of.size() ? where_of[i] : "pose " + std::to_string(i); };
   const bool needs_dir = opt.compensate && cal.needs_dir();
   const bool needs_t = opt.compensate && cal.needs_temperature();

@@ -75,7 +75,7 @@ ProgramResult compensate_program_whole(const Robot& robot, const std::string& in
   for (int l : prog.pose_line) where_of.push_back(where(in_path, l));
   const ProgramResult res = compensate_poses(robot, prog.poses, where_of, opt, prog.temperature_c);
   std::vector<Vec6> qc = res.q_deg;  // the controller's numbers
-  for (Vec6& q : qc) joints_to_controller(robot.nominal->spec(), q.data(), 6);
+  for (Vec6& q : qc) joints_to_controller(robot.nominal()->spec(), q.data(), 6);
   write_file_atomic(out_path, format_joint_program(prog, qc, format));
   return res;
 }
@@ -158,7 +158,7 @@ ProgramResult program_pass(const ProgramFile& f, const Vec6& dir0, JointProgramO
     prev = s.q_deg;
     if (out) {
       Vec6 qc = s.q_deg;  // the controller's numbers
-      joints_to_controller(f.robot.nominal->spec(), qc.data(), 6);
+      joints_to_controller(f.robot.nominal()->spec(), qc.data(), 6);
       out->line(l, qc);
     }
   }
@@ -177,7 +177,7 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
                                       const ProgramOptions& opt, std::optional<ProgramFormat> out_format) {
   const ProgramFormat format = out_format ? *out_format : program_format(out_path);
   if (!is_regular_file(in_path)) return compensate_program_whole(robot, in_path, out_path, opt, format);
-  const Model& cal = *robot.calibrated;
+  const Model& cal = *robot.calibrated();
   const bool needs_dir = opt.compensate && cal.needs_dir();
   const bool needs_t = opt.compensate && cal.needs_temperature();
   // the joints whose periodic effects were fitted on a range of angles (compensate_poses' warnings)

@@ -18,7 +18,7 @@ namespace {
 
 // The directions into the first pose: a stream cannot look ahead to the first motion.
 Vec6 stream_directions(const Robot& robot, const ProgramOptions& opt) {
-  if (!opt.compensate || !robot.calibrated->needs_dir()) return Vec6::Ones();
+  if (!opt.compensate || !robot.calibrated()->needs_dir()) return Vec6::Ones();
   if (opt.initial_direction.empty())
     throw InputError("the model has backlash and a stream cannot look ahead to the first motion: give each "
                      "joint's direction into the first pose (--initial-direction)");
@@ -83,12 +83,12 @@ constexpr const char* kBrokenQuote = "a quoted field is not closed, or text foll
 StreamCompensator::StreamCompensator(Robot robot, ProgramOptions opt)
     : robot_(std::move(robot)), opt_(std::move(opt)), cursor_(robot_, opt_, stream_directions(robot_, opt_)) {
   warning_.reserve(512);
-  if (opt_.compensate) periodic_ = periodic_joints(robot_.calibrated->spec());
+  if (opt_.compensate) periodic_ = periodic_joints(robot_.calibrated()->spec());
 }
 
 Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
   cursor_.ctx.temperature_c = std::isfinite(temperature_c) ? temperature_c : opt_.temperature_c;
-  if (opt_.compensate && robot_.calibrated->needs_temperature() && !std::isfinite(cursor_.ctx.temperature_c))
+  if (opt_.compensate && robot_.calibrated()->needs_temperature() && !std::isfinite(cursor_.ctx.temperature_c))
     fail_at("stdin", line_no_, kNeedsTemperature);
   const PoseSolution s = next_pose(robot_, opt_, p, cursor_);
   if (!s.ok()) throw InputError(std::string("stdin:") + std::to_string(line_no_) + ": " + s.error);
@@ -105,7 +105,7 @@ Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {
     if (j < 6) outside_[j] = out;
   }
   Vec6 q = s.q_deg;  // the cursor keeps the model's angles; the line carries the controller's numbers
-  joints_to_controller(robot_.nominal->spec(), q.data(), 6);
+  joints_to_controller(robot_.nominal()->spec(), q.data(), 6);
   return q;
 }
 

@@ -36,7 +36,7 @@ Vec6 nominal_ik_near(const Robot& robot, const Eigen::Isometry3d& target, const 
     }
     if (k >= 0) return s.sol[k].q_deg;
   } else {
-    const CompensationResult r = compensate(*robot.nominal, iso_to_pose(target), ref);
+    const CompensationResult r = compensate(*robot.nominal(), iso_to_pose(target), ref);
     if (r.status == CompStatus::Converged) return r.q_deg;
   }
   throw InputError("the controller's straight line between the targets leaves the nominal model's reach");
@@ -46,11 +46,11 @@ Vec6 nominal_ik_near(const Robot& robot, const Eigen::Isometry3d& target, const 
 
 double segment_deviation_mm(const Robot& robot, const Pose6& a, const Pose6& b, const Vec6& qa, const Vec6& qb,
                             PathKind kind, const EffectContext& ctx_a, const EffectContext& ctx_b) {
-  const Model& cal = *robot.calibrated;
+  const Model& cal = *robot.calibrated();
   Pose6 ta, tb;
   if (kind == PathKind::NominalLine) {
-    ta = iso_to_pose(fk(*robot.nominal, VecQ(qa * kDeg)));
-    tb = iso_to_pose(fk(*robot.nominal, VecQ(qb * kDeg)));
+    ta = iso_to_pose(fk(*robot.nominal(), VecQ(qa * kDeg)));
+    tb = iso_to_pose(fk(*robot.nominal(), VecQ(qb * kDeg)));
   }
   EffectContext ctx = ctx_b;
   Vec6 q = qa;
@@ -95,7 +95,7 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
   std::vector<std::string> label = r.where;  // per pose: the input line it belongs to
   std::vector<double> temps(poses.size(), opt.temperature_c);
   for (size_t i = 0; i < temperature_c.size() && i < poses.size(); ++i) temps[i] = temperature_c[i];
-  const Eigen::Isometry3d to_base = opt.instrument_frame ? robot.calibrated->base_in_instrument().inverse()
+  const Eigen::Isometry3d to_base = opt.instrument_frame ? robot.calibrated()->base_in_instrument().inverse()
                                                          : Eigen::Isometry3d::Identity();
   constexpr int kMaxRounds = 20;
   for (int round = 0;; ++round) {
@@ -112,7 +112,7 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
       if (kinds[i] == PathKind::Unchecked) continue;
       EffectContext ca, cb;
       ca.temperature_c = temps[i], cb.temperature_c = temps[i + 1];
-      if (opt.compensate && robot.calibrated->needs_dir()) ca.dir = r.result.dir[i + 1], cb.dir = r.result.dir[i + 1];
+      if (opt.compensate && robot.calibrated()->needs_dir()) ca.dir = r.result.dir[i + 1], cb.dir = r.result.dir[i + 1];
       double d;
       try {
         d = segment_deviation_mm(robot, iso_to_pose(to_base * pose_to_iso(r.poses[i])),

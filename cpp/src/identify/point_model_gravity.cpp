@@ -5,6 +5,7 @@
 // columns of the fitted gravity's mass moments (point_model.hpp), which act only through tau.
 // K tau itself acts in row_frames() (point_model.cpp); these are its derivatives.
 #include "point_eval.hpp"
+#include "../kinematics/weight_torque.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -61,17 +62,16 @@ void PointEval::gravity_state(const Model& model, const Measurement& m, GravityS
   gs.cp = gr[n] * (rm_ * sp.payload_com + tm_) + gt[n];
   gs.S[n] = mp * gs.cp;
   gs.M[n] = mp;
-  for (int k = n - 1; k >= 0; --k) {
-    const double mk = sp.joints[k].mass_kg;
-    gs.S[k] = gs.S[k + 1] + mk * (gr[k + 1] * sp.joints[k].com + gt[k + 1]);
-    gs.M[k] = gs.M[k + 1] + mk;
+  for (int k = 0; k < n; ++k) {
+    gs.M[k] = sp.joints[k].mass_kg;
+    gs.S[k] = gs.M[k] * (gr[k + 1] * sp.joints[k].com + gt[k + 1]);
   }
+  detail::carried_loads(n, gs.S, gs.M);
   const Vec3& g = model.gravity();
   for (int j = 0; j < n; ++j) {
     gs.wc[j] = gr[j] * w_[j];
     gs.oc[j] = gr[j] * p_[j] + gt[j];
-    gs.arm[j] = gs.S[j] - gs.M[j] * gs.oc[j];
-    gs.tau[j] = gs.wc[j].dot(gs.arm[j].cross(g));  // N mm, the same as gravity_torque()
+    gs.tau[j] = detail::weight_torque(gs.wc[j], gs.oc[j], gs.S[j], gs.M[j], g, gs.arm[j]);
   }
 }
 

@@ -248,15 +248,15 @@ struct Reader {
 std::string spec_to_json(const ModelSpec& spec) { return spec_json(spec).dump(2); }
 
 std::string robot_to_json(const Robot& robot) {
-  json o{{"format", "kincal-model"}, {"version", 2}, {"nominal", spec_json(robot.nominal->spec())}};
-  if (robot.identified()) o["calibrated"] = spec_json(robot.calibrated->spec());
-  if (!robot.nominal->spec().joint_convention.empty()) o["joint_convention"] = robot.nominal->spec().joint_convention;
-  if (!robot.calibrated->spec().tcp.empty()) o["tcp"] = robot.calibrated->spec().tcp;
+  json o{{"format", "kincal-model"}, {"version", 2}, {"nominal", spec_json(robot.nominal()->spec())}};
+  if (robot.identified()) o["calibrated"] = spec_json(robot.calibrated()->spec());
+  if (!robot.nominal()->spec().joint_convention.empty()) o["joint_convention"] = robot.nominal()->spec().joint_convention;
+  if (!robot.calibrated()->spec().tcp.empty()) o["tcp"] = robot.calibrated()->spec().tcp;
   return o.dump(2) + "\n";
 }
 
 std::string tcp_warning(const Robot& robot, const std::string& source) {
-  if (robot.calibrated->spec().tcp != "nominal") return "";
+  if (robot.calibrated()->spec().tcp != "nominal") return "";
   return source + ": the TCP is nominal (not measured): every pose carries the tool's error; identify with "
                   "--tool-targets or 6-D rows";
 }
@@ -345,7 +345,7 @@ Robot with_joint_convention(const Robot& robot, const std::string& source, const
   if (source.size() >= 5 && source.compare(source.size() - 5, 5, ".json") == 0)
     throw InputError(source + ": a model JSON carries its joint convention (\"joint_convention\"); "
                      "--joint-convention is for a URDF or a built-in robot");
-  auto m = std::make_shared<Model>(with_joint_convention(robot.nominal->spec(), convention));
+  auto m = std::make_shared<Model>(with_joint_convention(robot.nominal()->spec(), convention));
   return Robot{m, m};
 }
 

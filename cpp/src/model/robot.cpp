@@ -5,8 +5,8 @@
 namespace kincal {
 
 Robot::Robot(ModelPtr nominal_model, ModelPtr calibrated_model)
-    : nominal(std::move(nominal_model)),
-      calibrated(std::move(calibrated_model)),
-      ik_(nominal ? std::make_shared<const IkSolver>(*nominal) : nullptr) {}
+    : nominal_(std::move(nominal_model)),
+      calibrated_(std::move(calibrated_model)),
+      ik_(nominal_ ? std::make_shared<const IkSolver>(*nominal_) : nullptr) {}
 
 }  // namespace kincal

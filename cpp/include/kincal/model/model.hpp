@@ -170,17 +170,21 @@ class IkSolver;  // kincal/ik/ik.hpp
 /// calibrated one (for FK and compensation). For a nominal robot both are the same object. The
 /// nominal model's IK solver is built once with the Robot (src/model/robot.cpp), so that programs
 /// do not rebuild it per pose; set the models through the constructor only.
-struct Robot {
-  ModelPtr nominal;
-  ModelPtr calibrated;
-
+class Robot {
+ public:
   Robot() = default;  ///< no models (to be assigned a whole Robot)
   Robot(ModelPtr nominal_model, ModelPtr calibrated_model);
-  bool identified() const { return nominal != calibrated; }
+  /// The models are fixed at construction (a new Robot for new models): the IK below always follows
+  /// the nominal model it was built from
+  const ModelPtr& nominal() const { return nominal_; }
+  const ModelPtr& calibrated() const { return calibrated_; }
+  bool identified() const { return nominal_ != calibrated_; }
   /// the nominal model's closed-form IK (ik/ik.hpp); only on a Robot built with its models
   const IkSolver& ik() const { return *ik_; }
 
  private:
+  ModelPtr nominal_;
+  ModelPtr calibrated_;
   std::shared_ptr<const IkSolver> ik_;
 };
 

@@ -6,10 +6,14 @@ a test checks both give the same residuals."""
 from __future__ import annotations
 
 import json
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from kincal import _core
+
+if TYPE_CHECKING:
+    from kincal._core import Measurements
 
 
 def _unit_orthogonal(w: np.ndarray) -> np.ndarray:
@@ -74,7 +78,7 @@ class NumpyPointModel:
             gr.append(gr[-1] @ e)
         return gr, gt
 
-    def residuals(self, x: np.ndarray, data: dict) -> np.ndarray:
+    def residuals(self, x: np.ndarray, data: Measurements) -> np.ndarray:
         x = np.asarray(x, float)
         n = self.n
         w = [(self.w0[j] + x[4 * j] * self.u[j] + x[4 * j + 1] * self.v[j]) for j in range(n)]

@@ -22,6 +22,12 @@ void define_effects(py::module_& m) {
       .def_readonly("acts_on", &EffectKind::acts_on, "'joint_angle', 'length_scale' or 'link_length'")
       .def_readonly("description", &EffectKind::description)
       .def_readonly("gravity_loaded_only", &EffectKind::gravity_loaded_only)
+      .def_readonly("harmonic", &EffectKind::harmonic, "sine and cosine amplitudes per harmonic order")
+      .def_readonly("ordered", &EffectKind::ordered, "harmonic with every order 1..K, named by its order K")
+      .def_property_readonly("reads_dir", &EffectKind::reads_dir, "reads the direction of motion (dir1..dirN)")
+      .def_property_readonly("scales_lengths", &EffectKind::scales_lengths, "scales the robot's lengths")
+      .def_property_readonly("of_instrument", &EffectKind::of_instrument,
+                             "the measurement's (the instrument's drift), never applied to the robot")
       .def("__repr__", [](const EffectKind& k) { return "<EffectKind " + k.name + ">"; });
   m.def("effect_kinds", &effect_kinds, py::return_value_policy::copy, "Every effect kind, in the diagnosis's order");
   m.def("effect_kind", py::overload_cast<const std::string&>(&effect_kind), py::arg("name"), py::return_value_policy::copy);
@@ -59,6 +65,7 @@ void define_effects(py::module_& m) {
            "joint counted from 1; 0 for an effect on the whole robot; harmonics: transmission_error's orders; "
            "order: joint_map's order K (harmonics 1..K; default 2)")
       .def_readonly("name", &Effect::name)
+      .def_property_readonly("kind", [](const Effect& e) { return e.kind(); }, "its kind in the registry")
       .def_property_readonly("joint", [](const Effect& e) { return e.joint + 1; }, "from 1; 0: the whole robot")
       .def_readonly("harmonics", &Effect::harmonics)
       .def_property_readonly("order", &Effect::order, "joint_map: its order K; 0 for the others")

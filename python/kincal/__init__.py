@@ -19,7 +19,7 @@ import importlib
 import warnings
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import numpy as np
 
@@ -28,6 +28,7 @@ from ._core import Robot
 from .io.urdf import urdf_model_json
 
 if TYPE_CHECKING:
+    from ._core import CompensationResult, IkSolution
     from .typing_ import FloatArray
 
 #: the modules of the flat layout of 0.1 and where they are now; reachable by the old name, with a
@@ -102,7 +103,7 @@ def jacobian(robot: Robot, q_deg: Sequence[float], calibrated: bool = True) -> F
     return _core.jacobian(robot, np.asarray(q_deg, dtype=float), calibrated)
 
 
-def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] = None) -> list[dict[str, Any]]:
+def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] = None) -> list[IkSolution]:
     """Every closed-form solution of the nominal model for one pose x,y,z,a,b,c (up to 8).
 
     Each is a dict with ``q_deg``, ``within_limits``, ``wrist_singular``, ``shoulder_singular``;
@@ -114,7 +115,7 @@ def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finit
                delta: float = 1e-8, epsilon: float = 1e-15, max_iterations: int = 20,
                corrected_start: bool = True, frame: str = "base", residual: str = "rotation_vector",
                temperature_c: Floats = None,
-               initial_direction: Floats = None, keep_branch: bool = False) -> dict[str, Any]:
+               initial_direction: Floats = None, keep_branch: bool = False) -> CompensationResult:
     """Machine coordinates for desired tool poses (N x 6, in program order) on the robot's calibrated
     model, every effect it carries acting: backlash with the directions of the program's own
     commanded motion (the first pose's from ``initial_direction``, default the direction of the

@@ -3,7 +3,8 @@ tests over 500 lines (python/kincal, cpp/, benchmarks' own sources), no function
 (Python: every def, methods and nested ones included, from its `def` line to its last; C++: every
 function defined at namespace level, from the line its declaration starts on to its closing brace at
 column 0, the style every file here follows; a lambda counts with its enclosing function, and member
-functions defined inside a class or struct body are not measured)."""
+functions defined inside a class or struct body are not measured); and no effect named in code
+outside its own file and the registry (issue 31: the code asks an effect's kind)."""
 
 from __future__ import annotations
 
@@ -74,3 +75,51 @@ def test_no_function_over_100_lines():
         funcs = _python_functions(p) if p.suffix == ".py" else cpp_functions(p.read_text())
         long += [(str(p.relative_to(ROOT)), name[:60], line, n) for name, line, n in funcs if n > MAX_FUNCTION]
     assert not long, long
+
+
+def _effect_names() -> set[str]:
+    import kincal
+
+    return {k.name for k in kincal._core.effect_kinds()}
+
+
+def _compared_names(tree: ast.AST, names: set[str]) -> list[tuple[int, str]]:
+    """(line, name) of every comparison (==, !=, in, not in) of a value with an effect's name written
+    as a string, alone or in a tuple, list or set."""
+    out = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Compare):
+            continue
+        if not any(isinstance(op, (ast.Eq, ast.NotEq, ast.In, ast.NotIn)) for op in node.ops):
+            continue
+        for operand in [node.left, *node.comparators]:
+            items = operand.elts if isinstance(operand, (ast.Tuple, ast.List, ast.Set)) else [operand]
+            out += [(node.lineno, i.value) for i in items
+                    if isinstance(i, ast.Constant) and isinstance(i.value, str) and i.value in names]
+    return out
+
+
+def test_the_comparison_finder_finds_names_in_every_form():
+    tree = ast.parse('a == "backlash"\nif "drift" != b: pass\nc in ("x", "joint_map")\nd == "other"\n')
+    assert _compared_names(tree, {"backlash", "drift", "joint_map"}) == [(1, "backlash"), (2, "drift"),
+                                                                         (3, "joint_map")]
+
+
+def test_no_effect_is_compared_by_its_name_outside_the_registry():
+    """Python asks an effect's kind (Effect.kind, effect_kind(name): gravity_loaded_only, harmonic,
+    ordered, needs, reads_dir, of_instrument), and C++ its id, never its name: adding an effect touches
+    its own file and the registry line only (README, "Adding an effect")."""
+    names = _effect_names()
+    offences = []
+    for path in (ROOT / "python" / "kincal").rglob("*.py"):
+        offences += [f"{path.relative_to(ROOT)}:{line}: {name}" for line, name in
+                     _compared_names(ast.parse(path.read_text()), names)]
+    quoted = "|".join(re.escape(n) for n in sorted(names))
+    pattern = re.compile(rf'(==|!=)\s*"({quoted})"|"({quoted})"\s*(==|!=)')
+    for path in (ROOT / "cpp").rglob("*.[ch]pp"):
+        if path.parent.name == "effects":  # the effects' own files and the registry
+            continue
+        for k, line in enumerate(path.read_text().split("\n"), 1):
+            if pattern.search(line):
+                offences.append(f"{path.relative_to(ROOT)}:{k}: {line.strip()}")
+    assert not offences, "effects compared by name:\n" + "\n".join(offences)

@@ -24,7 +24,8 @@ const EffectKind& joint_map_kind() {
       EffectId::joint_map, "joint_map", "serial", "joint", "", "joint_angle",
       "a smooth periodic error of the joint angle of any order K: sine and cosine amplitudes of orders 1..K (deg)",
       false, true, 0, [](const Effect& e) { return harmonic::names("map_", e.harmonics); }, harmonic::units, check,
-      [](const Effect& e, double q, double, double* b, double* db) { harmonic::basis(e.harmonics, q, b, db); }};
+      [](const Effect& e, double q, double, double* b, double* db) { harmonic::basis(e.harmonics, q, b, db); },
+      true};
   return k;
 }
 

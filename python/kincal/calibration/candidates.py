@@ -6,13 +6,16 @@ search these candidates."""
 
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core
 from .._core import Robot
 from .fitting import gravity_fitted
+
+if TYPE_CHECKING:
+    from .._core import Measurements
 
 #: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
 MAX_MAP_ORDER = 8
@@ -31,6 +34,10 @@ class JointCompliance:
         if gravity not in ("masses", "fit"):
             raise ValueError(f"joint compliance's gravity is 'masses' or 'fit', not '{gravity}'")
         self.gravity = gravity
+
+    @property
+    def kind(self) -> _core.EffectKind:
+        return _core.effect_kind(self.name)
 
     @property
     def label(self) -> str:
@@ -77,7 +84,7 @@ def _needs_column(kind: _core.EffectKind) -> str:
     return "dir" if kind.needs == "dir" else kind.needs
 
 
-def candidates(robot: Robot, data: dict[str, Any], start: Sequence[Candidate] = (),
+def candidates(robot: Robot, data: Measurements, start: Sequence[Candidate] = (),
                gravity: str = "auto") -> tuple[list[Candidate], list[str]]:
     """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
     compliance as one JointCompliance in the form ``gravity`` gives) the data can support, and notes
@@ -92,17 +99,17 @@ def candidates(robot: Robot, data: dict[str, Any], start: Sequence[Candidate] = 
         if col == "dir" and col not in data:
             notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
             continue
-        if col == "temperature_c" and (col not in data or np.ptp(data[col]) <= 0.5):
+        if col == "temperature_c" and (col not in data or np.ptp(data["temperature_c"]) <= 0.5):
             notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
             continue
-        if col == "time_s" and (col not in data or np.ptp(data[col]) <= 0):
+        if col == "time_s" and (col not in data or np.ptp(data["time_s"]) <= 0):
             notes.append(f"{kind.name} skipped: no time_s column, or it does not vary")
             continue
         if col and col not in data:
             notes.append(f"{kind.name} skipped: the data have no {col} column")
             continue
         joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
-        if kind.name == "joint_compliance":  # one candidate: every gravity-loaded joint
+        if kind.gravity_loaded_only:  # one candidate: every gravity-loaded joint
             if joints and not any(e.name == kind.name for e in start):
                 fitted = gravity_fitted(robot, gravity)
                 out.append(JointCompliance("fit" if fitted else "masses"))
@@ -111,7 +118,7 @@ def candidates(robot: Robot, data: dict[str, Any], start: Sequence[Candidate] = 
                     notes.append(f"{kind.name} on joints {', '.join(map(str, joints))}: the gravity torques' mass "
                                  f"moments fitted with it ({why})")
             continue
-        if kind.name == "joint_map":  # the highest order: the engine chooses among its variants
+        if kind.ordered:  # the highest order: the engine chooses among its variants
             out += [_core.Effect(kind.name, j, order=MAX_MAP_ORDER) for j in joints if (kind.name, j) not in have]
         else:
             out += [_core.Effect(kind.name, j) for j in joints if (kind.name, j) not in have]
@@ -133,7 +140,7 @@ def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effec
     return out, gravity
 
 
-def check_data(effects: Sequence[Candidate], data: dict[str, Any], robot: Robot) -> None:
+def check_data(effects: Sequence[Candidate], data: Measurements, robot: Robot) -> None:
     """The data columns the effects read (the registry's ``needs``) are present: a clear error names
     the file and the column otherwise."""
     # the core's check (JointCompliance reads no column of its own)

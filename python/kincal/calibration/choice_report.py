@@ -59,8 +59,8 @@ def _label_of(c: dict[str, Any]) -> str:
     """A scored candidate's label (as _core.Effect.label names it)."""
     if c.get("gravity"):
         return effect_choice.JointCompliance(c["gravity"]).label
-    if c["effect"] == "joint_map":
-        return _core.Effect("joint_map", c["joint"], order=c["order"]).label
+    if _core.effect_kind(c["effect"]).ordered:
+        return _core.Effect(c["effect"], c["joint"], order=c["order"]).label
     return _core.Effect(c["effect"], c["joint"] or 0).label
 
 

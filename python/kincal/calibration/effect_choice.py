@@ -33,11 +33,13 @@ from .._core import Robot
 from .candidates import (MAX_MAP_ORDER as MAX_MAP_ORDER, Candidate as Candidate, JointCompliance as JointCompliance,
                          applicable_joints as applicable_joints, candidates as candidates, check_data as check_data,
                          expand as expand, loaded_joints)
-from .fitting import FitOptions, folds as grouped_folds, point_errors, subset
+from ..stats.grouping import subset
+from .fitting import FitOptions, folds as grouped_folds, point_errors
 from .linearisation import evaluate as evaluate, equations, prior_rows as _prior_rows
 from ..stats.robust_scores import loss_threshold, robust_noise, robust_weights
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray
 
 #: joint_map's smoothness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k (the
@@ -48,8 +50,6 @@ if TYPE_CHECKING:
 MAP_SMOOTHING = (1e-1, 1e-2, 1e-3)
 #: joint_map's variant (order, smoothing) is chosen leaving out each of this many ranges of its angle
 VARIANT_BLOCKS = 5
-#: periodic errors of a joint angle: also scored holding out ranges of that angle (SerialProblem.score_folds)
-PERIODIC = ("transmission_error", "joint_map")
 #: the significance rule of a step (the diagnosis's): F-test p below ALPHA and a linear
 #: cross-validated gain above MIN_GAIN
 ALPHA, MIN_GAIN = 1e-6, 0.03
@@ -88,21 +88,21 @@ class Spec:
 
     @property
     def compliance(self) -> list[int]:
-        return [e.joint for e in self.core_effects if e.name == "joint_compliance"]
+        return [e.joint for e in self.core_effects if e.kind.gravity_loaded_only]
 
     def label(self) -> str:
         return " + ".join(["geometry"] + [e.label for e in self.effects])
 
-    def fit(self, data: dict[str, Any], covariance: bool = False) -> _core.IdentifyResult:
+    def fit(self, data: Measurements, covariance: bool = False) -> _core.IdentifyResult:
         eff, gravity = expand(self.effects, self.robot)
         return self.fit_options.fit(self.robot, data, eff, covariance=covariance, penalties=self.penalties,
                                     gravity=gravity)
 
-    def errors(self, res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
+    def errors(self, res: _core.IdentifyResult, data: Measurements) -> FloatArray:
         return point_errors(res, data)
 
 
-def fitted_compliance_columns(res: _core.IdentifyResult, data: dict[str, Any], spec: Spec) -> FloatArray:
+def fitted_compliance_columns(res: _core.IdentifyResult, data: Measurements, spec: Spec) -> FloatArray:
     """The columns of JointCompliance("fit") for a model fitted without compliance (``res``, the model
     ``spec``): the model with it is fitted (its torques' mass moments with it), and its compliance
     columns are taken at that fit: each joint's deflection under the torques of the fitted moments.
@@ -125,11 +125,11 @@ class _Linearised:
     residual as the pseudo-residual of the fit's robust loss (robust_weights). ``step(cand)``: the
     linearisation after a step taken without a refit."""
 
-    def __init__(self, res: _core.IdentifyResult, data: dict[str, Any], candidates: Sequence[Candidate], robot: Robot,
+    def __init__(self, res: _core.IdentifyResult, data: Measurements, candidates: Sequence[Candidate], robot: Robot,
                  dims: int, fit: FitOptions, spec: Optional[Spec] = None) -> None:
         self.res, self.data, self.robot, self.dims, self.fit, self.spec = res, data, robot, dims, fit, spec
         have = {(e.name, e.joint) for e in res.layout.effect_list}
-        self.extra = [c for c in candidates if isinstance(c, _core.Effect) and c.name != "joint_compliance"
+        self.extra = [c for c in candidates if isinstance(c, _core.Effect) and not c.kind.gravity_loaded_only
                       and (c.name, c.joint) not in have]
         self.cols: Optional[dict[tuple[str, int, tuple[int, ...], str],
                                  tuple[FloatArray, FloatArray, FloatArray]]] = None
@@ -153,12 +153,12 @@ class _Linearised:
                 spec = self.spec or Spec(self.robot, list(self.res.layout.effect_list), fit=self.fit)
                 self.cols[key] = (self.r, self.cur, fitted_compliance_columns(self.res, self.data, spec))
                 return self.cols[key]
-            if (isinstance(cand, _core.Effect) and cand.name != "joint_compliance"
+            if (isinstance(cand, _core.Effect) and not cand.kind.gravity_loaded_only
                     and not any(cand == e for e in self.extra)):
                 r, cur, J, new, fit_of = evaluate(self.res, self.data, [cand])  # not among the round's candidates
             else:
                 r, cur, J, new, fit_of = self.r, self.cur, self.J, self.new, self.fit_of
-            kind = "compliance" if cand.name == "joint_compliance" else cand.name
+            kind = "compliance" if cand.kind.gravity_loaded_only else cand.name
             idx = [p.index for p in new if p.kind == kind and (p.joint == cand.joint or isinstance(cand, JointCompliance))
                    and (kind == "compliance" or (p.index not in fit_of and p.effect == cand))]
             self.cols[key] = (r, cur, J[:, idx])
@@ -226,7 +226,7 @@ class SerialProblem:
     and the fitting options of every fit; ``fits``: every linearisation's fit, in order. ``dims``:
     residual coordinates per row (3; 6 with measured orientations)."""
 
-    def __init__(self, robot: Robot, data: dict[str, Any], folds: list[BoolArray], fit: FitOptions,
+    def __init__(self, robot: Robot, data: Measurements, folds: list[BoolArray], fit: FitOptions,
                  candidates: Sequence[Candidate] = ()) -> None:
         self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit
         self.candidates = list(candidates)
@@ -262,7 +262,7 @@ class SerialProblem:
         """joint_map's orders 1..K (its columns R: sine and cosine of each order, in order), each with
         each smoothness penalty of MAP_SMOOTHING (the strongest first): (effect, columns, weights).
         The library's transmission_error is fitted as it always was, without a penalty."""
-        if cand.name != "joint_map":
+        if not cand.kind.ordered:
             return None
         s = float(np.mean(np.sum(R[:, :2] ** 2, axis=0)))
         self.map_scale[cand.joint] = s
@@ -279,9 +279,9 @@ class SerialProblem:
         looks better than it predicts); the first variant listed within ORDER_MARGIN of the best held-out
         sum of squares. Orders the library's transmission_error covers on that joint are not offered
         (covered()). Any other candidate is returned as it is."""
-        if cand.name != "joint_map" or cand.joint not in self.map_scale:
+        if not cand.kind.ordered or cand.joint not in self.map_scale:
             return cand
-        top = max([c.order for c in self.candidates if c.name == "joint_map" and c.joint == cand.joint] + [cand.order])
+        top = max([c.order for c in self.candidates if c.kind.ordered and c.joint == cand.joint] + [cand.order])
         s = self.map_scale[cand.joint]
         base = [p for e in effects for p in self.penalty.get((e.name, e.joint, e.order), [])]
         held_masks = self.variant_folds(cand)
@@ -355,14 +355,14 @@ class SerialProblem:
         VARIANT_BLOCKS ranges of that angle. Such an effect must predict angles it has not seen, as on
         the next campaign: a sinusoid fitted over part of a turn that only mimics another effect there
         (the gravity's) is not kept for the turn."""
-        return self.variant_folds(cand) if cand.name in PERIODIC else None
+        return self.variant_folds(cand) if cand.kind.harmonic else None
 
     def variant_evidence(self, cand: Candidate, i: int, gains: Sequence[float]) -> dict[str, Any]:
         """A joint_map step's evidence: the order and smoothing chosen, and the best gain of each order
         1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
         g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
         out: dict[str, Any] = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
-        if cand.name == "joint_map":
+        if cand.kind.ordered:
             out["order"] = cand.order
             out["order_range_cv_gain"] = [round(float(x), 6) for x in g.max(axis=1)]
             ref = self.refined.get(cand.joint)
@@ -379,13 +379,13 @@ class SerialProblem:
     def covered(self, cand: Candidate, candidates: Sequence[Candidate]) -> bool:
         """A joint_map of order 1 or 2 is the library's transmission_error (orders 1, 2) where that is a
         candidate on the same joint: the library's name is kept."""
-        return cand.name == "joint_map" and cand.order <= 2 and any(
-            c.name == "transmission_error" and c.joint == cand.joint and set(range(1, cand.order + 1)) <= set(c.harmonics)
+        return cand.kind.ordered and cand.order <= 2 and any(
+            c.kind.harmonic and not c.kind.ordered and c.joint == cand.joint and set(range(1, cand.order + 1)) <= set(c.harmonics)
             for c in candidates)
 
     def describe(self, effect: Candidate) -> dict[str, Any]:
         d: dict[str, Any] = {"effect": effect.name, "joint": effect.joint if effect.joint > 0 else None}
-        if effect.name == "joint_map":
+        if effect.kind.ordered:
             d["order"] = effect.order
         if isinstance(effect, JointCompliance):
             d["gravity"] = effect.gravity
@@ -412,7 +412,7 @@ class Choice:
     problem: Optional[SerialProblem] = field(repr=False, default=None)
 
 
-def choose(robot: Robot, data: dict[str, Any], fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5,
+def choose(robot: Robot, data: Measurements, fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5,
            seed: int = 0, max_steps: int = 6, say: Callable[[str], None] = lambda s: None,
            fit_chosen: bool = True) -> Choice:
     """`--effects auto` on one data set: the stepwise search over the candidates from the

@@ -27,6 +27,7 @@ from . import priors
 from .._core import Robot
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray
 
 LOSSES = ("none", "huber", "cauchy")
@@ -94,7 +95,7 @@ class FitOptions:
         fit by grouped cross-validation when ``prior_scale`` is None)."""
         return priors.Fitter(robot, self.prior_model, auto_scale=self.auto_prior_scale, seed=seed)
 
-    def fit(self, robot: Robot, data: dict[str, Any], effects: Sequence[_core.Effect] = (), *, covariance: bool = False,
+    def fit(self, robot: Robot, data: Measurements, effects: Sequence[_core.Effect] = (), *, covariance: bool = False,
             penalties: Sequence[tuple[str, float]] = (), gravity: Optional[str] = None, seed: int = 0,
             progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         """One fit of ``data`` with these options."""
@@ -116,7 +117,7 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
     target's start on the tool (mm), e.g. a probe's nominal ball offset; ``noise_mm``: the noise per
     coordinate when known (weighs the priors, bends the loss; None: estimated from the residuals)."""
     effects = list(effects)
-    o = _core.IdentifyOptions(compliance=any(e.name == "joint_compliance" for e in effects), loss=loss, gravity=gravity,
+    o = _core.IdentifyOptions(compliance=any(e.kind.gravity_loaded_only for e in effects), loss=loss, gravity=gravity,
                               loss_scale_mm=loss_scale_mm, max_iterations=max_iterations, fix=list(fix),
                               effects=effects, covariance=covariance, orientation_weight=orientation_weight)
     o.penalties = [(str(n), float(w)) for n, w in penalties]
@@ -131,12 +132,7 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_s
     return o
 
 
-def subset(data: dict[str, Any], mask: BoolArray) -> dict[str, Any]:
-    """The rows ``mask`` of a measurement set (its other entries as they are)."""
-    return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()}
-
-
-def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
+def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
     """k masks of held-out rows, whole configurations per fold, as many as the configurations allow
     (at least 2 configurations; none when fewer)."""
     k = min(k, grouping.configurations(data).count)
@@ -149,13 +145,13 @@ def rms(e: FloatArray) -> float:
     return float(np.sqrt(np.mean(np.square(e)))) if len(e) else float("nan")
 
 
-def orientation_errors_deg(robot: Robot, data: dict[str, Any]) -> FloatArray:
+def orientation_errors_deg(robot: Robot, data: Measurements) -> FloatArray:
     """Angle (deg) between the measured and the predicted tool orientation of every 6-D row (each
     row seen from its setup's placement, the model's drift at its time)."""
     return np.asarray(_core.orientation_errors(robot, data))
 
 
-def point_errors(res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
+def point_errors(res: _core.IdentifyResult, data: Measurements) -> FloatArray:
     """3-D distance (mm) between each measured point and the fitted model's prediction (a probe row's
     error along its constraint, against the fit's station)."""
     return np.asarray(_core.point_errors(res.robot, res.targets, data, res.stations))

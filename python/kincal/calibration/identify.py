@@ -23,7 +23,8 @@ from .._core import Robot
 from .choice_report import choice_lines, choice_report
 from .tool_frame import tcp_summary_line, tool_from_targets as place
 from .effect_choice import Candidate, applicable_joints, check_data as check_data_for
-from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, orientation_errors_deg, point_errors, rms, subset
+from ..stats.grouping import subset
+from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, orientation_errors_deg, point_errors, rms
 from .setups import _refit_placements, drift_report, setup_frames
 # the names kincal.identify had before the calibration package, re-exported (`X as X`: explicitly, for mypy)
 from .fitting import options as options
@@ -35,6 +36,7 @@ from .simulation import (DEFAULT_HARMONICS as DEFAULT_HARMONICS, DEFAULT_INSTRUM
                          simulate as simulate)
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray
 
 #: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
@@ -59,16 +61,16 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     for item in items:
         name, _, joint = item.partition(":")
         name = name.strip()
+        kind = next((k for k in _core.effect_kinds() if k.name == name), None)
+        if kind is None:
+            raise ValueError(f"{option}: unknown effect '{item}' (known: {known})")
         order = DEFAULT_MAP_ORDER
-        if name == "joint_map" and ":" in joint:
+        if kind.ordered and ":" in joint:
             joint, _, k = joint.partition(":")
             try:
                 order = int(k)
             except ValueError:
-                raise ValueError(f"{option}: '{item}': joint_map's order must be a number 1..64") from None
-        kind = next((k for k in _core.effect_kinds() if k.name == name), None)
-        if kind is None:
-            raise ValueError(f"{option}: unknown effect '{item}' (known: {known})")
+                raise ValueError(f"{option}: '{item}': {name}'s order must be a number 1..64") from None
         if kind.domain != "serial":
             raise ValueError(f"{option}: '{item}': {name} belongs to the {kind.domain} robot, not to a serial "
                              f"robot (known here: {known})")
@@ -90,7 +92,7 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
             joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
         for j in joints:
             try:
-                e = (_core.Effect(name, j, order=order) if name == "joint_map"
+                e = (_core.Effect(name, j, order=order) if kind.ordered
                      else _core.Effect(name, j, list(harmonics)))
                 e.check(robot.dof)
             except ValueError as err:
@@ -100,23 +102,23 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     return out
 
 
-def read_measurements(path: str, robot: Robot, artifact: str | None = None) -> dict[str, Any]:
+def read_measurements(path: str, robot: Robot, artifact: str | None = None) -> Measurements:
     """The measurement CSV of the contract (errors name file:line and cause), with the known distances
     and angles between its probe stations from an artifact file."""
     data = _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
     return _core.read_artifact(str(artifact), data, robot.dof) if artifact else data
 
 
-def measurements_csv(data: dict[str, Any], dof: int) -> str:
+def measurements_csv(data: Measurements, dof: int) -> str:
     return _core.format_measurements(data, dof)
 
 
-def split_poses(data: dict[str, Any], holdout: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
+def split_poses(data: Measurements, holdout: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
     """Row masks (fit, held out): a share of the configurations held out whole (grouping.split)."""
     return grouping.split(data, holdout, seed)
 
 
-def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
+def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
     """k masks of held-out rows, whole configurations per fold (grouping.folds)."""
     return grouping.folds(data, k, seed)
 
@@ -216,7 +218,7 @@ class Identification:
             lines.append(f"instrument drift about t = {drift['t_mean_s']:.0f} s (removed from the fit, never "
                          f"compensated): {rates}")
         ranges = self.robot.fitted_ranges_deg
-        periodic = sorted({e.joint for e, _ in self.robot.effects if e.name in ("transmission_error", "joint_map")})
+        periodic = sorted({e.joint for e, _ in self.robot.effects if e.kind.harmonic})
         if ranges and periodic:
             lines.append("periodic effects known over the fitted angles (validate and compensate warn beyond them): " +
                          ", ".join(f"joint {j} {ranges[j - 1][0]:.0f}..{ranges[j - 1][1]:.0f} deg" for j in periodic))
@@ -265,7 +267,7 @@ def check_effects(effects: Union[str, Iterable[Union[str, Candidate]]], robot: R
     return out
 
 
-def _errors(r: _core.IdentifyResult, h: dict[str, Any]) -> dict[str, FloatArray]:
+def _errors(r: _core.IdentifyResult, h: Measurements) -> dict[str, FloatArray]:
     """Position (and, with measured orientations, orientation) errors of the rows h: before (the
     nominal geometry, frames fitted) and after (the identified model r)."""
     out = {"ea": _core.point_errors(r.robot, r.targets, h, r.stations),
@@ -278,12 +280,12 @@ def _errors(r: _core.IdentifyResult, h: dict[str, Any]) -> dict[str, FloatArray]
 
 
 #: a training set's model: the model fitted on it and its effect choice (None: the effects were given)
-ModelOf = Callable[[dict[str, Any]], "tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]"]
+ModelOf = Callable[["Measurements"], "tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]"]
 #: the errors of a setup held out whole, on the model fitted on the others (_setup_refit)
-SetupRefit = Callable[[Robot, dict[str, Any]], "dict[str, FloatArray]"]
+SetupRefit = Callable[[Robot, "Measurements"], "dict[str, FloatArray]"]
 
 
-def _fold_errors(model_of: ModelOf, data: dict[str, Any], held_masks: Sequence[BoolArray],
+def _fold_errors(model_of: ModelOf, data: Measurements, held_masks: Sequence[BoolArray],
                  progress: Optional[Callable[[int, int], None]], refit: Optional[SetupRefit] = None
                  ) -> tuple[dict[str, FloatArray], list[Optional[effect_choice.Choice]]]:
     """_errors of every held-out row, each fold predicted by the model fitted without it
@@ -315,7 +317,7 @@ def _fold_errors(model_of: ModelOf, data: dict[str, Any], held_masks: Sequence[B
 def _setup_refit(loss: str, loss_scale_mm: float) -> SetupRefit:
     """The errors of a setup held out whole: its placement and targets refitted on its rows
     (validate()'s refit) on the model fitted on the other setups."""
-    def refit(robot: Robot, held: dict[str, Any]) -> dict[str, FloatArray]:
+    def refit(robot: Robot, held: Measurements) -> dict[str, FloatArray]:
         ea, eb, oa, ob, _ = _refit_placements(robot, held, loss, loss_scale_mm)
         out = {"ea": ea, "eb": eb}
         if oa is not None and ob is not None:  # measured orientations: both, or neither
@@ -334,7 +336,7 @@ def _fit_options(fit: Optional[FitOptions], **kw: Any) -> FitOptions:
     return FitOptions(**kw)
 
 
-def _validation_scheme(data: dict[str, Any], fit: FitOptions, *, hold_out_setups: bool, holdout: Optional[float],
+def _validation_scheme(data: Measurements, fit: FitOptions, *, hold_out_setups: bool, holdout: Optional[float],
                        k_folds: int, seed: int
                        ) -> tuple[BoolArray, list[BoolArray], dict[str, Any], Optional[SetupRefit]]:
     """How identify() validates: the rows its model is fitted on, the held-out masks (each setup
@@ -367,7 +369,7 @@ def _validation_scheme(data: dict[str, Any], fit: FitOptions, *, hold_out_setups
     return fit_mask, masks, val, refit
 
 
-def identify(robot: Robot, data: dict[str, Any], *, effects: Union[str, Sequence[Union[str, Candidate]]] = "auto",
+def identify(robot: Robot, data: Measurements, *, effects: Union[str, Sequence[Union[str, Candidate]]] = "auto",
              fit: Optional[FitOptions] = None, loss: str = "huber",
              loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM, prior_sd: Optional[dict[str, float]] = None,
              prior_scale: Union[float, str, None] = 1.0,
@@ -417,7 +419,7 @@ def identify(robot: Robot, data: dict[str, Any], *, effects: Union[str, Sequence
     holdout = holdout or None  # a share of 0 holds nothing out
     core_effects, gravity_of = effect_choice.expand(effects, robot)
 
-    def model_of(train: dict[str, Any]) -> tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]:
+    def model_of(train: Measurements) -> tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]:
         """The model of a training set: its effects chosen on it (auto), then fitted on it."""
         if auto:
             ch = effect_choice.choose(robot, train, fit, k_folds=CHOICE_FOLDS, seed=seed)

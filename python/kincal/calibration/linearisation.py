@@ -4,13 +4,14 @@ priors as pseudo-rows (effect_choice's candidates and the diagnosis's residual v
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional, Sequence
+from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
 from .. import _core
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray
 
 
@@ -18,7 +19,7 @@ def _key(p: _core.Parameter) -> tuple[str, int, int, str]:
     return (p.kind, p.joint, p.target, p.name)
 
 
-def evaluate(res: _core.IdentifyResult, data: dict[str, Any], extra: Sequence[_core.Effect]
+def evaluate(res: _core.IdentifyResult, data: Measurements, extra: Sequence[_core.Effect]
              ) -> tuple[FloatArray, FloatArray, FloatArray, list[_core.Parameter], dict[int, int]]:
     """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
     parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
@@ -52,7 +53,7 @@ def evaluate(res: _core.IdentifyResult, data: dict[str, Any], extra: Sequence[_c
     return np.asarray(r), cur, J, new, fit_of
 
 
-def equations(data: dict[str, Any]) -> Optional[BoolArray]:
+def equations(data: Measurements) -> Optional[BoolArray]:
     """Per row and position coordinate, whether it carries an equation (a plane's or a ballbar's row
     has one: its first); None when every row has three."""
     station = np.asarray(data.get("station", np.full(len(data["pose"]), -1)))
@@ -65,7 +66,7 @@ def equations(data: dict[str, Any]) -> Optional[BoolArray]:
     return used
 
 
-def prior_rows(res: _core.IdentifyResult, data: dict[str, Any], fit_of: dict[int, int]
+def prior_rows(res: _core.IdentifyResult, data: Measurements, fit_of: dict[int, int]
                 ) -> Optional[tuple[FloatArray, FloatArray]]:
     """On probe data, the fit's priors as pseudo-rows of the linearisation: for each of its free
     columns with a prior, noise / sd times the parameter's distance from the prior's centre, and

@@ -30,9 +30,11 @@ import numpy as np
 from .. import _core
 from . import identify as ident
 from .._core import Robot
-from .fitting import options, subset
+from ..stats.grouping import subset
+from .fitting import options
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray, IntArray
 
 
@@ -142,7 +144,7 @@ def keep_out(robot: Robot, q: FloatArray, targets: FloatArray, rules: KeepOut) -
     return ok, {k: v for k, v in rejected.items() if v}
 
 
-def _campaign(robot: Robot, q: FloatArray, targets: FloatArray) -> dict[str, Any]:
+def _campaign(robot: Robot, q: FloatArray, targets: FloatArray) -> Measurements:
     """A noise-free campaign at the nominal model (the instrument at the base), for the Jacobian."""
     n, t = len(q), len(targets)
     frames = _tool_frames(robot, q)
@@ -159,7 +161,7 @@ def _jacobian(robot: Robot, q: FloatArray, targets: FloatArray, effects: list[_c
     the targets at their offsets, of every parameter or of ``columns`` (indices), and the layout's
     parameters."""
     data = _campaign(robot, q, targets)
-    pm = _core.PointModel(robot, len(targets), [e for e in effects if e.name != "joint_compliance"])
+    pm = _core.PointModel(robot, len(targets), [e for e in effects if not e.kind.gravity_loaded_only])
     params = list(pm.layout.parameters)
     # the start (the nominal model; base and targets fitted to these noise-free points) from the first
     # 500 candidates: the same to 1e-7 (the plan's TCP figure), in a fraction of the time of 100,000
@@ -180,7 +182,7 @@ def _free_columns(robot: Robot, q: FloatArray, targets: FloatArray, effects: lis
     data = _campaign(robot, sub, targets)
     res = _core.identify(robot, data, options(effects, loss="none", max_iterations=0, covariance=False))
     fixed = np.asarray(res.fixed)
-    compliance = any(e.name == "joint_compliance" for e in effects)
+    compliance = any(e.kind.gravity_loaded_only for e in effects)
     free: list[int] = []
     left: list[tuple[str, str]] = []
     for p, fx, why in zip(res.layout.parameters, fixed, res.fixed_reason):
@@ -318,8 +320,8 @@ def plan(robot: Robot, k: int, *, targets: FloatArray,
                 min_singular_value=float(s[-1]) if m else 0.0, candidates=int(len(q)), rejected=rejected)
 
 
-def select_observable(robot: Robot, candidates: dict[str, Any], poses: int,
-                      compliance: bool = True) -> dict[str, Any]:
+def select_observable(robot: Robot, candidates: Measurements, poses: int,
+                      compliance: bool = True) -> Measurements:
     """Choose ``poses`` of the candidate campaign's poses that maximise observability: greedy
     D-optimal design on the nominal model's identification Jacobian (unit-scaled columns of the
     parameters a generic campaign identifies), each step adding the pose that most increases

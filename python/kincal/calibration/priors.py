@@ -21,7 +21,7 @@ from ..stats import grouping
 from .._core import Robot
 
 if TYPE_CHECKING:
-    from ..typing_ import BoolArray
+    from .._core import Measurements
 
 #: prior standard deviations by kind (file units): a robot maker's tolerances for the joint geometry,
 #: a tool known to a few mm; none for the compliances (their size per kN m differs 100-fold between
@@ -48,7 +48,7 @@ def parse_prior_sd(text: Optional[str]) -> dict[str, float]:
     text = (text or "").strip()
     if text == "none":
         return {}
-    effects = [k.name for k in _core.effect_kinds() if k.domain == "serial" and k.name != "joint_compliance"]
+    effects = [k.name for k in _core.effect_kinds() if k.domain == "serial" and not k.gravity_loaded_only]
     for item in filter(None, (t.strip() for t in text.split(","))):
         kind, eq, value = item.partition("=")
         kind = kind.strip()
@@ -108,18 +108,18 @@ class Fitter:
         self.auto_scale, self.folds, self.seed = auto_scale, folds, seed
         self.scales: list[float] = []
 
-    def _once(self, data: dict[str, Any], opts: _core.IdentifyOptions,
+    def _once(self, data: Measurements, opts: _core.IdentifyOptions,
               progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         return _core.identify(self.robot, data, opts, progress, self.from_calibrated)
 
-    def __call__(self, data: dict[str, Any], opts: _core.IdentifyOptions,
+    def __call__(self, data: Measurements, opts: _core.IdentifyOptions,
                  progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         if self.auto_scale and opts.prior_scale > 0:
             opts = _copy(opts, prior_scale=self.choose_scale(data, opts))
             self.scales.append(opts.prior_scale)
         return self._once(data, opts, progress)
 
-    def choose_scale(self, data: dict[str, Any], opts: _core.IdentifyOptions) -> float:
+    def choose_scale(self, data: Measurements, opts: _core.IdentifyOptions) -> float:
         """The overall prior width with the least grouped cross-validated RMS error on data."""
         k = min(self.folds, grouping.configurations(data).count)
         if k < 2:
@@ -132,18 +132,14 @@ class Fitter:
             ss, n = 0.0, 0
             try:
                 for held in masks:
-                    r = self._once(_subset(data, ~held), o)
-                    e = np.asarray(_core.point_errors(r.robot, r.targets, _subset(data, held), r.stations))
+                    r = self._once(grouping.subset(data, ~held), o)
+                    e = np.asarray(_core.point_errors(r.robot, r.targets, grouping.subset(data, held), r.stations))
                     ss, n = ss + float(np.sum(e ** 2)), n + len(e)
             except ValueError:  # a fold these priors cannot fit (too narrow data for a wide prior)
                 continue
             if n and math.sqrt(ss / n) < best_rms:
                 best, best_rms = s, math.sqrt(ss / n)
         return best
-
-
-def _subset(data: dict[str, Any], mask: BoolArray) -> dict[str, Any]:
-    return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()}
 
 
 def _copy(o: _core.IdentifyOptions, **changes: Any) -> _core.IdentifyOptions:
@@ -156,7 +152,7 @@ def _copy(o: _core.IdentifyOptions, **changes: Any) -> _core.IdentifyOptions:
     return c
 
 
-def down_weighted(fit: _core.IdentifyResult, data: dict[str, Any], n: int = 5) -> list[tuple[int, int, float, float]]:
+def down_weighted(fit: _core.IdentifyResult, data: Measurements, n: int = 5) -> list[tuple[int, int, float, float]]:
     """The rows the robust loss down-weighted most: (pose, target, residual mm, weight), the weight
     the loss gives a row of that residual norm (Huber: scale / residual), smallest first."""
     scale = fit.loss_scale_mm

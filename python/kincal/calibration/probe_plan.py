@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Union, cast
 
 import numpy as np
 
@@ -44,6 +44,7 @@ from .fitting import options
 from .plan import KeepOut, _tool_frames, keep_out, path_order
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import FloatArray, IntArray
 
 Kind = Literal["sphere", "plane", "distance"]
@@ -58,7 +59,7 @@ class ProbePlan:
     """The chosen touches (a measurement set without measurements: q_deg, kind, station, radius,
     length and the artifact of the stations as placed) and what they promise."""
     kind: str
-    data: dict[str, Any]
+    data: Measurements
     tcp_uncertainty_mm: float         #: predicted RMS of the ball centre over the configurations, rigid part removed (median)
     tcp_uncertainty_p90_mm: float     #: its 90th percentile over repeated campaigns
     priors_tcp_mm: float              #: the same (median) for a robot one prior sd off the priors' centre, noise aside
@@ -105,15 +106,17 @@ def rigid_rms(a: FloatArray, b: FloatArray) -> float:
     return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
 
 
-def _subset(data: dict[str, Any], rows: IntArray) -> dict[str, Any]:
+def _subset(data: Measurements, rows: IntArray) -> Measurements:
     """The rows ``rows`` of a measurement set, numbered again from 0 (its other entries as they are)."""
     n = len(data["pose"])
-    out = {k: (v[rows] if isinstance(v, np.ndarray) and len(v) == n else v) for k, v in data.items()}
+    # the same keys, the per-row arrays' rows picked: still a measurement set
+    out = cast("Measurements", {k: (v[rows] if isinstance(v, np.ndarray) and len(v) == n else v)
+                                for k, v in data.items()})
     out["pose"] = np.arange(len(rows), dtype=np.int32)
     return out
 
 
-def _whitened_rows(J: FloatArray, data: dict[str, Any], sigma: float) -> tuple[FloatArray, IntArray]:
+def _whitened_rows(J: FloatArray, data: Measurements, sigma: float) -> tuple[FloatArray, IntArray]:
     """The Jacobian's rows of each touch (residual_size rows per row in J, the constraint's
     equations first) divided by the noise, as (touches, equations, columns), and each touch's
     station."""
@@ -134,9 +137,9 @@ def _ball_jacobian(robot: Robot, q: FloatArray, probe: FloatArray, effects: list
     frames = _tool_frames(robot, q)
     pts = frames[:, :3, :3] @ probe + frames[:, :3, 3]
     n = len(q)
-    data = {"pose": np.arange(n, dtype=np.int32), "q_deg": q, "xyz": pts, "target": np.zeros(n, dtype=np.int32),
-            "payload_kg": np.full(n, np.nan), "line": np.zeros(n, dtype=np.int32), "source": "<plan>",
-            "dir": np.ones((n, robot.dof))}
+    data: Measurements = {"pose": np.arange(n, dtype=np.int32), "q_deg": q, "xyz": pts,
+                          "target": np.zeros(n, dtype=np.int32), "payload_kg": np.full(n, np.nan),
+                          "line": np.zeros(n, dtype=np.int32), "source": "<plan>", "dir": np.ones((n, robot.dof))}
     pm = _core.PointModel(robot, 1, effects)
     x = np.asarray(pm.start(data), dtype=float)
     for p in pm.layout.parameters:
@@ -250,7 +253,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
     params = list(res.layout.parameters)
     free = np.flatnonzero(~np.asarray(res.fixed))
     left_out = [(p.name, why) for p, fx, why in zip(params, res.fixed, res.fixed_reason) if fx]
-    pm = _core.PointModel(robot, 1, [e for e in core_effects if e.name != "joint_compliance"],
+    pm = _core.PointModel(robot, 1, [e for e in core_effects if not e.kind.gravity_loaded_only],
                           stations_of=res.layout)
     x = np.asarray(res.start, dtype=float)  # the ball at the probe's offset, the stations through it
     r, J = pm.residuals(list(x), pool, True, artifact=True, columns=free.tolist())
@@ -275,7 +278,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
         q = np.random.default_rng(seed + 1).uniform(0.9 * lim[:, 0], 0.9 * lim[:, 1], size=(n_configurations, robot.dof))
     q = np.asarray(q, dtype=float)
     names = [params[i].name for i in free]
-    G = _ball_jacobian(robot, q, probe_v, [e for e in core_effects if e.name != "joint_compliance"], names) * scale
+    G = _ball_jacobian(robot, q, probe_v, [e for e in core_effects if not e.kind.gravity_loaded_only], names) * scale
     frames = _tool_frames(robot, q)
     balls = frames[:, :3, :3] @ probe_v + frames[:, :3, 3]
     rand = [int(i) for s in np.unique(station) for i in np.flatnonzero(station == s)[:touches]]
@@ -294,7 +297,7 @@ def _nominal(robot: Robot) -> Robot:
     return robot.nominal_only() if robot.identified else robot
 
 
-def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> dict[str, Any]:
+def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> Measurements:
     """The candidate touches: `kincal simulate --kind`'s campaign on the robot's nominal model, noise-free,
     without the candidates near a singularity (a touch there cannot be made again to the plan's
     orientation). Stations placed where the cone cannot be reached, or with fewer than ``needed``
@@ -318,7 +321,7 @@ def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> dic
                      "--touches or a smaller --cone")
 
 
-def _path_within_stations(pool: dict[str, Any], chosen: list[int]) -> IntArray:
+def _path_within_stations(pool: Measurements, chosen: list[int]) -> IntArray:
     """The chosen touches station by station, each station's in a short path order (nearest
     neighbour in joint space)."""
     st = np.asarray(pool["station"])[chosen]
@@ -330,8 +333,8 @@ def _path_within_stations(pool: dict[str, Any], chosen: list[int]) -> IntArray:
     return np.concatenate(out)
 
 
-def measure(truth: Robot, plan: dict[str, Any], probe: Sequence[float] = (0.0, 0.0, 150.0), noise_mm: float = 0.005,
-            seed: int = 1) -> dict[str, Any]:
+def measure(truth: Robot, plan: Measurements, probe: Sequence[float] = (0.0, 0.0, 150.0), noise_mm: float = 0.005,
+            seed: int = 1) -> Measurements:
     """The planned touches made on a true robot: each row's ball centre is where the plan put it on
     the nominal model (a sphere's centre, a point of a face, the ballbar's far end) with the same tool
     orientation, reached on the truth's calibrated model (Newton on its forward kinematics, from the
@@ -341,7 +344,7 @@ def measure(truth: Robot, plan: dict[str, Any], probe: Sequence[float] = (0.0, 0
     probe_v = np.asarray(probe, dtype=float)
     q = np.asarray(plan["q_deg"], dtype=float).copy()
     nominal = _tool_frames(truth, q)
-    out = dict(plan)
+    out = cast("Measurements", dict(plan))  # a copy: the same keys
     kinds = [plan["station_kinds"][s] for s in plan["station"]]
     dirs = np.asarray(plan["dir"], dtype=float) if "dir" in plan else None  # the last motion's, when recorded
     length = np.asarray(plan["length_mm"], dtype=float).copy()
@@ -359,7 +362,7 @@ def measure(truth: Robot, plan: dict[str, Any], probe: Sequence[float] = (0.0, 0
     return out
 
 
-def _plane_normal(frames: FloatArray, plan: dict[str, Any], i: int) -> FloatArray:
+def _plane_normal(frames: FloatArray, plan: Measurements, i: int) -> FloatArray:
     """The unit normal of row i's plane, from the station's touches' tool axes (the probe points into
     the face, so their mean is along the inward normal)."""
     rows = np.flatnonzero(np.asarray(plan["station"]) == plan["station"][i])

@@ -5,7 +5,7 @@ The joint identification of every placement and the validation itself are in ide
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, Iterable, Mapping, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Optional, Sequence, Union, cast
 
 import numpy as np
 
@@ -15,11 +15,15 @@ from .fitting import orientation_errors_deg, rms
 from .simulation import simulate
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray
+
+    #: a measurement set's entry, whatever its key (Measurements: arrays, the source, names, artifact tuples)
+    Column = Union[np.ndarray, str, list[str], list[tuple[str, str, float, float, str]]]
 
 
 def simulate_setups(truth: Robot, placements: Mapping[str, Sequence[float]], poses: int = 150, *, seed: int = 1,
-                    **options: Any) -> dict[str, Any]:
+                    **options: Any) -> Measurements:
     """A campaign measured from several instrument placements: ``placements`` maps each setup's
     name to the robot base frame seen from the instrument there, (x, y, z mm, a, b, c deg). Each
     setup measures ``poses`` random configurations (its own seed, ``seed`` + its index) with the
@@ -42,8 +46,11 @@ def simulate_setups(truth: Robot, placements: Mapping[str, Sequence[float]], pos
             d["time_s"] = d["time_s"] + t0
             t0 = float(d["time_s"][-1]) + 60.0
         parts.append(d)
-    out = {key: (np.concatenate([p[key] for p in parts]) if isinstance(parts[0][key], np.ndarray) else parts[0][key])
-           for key in parts[0]}
+    # the parts' entries by name (the same keys in each): the arrays' rows concatenated, the rest the
+    # first part's; the result has the parts' keys, so it is a measurement set
+    cols = cast("list[Mapping[str, Column]]", parts)
+    out = cast("Measurements", {key: (np.concatenate([p[key] for p in cols]) if isinstance(cols[0][key], np.ndarray)
+                                      else cols[0][key]) for key in cols[0]})
     out["setup_names"] = [str(n) for n in placements]
     return out
 
@@ -102,12 +109,11 @@ def setup_frames(placements: Iterable[tuple[str, Iterable[float], Iterable[float
 def drift_report(fit: _core.IdentifyResult) -> Optional[dict[str, Any]]:
     """The instrument's drift an identification found (a property of the measurement: removed from
     the fit, never compensated), in the model file's units with standard deviations, or None."""
-    names = [e.name for e in fit.layout.effect_list]
-    if "drift" not in names:
+    found = [i for i, e in enumerate(fit.layout.effect_list) if e.kind.of_instrument]
+    if not found:
         return None
-    e = fit.layout.effect_list[names.index("drift")]
-    off = fit.layout.effect_offset[names.index("drift")]
-    vals, sd = np.asarray(fit.x)[off:off + 6], np.asarray(fit.stddev)[off:off + 6]
+    e, off = fit.layout.effect_list[found[0]], fit.layout.effect_offset[found[0]]
+    vals, sd = np.asarray(fit.x)[off:off + e.size], np.asarray(fit.stddev)[off:off + e.size]
     return {"t_mean_s": fit.t_mean_s,
             "note": "the instrument's placement moving with time_s about t_mean_s (a base point x is seen at "
                     "Exp(tau w) R x + t + tau v, tau in hours, v and w in the instrument's axes): removed from the "
@@ -118,7 +124,7 @@ def drift_report(fit: _core.IdentifyResult) -> Optional[dict[str, Any]]:
 
 
 def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[FloatArray],
-                       o_before: Optional[FloatArray], data: dict[str, Any]) -> dict[str, Any]:
+                       o_before: Optional[FloatArray], data: Measurements) -> dict[str, Any]:
     """The figures of `kincal validate` from the position errors (mm) after (the calibrated model)
     and before (the nominal one) and, with measured orientations, the orientation errors (deg):
     ``points``, ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm`` (``before_mean_mm``,
@@ -148,7 +154,7 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
     return v
 
 
-def _refit_placements(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1,
+def _refit_placements(robot: Robot, data: Measurements, loss: str = "huber", loss_scale_mm: float = 0.1,
                       target_start: Optional[Sequence[Sequence[float]]] = None) -> tuple[
         FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
@@ -183,7 +189,7 @@ def extrapolated(robot: Robot, q_deg: FloatArray) -> list[dict[str, Any]]:
             for e in _core.extrapolated(robot, np.asarray(q_deg, dtype=float))]
 
 
-def inside_and_outside(robot: Robot, data: dict[str, Any], loss: str = "huber",
+def inside_and_outside(robot: Robot, data: Measurements, loss: str = "huber",
                        loss_scale_mm: float = 0.1) -> dict[str, dict[str, Any]]:
     """validate()'s RMS (after, before) split between the rows that take none of the robot's periodic
     effects outside their fitted ranges and the rows that take one: ``{"inside": {"rows",
@@ -200,7 +206,7 @@ def inside_and_outside(robot: Robot, data: dict[str, Any], loss: str = "huber",
     return {"inside": part(~out), "outside": part(out)}
 
 
-def validate(robot: Robot, data: dict[str, Any], loss: str = "huber", loss_scale_mm: float = 0.1,
+def validate(robot: Robot, data: Measurements, loss: str = "huber", loss_scale_mm: float = 0.1,
              target_start: Optional[Sequence[Sequence[float]]] = None) -> dict[str, Any]:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit

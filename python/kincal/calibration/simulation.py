@@ -4,12 +4,15 @@ its measurements by a simulated laser tracker, and the effects hidden in it (`--
 from __future__ import annotations
 
 import math
-from typing import Any, Literal, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Literal, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import _core
 from .._core import Robot
+
+if TYPE_CHECKING:
+    from .._core import Measurements
 
 #: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
 DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
@@ -32,7 +35,7 @@ def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg:
 def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
              outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence[HiddenEffect] = (),
              t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None,
-             duration_h: Optional[float] = None) -> dict[str, Any]:
+             duration_h: Optional[float] = None) -> Measurements:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
     model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
     ``effects`` hides more effects in the truth: (Effect, values) or (name, joint from 1 or 0, values),
@@ -63,7 +66,7 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
 def simulate_probe(truth: Robot, kind: Literal["sphere", "plane", "distance"], *, stations: int = 3, touches: int = 25, cone_deg: float = 35.0,
                    probe: Sequence[float] = (0.0, 0.0, 150.0), radius_mm: float = 3.0, length_mm: float = 150.0,
                    block_mm: float = 400.0, noise_mm: float = 0.005, seed: int = 1,
-                   artifact: bool = True) -> dict[str, Any]:
+                   artifact: bool = True) -> Measurements:
     """A probe campaign (no tracker) on the truth's calibrated model: ``kind`` 'sphere' (the ball in
     ``stations`` fixed nests placed in reach), 'plane' (the faces of one block of ``block_mm``: top,
     the face towards the robot, the sideways ones, the surface plate it stands on) or 'distance' (a ballbar of
@@ -90,8 +93,8 @@ def _effect_value(e: HiddenEffect) -> tuple[_core.Effect, list[float]]:
         return e[0], [float(v) for v in e[1]]
     name, joint, vals = e
     vals = [float(v) for v in vals]
-    if name == "joint_map":  # its order from the number of values: a sine and a cosine per order
-        return _core.Effect("joint_map", int(joint), order=max(1, len(vals) // 2)), vals
+    if _core.effect_kind(str(name)).ordered:  # its order from the number of values: a sine and a cosine per order
+        return _core.Effect(str(name), int(joint), order=max(1, len(vals) // 2)), vals
     return _core.Effect(str(name), int(joint)), vals
 
 
@@ -105,7 +108,7 @@ def parse_hidden_effect(text: str, dof: int,
     if len(parts) != 3:
         raise ValueError(f"--hide {text}: expected NAME:JOINT:VALUES")
     name, joint, vals = parts[0], parts[1], parts[2]
-    kinds = [k for k in _core.effect_kinds() if k.domain == "serial" and k.name != "joint_compliance"]
+    kinds = [k for k in _core.effect_kinds() if k.domain == "serial" and not k.gravity_loaded_only]
     kind = next((k for k in kinds if k.name == name), None)
     if kind is None:
         raise ValueError(f"--hide {text}: unknown effect '{name}' ({', '.join(k.name for k in kinds)})")
@@ -116,9 +119,9 @@ def parse_hidden_effect(text: str, dof: int,
         raise ValueError(f"--hide {text}: joint and values must be numbers") from None
     if kind.concerns == "joint" and not 1 <= j <= dof:
         raise ValueError(f"--hide {text}: joint {j} is not one of 1..{dof}")
-    if name == "joint_map":
+    if kind.ordered:
         if len(v) < 2 or len(v) % 2 or len(v) > 128:
-            raise ValueError(f"--hide {text}: joint_map takes a sine and a cosine amplitude (deg) per order "
+            raise ValueError(f"--hide {text}: {name} takes a sine and a cosine amplitude (deg) per order "
                              "1..K: an even number of values, 2 to 128")
         e = _core.Effect(name, j, order=len(v) // 2)
     else:

@@ -9,6 +9,7 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -23,6 +24,9 @@ from .options import (artifact_opt, artifact_out, effect_opts, effects_arg, fit_
                       loss_opts, probe_offset, probe_opts, probe_start, progress, robot_of, robot_opts, say, step_progress,
                       tool_targets)
 
+if TYPE_CHECKING:
+    from .._core import Measurements
+
 
 def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.Robot) -> None:
     """simulate --kind: a probe campaign and its artifact file."""
@@ -30,7 +34,8 @@ def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.R
     data = sim.simulate_probe(truth, args.kind, stations=args.stations, touches=args.touches, cone_deg=args.cone,
                               probe=probe, radius_mm=args.radius, length_mm=args.length, block_mm=args.block,
                               noise_mm=0.005 if args.noise is None else args.noise, seed=args.seed)
-    data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
+    # the controller's numbers (the same keys: still a measurement set)
+    data = cast("Measurements", dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"])))
     art = artifact_out(args)
     text = ident.measurements_csv(data, robot.dof)
     artifact = _core.format_artifact(data, robot.dof) if "artifact" in data else None
@@ -65,12 +70,13 @@ def cmd_simulate(args: argparse.Namespace) -> None:
                           orientation_noise_deg=args.orientation_noise, duration_h=args.duration)
     if args.truth_out and not args.truth:  # the truth as measured: its hidden effects too (not the
         # instrument's drift, a property of the measurement that no robot model carries)
-        acting = [e for e in hidden if e[0].name != "drift"]
+        acting = [e for e in hidden if not e[0].kind.of_instrument]
         _core.write_file_atomic(args.truth_out, (truth.with_effects(acting, 20.0) if acting else truth).to_json())
     if args.select == "observability":
         from ..calibration import plan
         data = plan.select_observable(robot, data, args.poses)
-    data = dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"]))  # the controller's numbers
+    # the controller's numbers (the same keys: still a measurement set)
+    data = cast("Measurements", dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"])))
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 

@@ -9,12 +9,15 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union, cast
 
 from .. import _core, load_robot
 from ..programs import feed
 from .options import joint_convention_option, robot_of, robot_opts, step_progress
 from ..calibration.tool_frame import warn_nominal_tcp
+
+if TYPE_CHECKING:
+    from .._core import BackupResult, ControllerProgramResult
 
 FORMATS = ["krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv"]
 
@@ -79,7 +82,8 @@ def _frame(text: Optional[str], option: str) -> list[float]:
 
 
 def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[str, Any],
-               progress: Optional[Callable[[int, int], None]] = None) -> dict[str, Any]:
+               progress: Optional[Callable[[int, int], None]] = None
+               ) -> Union[ControllerProgramResult, BackupResult]:
     """Compensates args.program (a file, or several files and folders: a controller backup) into args.out
     in the chosen language; returns the result dict (with `files`, the files written; a backup: `programs`,
     `copied`, `failed`). A model whose TCP is nominal (not measured) gets one warning line. One program's
@@ -100,7 +104,7 @@ def compensate(robot: _core.Robot, args: argparse.Namespace, comp_kwargs: dict[s
                                           threads=args.jobs, progress=progress)
 
 
-def summary(res: dict[str, Any]) -> list[str]:
+def summary(res: ControllerProgramResult) -> list[str]:
     """The summary's lines on a native program's targets (joints or filtered) and on --tolerance."""
     lines = [res["targets_note"]] if res.get("targets_note") else []
     if res.get("inserted") is None or res["path_before_mm"] != res["path_before_mm"]:  # NaN: no --tolerance
@@ -113,7 +117,9 @@ def compensate_backup(robot: _core.Robot, args: argparse.Namespace, comp_kwargs:
     """A controller backup (folders, several files): every program filtered into the same tree under --out;
     a program that fails is listed (file:line: cause) and the exit status is 1, the others are written."""
     step = step_progress("kincal compensate: programs")  # (done counts from 1)
-    res = compensate(robot, args, comp_kwargs, progress=None if step is None else lambda done, n: step(done - 1, n))
+    res = cast("BackupResult",  # several programs or a folder: the core compensates a backup
+               compensate(robot, args, comp_kwargs,
+                          progress=None if step is None else lambda done, n: step(done - 1, n)))
     if sys.stderr.isatty():
         print(file=sys.stderr)
     for p in res["programs"]:
@@ -149,7 +155,7 @@ def cmd_compensate(args: argparse.Namespace) -> None:
     if len(args.program) > 1 or Path(args.program[0]).is_dir():
         compensate_backup(robot, args, _comp_kwargs(args))
         return
-    res = compensate(robot, args, _comp_kwargs(args))
+    res = cast("ControllerProgramResult", compensate(robot, args, _comp_kwargs(args)))  # one program: no backup
     for w in res["warnings"]:
         print(f"kincal compensate: warning: {w}", file=sys.stderr)
     n = res["poses"]

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional, cast
 
 import numpy as np
 
@@ -40,7 +40,7 @@ from ..io import strict_json
 from ..io.csv_text import format_rows
 
 if TYPE_CHECKING:
-    from .._core import Robot
+    from .._core import CompensationResult, Measurements, Robot
     from ..typing_ import FloatArray
 
 SEED = 7
@@ -147,8 +147,8 @@ def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagno
     plan = probe_plan.plan_probe(robot, "sphere", stations=6, touches=25, cone_deg=60, probe=PROBE, noise_mm=0.005,
                                  configurations=q, seed=SEED)
     touches = probe_plan.measure(truth, plan.data, PROBE, 0.005, seed=SEED)  # the truth's backlash acting
-    _core.write_file_atomic(str(out / "spheres.csv"), ident.measurements_csv(
-        dict(touches, q_deg=_core.joints_to_controller(robot, touches["q_deg"])), robot.dof))
+    _core.write_file_atomic(str(out / "spheres.csv"), ident.measurements_csv(  # the controller's numbers
+        cast("Measurements", dict(touches, q_deg=_core.joints_to_controller(robot, touches["q_deg"]))), robot.dof))
     _core.write_file_atomic(str(out / "spheres-artifact.csv"), _core.format_artifact(touches, robot.dof))
     res = ident.identify(robot, touches, fit=FitOptions(target_start=[PROBE]))
     _core.write_file_atomic(str(out / "spheres_model.json"), res.model_json())
@@ -163,7 +163,7 @@ def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagno
 
 
 def _summary(res: ident.Identification, diag: dict[str, Any], diagnosed: ident.Identification, iso: dict[str, Any],
-             axes: dict[Any, Any], spheres: dict[str, Any], com: dict[str, Any], fres: dict[str, dict[str, Any]],
+             axes: dict[Any, Any], spheres: dict[str, Any], com: CompensationResult, fres: dict[str, dict[str, Any]],
              hb: list[float], table_fits: dict[str, dict[str, Any]], poses: int,
              errors: tuple[FloatArray, FloatArray, FloatArray],
              angles: tuple[FloatArray, FloatArray, FloatArray]) -> dict[str, Any]:

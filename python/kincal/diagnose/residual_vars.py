@@ -20,7 +20,7 @@ offsets as temperature_c, a compliance that is not linear as a gravity torque.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Sequence, Union
+from typing import TYPE_CHECKING, Any, Literal, Sequence, Union
 
 import numpy as np
 
@@ -28,6 +28,7 @@ from .. import _core
 from .._core import Robot
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray
 
 #: knots of the piecewise-linear functions of a continuous variable (at its quantiles)
@@ -39,7 +40,7 @@ RIDGE = 1e-2
 CARRIES = 0.05
 
 
-def variables(robot: Robot, data: dict[str, Any]) -> list[dict[str, Any]]:
+def variables(robot: Robot, data: Measurements) -> list[dict[str, Any]]:
     """The candidate variables of a measurement set: dicts with ``variable`` (its name), ``label``
     (in words, with unit), ``values`` (one per row) and ``discrete``."""
     q = np.asarray(data["q_deg"], dtype=float)
@@ -51,6 +52,7 @@ def variables(robot: Robot, data: dict[str, Any]) -> list[dict[str, Any]]:
         tau = gravity_torques(robot, q)
         out += [{"variable": f"tau{j}", "label": f"gravity torque on joint {j} (kN m)",
                  "values": tau[:, j - 1] / 1000.0, "discrete": False} for j in loaded]
+    key: Literal["temperature_c", "time_s"]  # the measurement set's optional columns of these names
     for key, label in (("temperature_c", "temperature (deg C)"), ("time_s", "measurement time (s)")):
         if key in data and np.ptp(np.asarray(data[key], dtype=float)) > 0:
             out.append({"variable": key, "label": label, "values": np.asarray(data[key], dtype=float),
@@ -69,7 +71,7 @@ def gravity_torques(robot: Robot, q_deg: FloatArray) -> FloatArray:
     return np.array([_core.gravity_torque(robot, qq)[0] for qq in np.asarray(q_deg, dtype=float)])
 
 
-def carriers(res: _core.IdentifyResult, data: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
+def carriers(res: _core.IdentifyResult, data: Measurements) -> tuple[FloatArray, FloatArray]:
     """The residual r (dims per row) of a fit and the carriers C (one column per way the model moves
     a point: the instrument's 6 placement parameters, then each joint's angle, in mm per rad) at
     that fit."""
@@ -85,7 +87,7 @@ def carriers(res: _core.IdentifyResult, data: dict[str, Any]) -> tuple[FloatArra
     s, c = np.repeat(np.sin(q), dims, axis=0), np.repeat(np.cos(q), dims, axis=0)
     # the appended maps' (sine, cosine) columns, joint by joint (not the fit's own, nor a probe
     # campaign's stations after them)
-    added = [p.index for p in new if p.kind == "joint_map" and p.index not in fit_of]
+    added = [p.index for p in new if p.effect in extra and p.index not in fit_of]
     tail = J[:, added]
     joints = tail[:, 0::2] * s + tail[:, 1::2] * c  # J_j = sin q_j d/d(s_1) + cos q_j d/d(c_1)
     return r, np.c_[J[:, base], joints]

@@ -23,11 +23,12 @@ from ..calibration.fitting import FitOptions
 from . import residual_vars
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import FloatArray
 
 __all__ = ["JointCompliance", "SerialProblem", "Spec", "candidates", "diagnose", "final_identification", "step_effect"]
 
-def diagnose(robot: Robot, data: dict[str, Any], *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
+def diagnose(robot: Robot, data: Measurements, *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
              max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
              progress: Optional[Callable[[str], None]] = None,
              effects: Union[str, Sequence[Union[str, Candidate]]] = (),
@@ -80,14 +81,14 @@ def fitting_report(fit: FitOptions) -> dict[str, Any]:
 
 def step_effect(step: dict[str, Any]) -> Candidate:
     """The _core.Effect a step of diagnosis.json names (joint_map with its order)."""
-    if step["effect"] == "joint_map":
-        return _core.Effect("joint_map", step["joint"], order=step["order"])
+    if _core.effect_kind(step["effect"]).ordered:
+        return _core.Effect(step["effect"], step["joint"], order=step["order"])
     if step.get("gravity"):
         return JointCompliance(step["gravity"])
     return _core.Effect(step["effect"], step["joint"] or 0)
 
 
-def final_identification(robot: Robot, data: dict[str, Any], diag: dict[str, Any],
+def final_identification(robot: Robot, data: Measurements, diag: dict[str, Any],
                          tool_targets: Optional[FloatArray] = None) -> ident.Identification:
     """The diagnosed model (every named effect and those it started from), identified on all the data
     with Ceres as `kincal identify` does (covariance included), ready for model.json; with

@@ -17,26 +17,28 @@ from ..stats.stepwise import noise_phrase
 from .serial import Spec, step_effect
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..calibration.effect_choice import Candidate
     from ..typing_ import BoolArray, FloatArray
 
 
 def _label(step: dict[str, Any]) -> str:
     e = step_effect(step)
-    return e.label + (f", order {e.order}" if e.name == "joint_map" else "")
+    return e.label + (f", order {e.order}" if e.kind.ordered else "")
 
 
-def _variable(robot: Robot, data: dict[str, Any], effect: str, joint: Optional[int]) -> tuple[FloatArray, str]:
+def _variable(robot: Robot, data: Measurements, effect: str, joint: Optional[int]) -> tuple[FloatArray, str]:
     """The natural variable of an effect for plots: (values per point, axis label)."""
     j = joint or 1
-    if effect in ("transmission_error", "joint_map"):
+    kind = _core.effect_kind(effect)
+    if kind.harmonic:
         return data["q_deg"][:, j - 1], f"q{joint} (deg)"
-    if effect == "backlash":
+    if kind.needs == "dir":
         return data["dir"][:, j - 1] + np.random.default_rng(0).uniform(-0.15, 0.15, len(data["pose"])), \
             f"dir{joint} (sign of the last motion, jittered)"
-    if effect == "thermal_expansion":
+    if kind.needs == "temperature_c":
         return data["temperature_c"], "temperature (C)"
-    if effect == "drift":
+    if kind.needs == "time_s":
         return np.asarray(data["time_s"]) / 3600.0, "time of the measurement (h)"
     if joint is None:  # compliance of every loaded joint: the shoulder's gravity torque, when the masses are known
         tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, 1] / 1000.0
@@ -50,7 +52,7 @@ def _variable(robot: Robot, data: dict[str, Any], effect: str, joint: Optional[i
 LEVER = 0.25
 
 
-def _joint_error(res: _core.IdentifyResult, data: dict[str, Any], joint: int) -> tuple[FloatArray, BoolArray]:
+def _joint_error(res: _core.IdentifyResult, data: Measurements, joint: int) -> tuple[FloatArray, BoolArray]:
     """The angle error of ``joint`` (deg) each row's residual implies: the least-squares joint-angle
     change that would close it (-J_j . r / J_j . J_j, J_j the joint's column at the fit); and which
     rows the joint moves enough (|J_j| at least LEVER times the median row's) to read it."""
@@ -63,19 +65,19 @@ def _joint_error(res: _core.IdentifyResult, data: dict[str, Any], joint: int) ->
     return err, lever >= LEVER * np.median(lever)
 
 
-def _effect_curve(res: _core.IdentifyResult, data: dict[str, Any], effect: Candidate,
+def _effect_curve(res: _core.IdentifyResult, data: Measurements, effect: Candidate,
                   var: FloatArray) -> Optional[tuple[FloatArray, FloatArray]]:
     """The identified effect as a joint-angle change (deg) along its variable, sorted, less its mean
     over the points (a constant change is the joint's offset, which the geometry carries, so the
     residuals never show it), or None (thermal_expansion)."""
-    if effect.name == "joint_compliance":
+    if effect.kind.gravity_loaded_only:
         c = [float(x) for p, x in zip(res.layout.parameters, res.x) if p.kind == "compliance" and p.joint == effect.joint]
         xs = np.sort(var)
         return (xs, c[0] * (xs - np.mean(var))) if c else None  # deg/kNm * kN m
     vals = next((v for e, v in res.robot.effects if e == effect), None)
-    if vals is None or effect.name == "thermal_expansion":
+    if vals is None or effect.kind.acts_on != "joint_angle":
         return None
-    if effect.name == "backlash":  # drawn at the two directions only (var: the jittered signs)
+    if effect.kind.reads_dir:  # drawn at the two directions only (var: the jittered signs)
         return np.array([-1.0, 1.0]), np.degrees(vals[0]) * (np.array([-1.0, 1.0]) - np.mean(np.sign(var)))
 
     def dq(deg: FloatArray) -> FloatArray:
@@ -88,7 +90,7 @@ def _effect_curve(res: _core.IdentifyResult, data: dict[str, Any], effect: Candi
     return xs, dq(xs) - float(np.mean(dq(np.asarray(var, dtype=float))))
 
 
-def _step_figure(plt: ModuleType, robot: Robot, data: dict[str, Any], k: int, st: dict[str, Any],
+def _step_figure(plt: ModuleType, robot: Robot, data: Measurements, k: int, st: dict[str, Any],
                  before_fit: _core.IdentifyResult, after_fit: _core.IdentifyResult, path: Path) -> None:
     """The residual against the variable that carries a step's effect, before and after it was
     added: as the joint's implied angle error for a joint-angle effect (with the identified effect's
@@ -109,7 +111,7 @@ def _step_figure(plt: ModuleType, robot: Robot, data: dict[str, Any], k: int, st
         ax.scatter(var, np.clip(b, -lim, lim) * 1000, s=6, alpha=0.5, label="before")
         ax.scatter(var, np.clip(a, -lim, lim) * 1000, s=6, alpha=0.5, label="after")
         curve = _effect_curve(after_fit, data, effect, var)
-        if curve is not None and effect.name == "backlash":  # one level per direction
+        if curve is not None and effect.kind.reads_dir:  # one level per direction
             ax.hlines(curve[1] * 1000, curve[0] - 0.15, curve[0] + 0.15, color="k", lw=2.5, label="identified effect")
         elif curve is not None:
             ax.plot(curve[0], curve[1] * 1000, color="k", lw=1.5, label="identified effect")
@@ -145,7 +147,7 @@ def _share(share: float) -> str:
     return f"{share:.1%}" if share > 0 else f"none ({share:.1%})"
 
 
-def _point_errors(res: _core.IdentifyResult, data: dict[str, Any]) -> FloatArray:
+def _point_errors(res: _core.IdentifyResult, data: Measurements) -> FloatArray:
     return _core.point_errors(res.robot, res.targets, data)
 
 
@@ -172,7 +174,7 @@ def _variables_figure(plt: ModuleType, scores: list[dict[str, Any]], path: Path)
     plt.close(fig)
 
 
-def _residual_figure(plt: ModuleType, data: dict[str, Any], e0: FloatArray, e1: FloatArray, path: Path) -> None:
+def _residual_figure(plt: ModuleType, data: Measurements, e0: FloatArray, e1: FloatArray, path: Path) -> None:
     """The rows' errors with the starting model (e0) and the final one (e1): a map of the measured
     points in the instrument frame; for a campaign with probe rows each row's error along its
     constraint against the configurations, one colour per station (tracker points as one more)."""
@@ -204,7 +206,7 @@ def _residual_figure(plt: ModuleType, data: dict[str, Any], e0: FloatArray, e1: 
     plt.close(fig)
 
 
-def write_report(robot: Robot, data: dict[str, Any], diag: dict[str, Any], out_dir: Union[str, Path],
+def write_report(robot: Robot, data: Measurements, diag: dict[str, Any], out_dir: Union[str, Path],
                  title: str = "kincal diagnose", model_file: Optional[str] = None) -> list[str]:
     """Figures and report.html of a diagnosis in out_dir; returns the files written. ``model_file``:
     the name of the final model's JSON written beside it (said in the report)."""

@@ -5,7 +5,7 @@ five-bar effects on each link, transmission errors on each actuator) and refit, 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Optional, Union
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union, cast
 
 import numpy as np
 
@@ -17,6 +17,7 @@ from .._core import FiveBar
 from .hidden_robot import error_map_figure
 
 if TYPE_CHECKING:
+    from .._core import FiveBarPoints
     from ..typing_ import BoolArray, FloatArray
 
 LINKS = ("a", "b", "c", "d")
@@ -32,7 +33,7 @@ def library() -> list[_core.Effect]:
             out += [_core.Effect(kind.name, i + 1) for i in range(len(LINKS))]
     for kind in _core.effect_kinds():
         # joint_map (any order) is the serial diagnosis's; here the transmission error's two orders
-        if kind.acts_on == "joint_angle" and not kind.needs and not kind.gravity_loaded_only and kind.name != "joint_map":
+        if kind.acts_on == "joint_angle" and not kind.needs and not kind.gravity_loaded_only and not kind.ordered:
             out += [_core.Effect(kind.name, j + 1) for j in range(2)]
     return out
 
@@ -55,7 +56,7 @@ def _basis(effect: _core.Effect, t1: FloatArray, t2: FloatArray) -> FloatArray:
     return b
 
 
-def predict(pts: dict[str, Any], x: FloatArray, effects: list[_core.Effect]) -> FloatArray:
+def predict(pts: FiveBarPoints, x: FloatArray, effects: list[_core.Effect]) -> FloatArray:
     """Model positions (n x 2) for lengths x[:4] and the effects' parameters after them (effects:
     _core.Effect objects, joint = link or actuator from 1)."""
     t1, t2 = np.radians(pts["theta1_deg"]), np.radians(pts["theta2_deg"])
@@ -79,7 +80,7 @@ def predict(pts: dict[str, Any], x: FloatArray, effects: list[_core.Effect]) -> 
     return out
 
 
-def fit_with_effects(pts: dict[str, Any], effects: list[_core.Effect],
+def fit_with_effects(pts: FiveBarPoints, effects: list[_core.Effect],
                      start: Optional[FloatArray] = None) -> FloatArray:
     """Least squares of the lengths and the effects' parameters on the measured positions
     (scipy's trust-region reflective; a few parameters, central-difference Jacobian)."""
@@ -94,8 +95,9 @@ def fit_with_effects(pts: dict[str, Any], effects: list[_core.Effect],
     return x
 
 
-def _subset(pts: dict[str, Any], mask: Union[BoolArray, slice]) -> dict[str, Any]:
-    return {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in pts.items()}
+def _subset(pts: FiveBarPoints, mask: Union[BoolArray, slice]) -> FiveBarPoints:
+    # the same keys, the arrays' rows picked: still a point set
+    return cast("FiveBarPoints", {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in pts.items()})
 
 
 class Diagnosis:
@@ -106,7 +108,7 @@ class Diagnosis:
 
     dims = 2
 
-    def __init__(self, pts: dict[str, Any], folds: int = 5, seed: int = 0) -> None:
+    def __init__(self, pts: FiveBarPoints, folds: int = 5, seed: int = 0) -> None:
         n = len(pts["id"])
         order = np.random.default_rng(seed).permutation(n)
         self.pts = pts
@@ -164,7 +166,7 @@ class Diagnosis:
         return " + ".join(["four lengths"] + [self.label(e) for e in effects])
 
 
-def diagnose(pts: dict[str, Any], folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
+def diagnose(pts: FiveBarPoints, folds: int = 5, alpha: float = 1e-6, min_gain: float = 0.03, seed: int = 0,
              noise_mm: Optional[float] = None, say: Callable[[str], None] = lambda s: None) -> dict[str, Any]:
     """The model-discrepancy workflow on the hidden robot (the engine of kincal.stepwise; contract
     names link_deflection, with "link": "a".."d", and transmission_error with the actuator as
@@ -188,17 +190,18 @@ def effects_of(diag: dict[str, Any]) -> list[_core.Effect]:
             for s in diag["steps"]]
 
 
-def write_diagnosis(pts: dict[str, Any], diag: dict[str, Any], out: Union[str, Path], title: str) -> None:
+def write_diagnosis(pts: FiveBarPoints, diag: dict[str, Any], out: Union[str, Path], title: str) -> None:
     """In the folder ``out``: residual_map.png (the four lengths against the model with the named
     effects), report.html and diagnosis.json."""
     with report.staged_folder(out) as folder:  # the whole folder or nothing
         _write_diagnosis(pts, diag, folder, title)
 
 
-def _write_diagnosis(pts: dict[str, Any], diag: dict[str, Any], folder: Path, title: str) -> None:
+def _write_diagnosis(pts: FiveBarPoints, diag: dict[str, Any], folder: Path, title: str) -> None:
     named = effects_of(diag)
-    before = dict(pts, desired=predict(pts, fit_with_effects(pts, []), []))
-    after = dict(pts, desired=predict(pts, fit_with_effects(pts, named), named))
+    # point sets with the model's positions as the desired ones (the same keys)
+    before = cast("FiveBarPoints", dict(pts, desired=predict(pts, fit_with_effects(pts, []), [])))
+    after = cast("FiveBarPoints", dict(pts, desired=predict(pts, fit_with_effects(pts, named), named)))
     error_map_figure([("four lengths", before)] + ([("with the named effects", after)] if named else []),
                      str(folder / "residual_map.png"), title="five-bar: model minus measured position")
     rows = [[k + 1, s["effect"], s.get("link") or s["joint"], f"{s['evidence']['F']:.3g}",

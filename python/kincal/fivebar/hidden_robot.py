@@ -21,6 +21,7 @@ from .._core import ErrorMatrix, FiveBar
 from ..io.csv_text import format_rows
 
 if TYPE_CHECKING:
+    from .._core import FiveBarPoints
     from ..typing_ import FloatArray
 
 METHODS = ("polynomial", "lsq", "minimax", "nonlinear")
@@ -29,19 +30,19 @@ METHODS = ("polynomial", "lsq", "minimax", "nonlinear")
 WORKSPACE = ((162.132, 262.132), (-75.0, 75.0))
 
 
-def read_table(path: str) -> dict[str, Any]:
+def read_table(path: str) -> FiveBarPoints:
     """A table with the columns of data/fivebar-table1.csv (errors name file:line and cause)."""
     return _core.read_fivebar_table(str(path))
 
 
-def largest_error(model: FiveBar, pts: dict[str, Any], desired: bool) -> float:
+def largest_error(model: FiveBar, pts: FiveBarPoints, desired: bool) -> float:
     """The largest distance (mm) between the model's position at the commanded angles and the
     desired (``desired``) or the measured position of every point: a fit's score."""
     return float(_core.fivebar_max_error(model, pts, desired))
 
 
 
-def minimax_fit(pts: dict[str, Any], start: FiveBar, desired: bool = False, sides: int = 64,
+def minimax_fit(pts: FiveBarPoints, start: FiveBar, desired: bool = False, sides: int = 64,
                 max_iter: int = 200) -> FiveBar:
     """The four lengths that minimise the largest distance between model and target (Chebyshev fit):
     linear programs on the linearised errors (each distance bounded by a regular polygon of
@@ -85,7 +86,7 @@ def minimax_fit(pts: dict[str, Any], start: FiveBar, desired: bool = False, side
     return model
 
 
-def fit(pts: dict[str, Any], method: str = "lsq", score: str = "measured") -> dict[str, Any]:
+def fit(pts: FiveBarPoints, method: str = "lsq", score: str = "measured") -> dict[str, Any]:
     """Hidden-robot synthesis (FIT.json of the contract). ``score``: rank models by the largest
     distance at the commanded angles to the measured (default) or, as the paper does, the desired
     positions. polynomial: every pair of points (eqs. 1-3); lsq: every subset of 3..N (eqs. 4-6);
@@ -157,7 +158,7 @@ def command(model: FiveBar, xy: FloatArray, matrix: Optional[ErrorMatrix] = None
 COMMAND_TOLERANCE_DEG = 0.005
 
 
-def check_commanded_by(model: FiveBar, pts: dict[str, Any], fit_file: str, grid_file: str) -> dict[str, Any]:
+def check_commanded_by(model: FiveBar, pts: FiveBarPoints, fit_file: str, grid_file: str) -> FiveBarPoints:
     """``pts`` when its angles are the commands ``model`` gives for its desired points: an error
     matrix corrects the model that commanded the grid, and only that one. Otherwise a ValueError
     naming the grid's line, the angles and the model's."""
@@ -181,13 +182,13 @@ def check_commanded_by(model: FiveBar, pts: dict[str, Any], fit_file: str, grid_
     return pts
 
 
-def position_errors(points: dict[str, Any]) -> FloatArray:
+def position_errors(points: FiveBarPoints) -> FloatArray:
     """Distance (mm) between desired and measured position of every point."""
     err: FloatArray = np.linalg.norm(points["measured"] - points["desired"], axis=1)
     return err
 
 
-def error_map_figure(maps: list[tuple[str, dict[str, Any]]], path: str,
+def error_map_figure(maps: list[tuple[str, FiveBarPoints]], path: str,
                      title: str = "five-bar positioning error") -> None:
     """One panel per (label, points) pair: the error (um) at each desired position, one colour scale
     (logarithmic: report.error_norm)."""
@@ -211,7 +212,7 @@ def error_map_figure(maps: list[tuple[str, dict[str, Any]]], path: str,
     plt.close(fig)
 
 
-def points_csv(pts: dict[str, Any]) -> str:
+def points_csv(pts: FiveBarPoints) -> str:
     """A point set as the CSV of data/fivebar-table1.csv."""
     rows = [[int(i), t1, t2, d[0], d[1], m[0], m[1]] for i, t1, t2, d, m in
             zip(pts["id"], pts["theta1_deg"], pts["theta2_deg"], pts["desired"], pts["measured"])]

@@ -3,20 +3,21 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._core import abc_to_rotation, rotation_to_abc
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import FloatArray
 
 UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
              "wrist_3_joint"]
 
 
-def read_ipa(path: str | Path, orientation: bool = False) -> dict[str, Any]:
+def read_ipa(path: str | Path, orientation: bool = False) -> Measurements:
     """A series of the UR10 laser-tracker data of Landgraf et al. (CASE 2021; ../shared/data/
     ipa-robot-accuracy): ';' separated, ',' decimal mark, joints in rad, the T-Mac probe's position
     in the tracker frame in mm. Returns a measurement set (one target: the probe) with the
@@ -50,7 +51,7 @@ def read_ipa(path: str | Path, orientation: bool = False) -> dict[str, Any]:
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{path}: row {bad + 2}: not a finite number")
     n = len(a)
-    out = {
+    out: Measurements = {
         "pose": np.arange(n, dtype=np.int32),
         "q_deg": np.degrees(a[:, :6]),
         "xyz": a[:, 6:9].copy(),

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import sys
-from typing import TYPE_CHECKING, Optional, Sequence
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import numpy as np
 
@@ -96,7 +96,7 @@ def fk_file(robot: _core.Robot, robot_arg: str, joints: str, out: str, frame: st
     _core.write_file_atomic(out, format_rows(head, rows))
 
 
-def _controller(robot: _core.Robot, q: Sequence[float]) -> list[float]:
+def _controller(robot: _core.Robot, q: Union[Sequence[float], FloatArray]) -> list[float]:
     """One configuration as the controller numbers its joints (the robot's joint convention)."""
     return list(_core.joints_to_controller(robot, np.asarray(q, dtype=float).reshape(1, -1))[0])
 

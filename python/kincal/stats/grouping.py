@@ -13,15 +13,22 @@ configuration, whatever the other rule says.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 if TYPE_CHECKING:
+    from .._core import Measurements
     from ..typing_ import BoolArray, FloatArray, IntArray
 
 #: joint angles that agree within this (deg) on every joint are one configuration
 JOINT_TOLERANCE_DEG = 1e-3
+
+
+def subset(data: Measurements, mask: BoolArray) -> Measurements:
+    """The rows ``mask`` of a measurement set (its other entries as they are)."""
+    # the same keys, the arrays' rows picked: still a measurement set
+    return cast("Measurements", {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()})
 
 
 @dataclass(frozen=True)
@@ -80,7 +87,7 @@ def _equal_joints(q: FloatArray, tol: float) -> tuple[IntArray, IntArray]:
     return np.concatenate(a_out), np.concatenate(b_out)
 
 
-def configurations(data: dict[str, Any], tol_deg: float = JOINT_TOLERANCE_DEG) -> Configurations:
+def configurations(data: Measurements, tol_deg: float = JOINT_TOLERANCE_DEG) -> Configurations:
     """The configuration of every row of a measurement set (see the module's text)."""
     pose = np.asarray(data["pose"])
     n = len(pose)
@@ -104,7 +111,7 @@ def configurations(data: dict[str, Any], tol_deg: float = JOINT_TOLERANCE_DEG) -
     return Configurations(codes, int(codes.max()) + 1, rule)
 
 
-def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
+def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
     """k boolean masks of held-out rows: whole configurations dealt at random into k folds."""
     cfg = configurations(data)
     if k > cfg.count:
@@ -116,7 +123,7 @@ def folds(data: dict[str, Any], k: int, seed: int = 0) -> list[BoolArray]:
     return [fold_of[cfg.codes] == i for i in range(k)]
 
 
-def split(data: dict[str, Any], share: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
+def split(data: Measurements, share: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
     """Boolean row masks (fitted, held out): a random share of the configurations is held out whole."""
     cfg = configurations(data)
     n_out = int(round(share * cfg.count))
@@ -125,7 +132,7 @@ def split(data: dict[str, Any], share: float, seed: int = 0) -> tuple[BoolArray,
     return ~held, held
 
 
-def describe(data: dict[str, Any], scheme: str) -> dict[str, Any]:
+def describe(data: Measurements, scheme: str) -> dict[str, Any]:
     """The validation scheme for a summary and a JSON: ``scheme`` (e.g. "5-fold"), the grouping rule
     and the number of configurations."""
     cfg = configurations(data)

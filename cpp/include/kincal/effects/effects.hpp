@@ -44,6 +44,8 @@ struct EffectKind {
   /// a joint-angle effect's basis, dq = sum_k p_k b_k(q, dir) (its derivatives in db when not null);
   /// nullptr for the others
   void (*basis)(const Effect&, double q_rad, double dir, double* b, double* db);
+  /// a harmonic effect that carries every order 1..K, named by its order K (joint_map)
+  bool ordered = false;
   bool reads_dir() const { return needs == "dir"; }               ///< the direction of motion (dir1..dirN)
   bool scales_lengths() const { return acts_on == "length_scale"; }  ///< scales the robot's lengths
   bool of_instrument() const { return acts_on == "instrument"; }    ///< the measurement's, never the robot's

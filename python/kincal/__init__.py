@@ -28,7 +28,7 @@ from ._core import Robot
 from .io.urdf import urdf_model_json
 
 if TYPE_CHECKING:
-    from ._core import CompensationResult, IkSolution
+    from ._core import CompensationResult, IkSolution, Residual
     from .typing_ import FloatArray
 
 #: the modules of the flat layout of 0.1 and where they are now; reachable by the old name, with a
@@ -113,7 +113,7 @@ def ik(robot: Robot, pose: Sequence[float], ref_deg: Optional[Sequence[float]] =
 
 def compensate(robot: Robot, poses: ArrayLike, *, compensate: bool = True, finite_difference: bool = False,
                delta: float = 1e-8, epsilon: float = 1e-15, max_iterations: int = 20,
-               corrected_start: bool = True, frame: str = "base", residual: str = "rotation_vector",
+               corrected_start: bool = True, frame: str = "base", residual: Residual = "rotation_vector",
                temperature_c: Floats = None,
                initial_direction: Floats = None, keep_branch: bool = False) -> CompensationResult:
     """Machine coordinates for desired tool poses (N x 6, in program order) on the robot's calibrated

@@ -6,7 +6,7 @@ search these candidates."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Literal, Optional, Sequence, Union
 
 import numpy as np
 
@@ -15,7 +15,7 @@ from .._core import Robot
 from .fitting import gravity_fitted
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import Gravity, Measurements
 
 #: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
 MAX_MAP_ORDER = 8
@@ -30,7 +30,7 @@ class JointCompliance:
     order = 0
     harmonics: tuple[int, ...] = ()
 
-    def __init__(self, gravity: str = "masses") -> None:
+    def __init__(self, gravity: Literal["masses", "fit"] = "masses") -> None:
         if gravity not in ("masses", "fit"):
             raise ValueError(f"joint compliance's gravity is 'masses' or 'fit', not '{gravity}'")
         self.gravity = gravity
@@ -125,11 +125,11 @@ def candidates(robot: Robot, data: Measurements, start: Sequence[Candidate] = ()
     return out, notes
 
 
-def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effect], Optional[str]]:
+def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effect], Optional[Gravity]]:
     """The core's effects of a model (JointCompliance as joint_compliance on every gravity-loaded
     joint) and the gravity mode it needs (None: the options' own)."""
     out: list[_core.Effect] = []
-    gravity = None
+    gravity: Optional[Gravity] = None
     for e in effects:
         if isinstance(e, JointCompliance):
             gravity = e.gravity

@@ -27,7 +27,7 @@ from . import priors
 from .._core import Robot
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import Gravity, Loss, Measurements
     from ..typing_ import BoolArray, FloatArray
 
 LOSSES = ("none", "huber", "cauchy")
@@ -46,12 +46,12 @@ class FitOptions:
     priors); ``prior_scale``: times every prior sd (None: chosen by grouped cross-validation inside
     each fit's own data); ``prior_model``: the priors' centre and the fits' start (default: the robot's
     nominal model); ``gravity``: the compliances' gravity torques (auto, masses, fit)."""
-    loss: str = "huber"
+    loss: Loss = "huber"
     loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM
     prior_sd: Optional[dict[str, float]] = None
     prior_scale: Optional[float] = 1.0
     prior_model: Optional[Robot] = None
-    gravity: str = "auto"
+    gravity: Gravity = "auto"
     orientation_weight: float = 100.0
     max_iterations: int = 100
     target_start: Optional[Sequence[Sequence[float]]] = None  #: each target's start on the tool (mm; a probe's ball)
@@ -81,7 +81,7 @@ class FitOptions:
         return self.prior_scale is None
 
     def core(self, effects: Sequence[_core.Effect] = (), *, covariance: bool = True,
-             penalties: Sequence[tuple[str, float]] = (), gravity: Optional[str] = None) -> _core.IdentifyOptions:
+             penalties: Sequence[tuple[str, float]] = (), gravity: Optional[Gravity] = None) -> _core.IdentifyOptions:
         """The core's IdentifyOptions for a model with ``effects`` (``gravity`` overrides the mode)."""
         return options(effects, loss=self.loss, loss_scale_mm=self.loss_scale_mm or 0.0, covariance=covariance,
                        orientation_weight=self.orientation_weight, max_iterations=self.max_iterations,
@@ -96,18 +96,18 @@ class FitOptions:
         return priors.Fitter(robot, self.prior_model, auto_scale=self.auto_prior_scale, seed=seed)
 
     def fit(self, robot: Robot, data: Measurements, effects: Sequence[_core.Effect] = (), *, covariance: bool = False,
-            penalties: Sequence[tuple[str, float]] = (), gravity: Optional[str] = None, seed: int = 0,
+            penalties: Sequence[tuple[str, float]] = (), gravity: Optional[Gravity] = None, seed: int = 0,
             progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         """One fit of ``data`` with these options."""
         return self.fitter(robot, seed)(data, self.core(effects, covariance=covariance, penalties=penalties,
                                                          gravity=gravity), progress)
 
 
-def options(effects: Sequence[_core.Effect] = (), *, loss: str = "huber", loss_scale_mm: float = 0.1,
+def options(effects: Sequence[_core.Effect] = (), *, loss: Loss = "huber", loss_scale_mm: float = 0.1,
             covariance: bool = True, orientation_weight: float = 100.0, max_iterations: int = 100,
             fix: Sequence[str] = (), penalties: Sequence[tuple[str, float]] = (),
             prior_sd: Optional[dict[str, float]] = None, prior_scale: float = 0.0,
-            gravity: str = "auto", target_start: Optional[Sequence[Sequence[float]]] = None,
+            gravity: Gravity = "auto", target_start: Optional[Sequence[Sequence[float]]] = None,
             noise_mm: Optional[float] = None, artifact_sd_mm: Optional[float] = None) -> _core.IdentifyOptions:
     """IdentifyOptions for a list of effects (joint_compliance entries switch the compliance of their
     joints on; without any, the compliances stay at their start value). ``penalties``: ridge

@@ -36,7 +36,7 @@ from .simulation import (DEFAULT_HARMONICS as DEFAULT_HARMONICS, DEFAULT_INSTRUM
                          simulate as simulate)
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import Loss, Measurements
     from ..typing_ import BoolArray, FloatArray
 
 #: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
@@ -314,7 +314,7 @@ def _fold_errors(model_of: ModelOf, data: Measurements, held_masks: Sequence[Boo
     return {k: np.concatenate([p[k] for p in parts if k in p]) for k in keys}, choices
 
 
-def _setup_refit(loss: str, loss_scale_mm: float) -> SetupRefit:
+def _setup_refit(loss: Loss, loss_scale_mm: float) -> SetupRefit:
     """The errors of a setup held out whole: its placement and targets refitted on its rows
     (validate()'s refit) on the model fitted on the other setups."""
     def refit(robot: Robot, held: Measurements) -> dict[str, FloatArray]:

@@ -15,7 +15,7 @@ from .fitting import orientation_errors_deg, rms
 from .simulation import simulate
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import Loss, Measurements
     from ..typing_ import BoolArray, FloatArray
 
     #: a measurement set's entry, whatever its key (Measurements: arrays, the source, names, artifact tuples)
@@ -154,7 +154,7 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
     return v
 
 
-def _refit_placements(robot: Robot, data: Measurements, loss: str = "huber", loss_scale_mm: float = 0.1,
+def _refit_placements(robot: Robot, data: Measurements, loss: Loss = "huber", loss_scale_mm: float = 0.1,
                       target_start: Optional[Sequence[Sequence[float]]] = None) -> tuple[
         FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
@@ -189,7 +189,7 @@ def extrapolated(robot: Robot, q_deg: FloatArray) -> list[dict[str, Any]]:
             for e in _core.extrapolated(robot, np.asarray(q_deg, dtype=float))]
 
 
-def inside_and_outside(robot: Robot, data: Measurements, loss: str = "huber",
+def inside_and_outside(robot: Robot, data: Measurements, loss: Loss = "huber",
                        loss_scale_mm: float = 0.1) -> dict[str, dict[str, Any]]:
     """validate()'s RMS (after, before) split between the rows that take none of the robot's periodic
     effects outside their fitted ranges and the rows that take one: ``{"inside": {"rows",
@@ -206,7 +206,7 @@ def inside_and_outside(robot: Robot, data: Measurements, loss: str = "huber",
     return {"inside": part(~out), "outside": part(out)}
 
 
-def validate(robot: Robot, data: Measurements, loss: str = "huber", loss_scale_mm: float = 0.1,
+def validate(robot: Robot, data: Measurements, loss: Loss = "huber", loss_scale_mm: float = 0.1,
              target_start: Optional[Sequence[Sequence[float]]] = None) -> dict[str, Any]:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit

@@ -47,7 +47,8 @@ def _rot(w: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 class NumpyPointModel:
     def __init__(self, robot: _core.Robot, n_targets: int):
-        spec = json.loads(robot.to_json())["nominal"]
+        doc = json.loads(robot.to_json())
+        spec = doc["nominal"]
         self.w0 = [np.asarray(j["axis"], float) / np.linalg.norm(j["axis"]) for j in spec["joints"]]
         self.p0 = [np.asarray(j["point_mm"], float) for j in spec["joints"]]
         self.u = [_unit_orthogonal(w) for w in self.w0]
@@ -59,7 +60,8 @@ class NumpyPointModel:
         self.g = np.asarray(spec["gravity_m_s2"], float)
         self.rm0 = _core.abc_to_rotation(np.asarray(spec["tool"]["abc_deg"], float))
         self.tm0 = np.asarray(spec["tool"]["xyz_mm"], float)
-        b = spec["base_in_instrument"]
+        # the placements are relative to the robot's campaign (PointModel's, from a nominal robot)
+        b = doc["campaign"]["base_in_instrument"]
         self.rb0 = _core.abc_to_rotation(np.asarray(b["abc_deg"], float))
         self.tb0 = np.asarray(b["xyz_mm"], float)
         self.names = list(_core.PointModel(robot, n_targets).names)

@@ -11,6 +11,8 @@ namespace py = pybind11;
 
 namespace kincal {
 struct MeasurementSet;
+struct Campaign;
+class Robot;
 }
 
 void define_effects(py::module_& m);
@@ -24,6 +26,11 @@ void define_measurements(py::module_& m);
 void define_measurement_model(py::module_& m);
 void define_identify(py::module_& m);
 void define_fivebar(py::module_& m);
+
+/// The campaign of a robot's calibrated (or nominal) model: the robot's own, but for the nominal
+/// model of an identified robot (then the identity placement: that campaign calibrated the other
+/// model). Fits start from it, fk(instrument=True) sees through it (measurement_model.cpp).
+const kincal::Campaign& campaign_of(const kincal::Robot& robot, bool calibrated);
 
 /// A measurement set as the dict of numpy arrays Python sees, and back (measurements.cpp).
 py::dict measurements_to_dict(const kincal::MeasurementSet& m, int dof);

@@ -117,9 +117,9 @@ struct PyIdentifyResult {
 
 py::array_t<double> vec(const std::vector<double>& v) { return py::array_t<double>(v.size(), v.data()); }
 
-/// Every instrument placement of a model: [(name, xyz_mm, abc_deg)], its base_in_instrument (name "")
-/// when it has no setups.
-std::vector<std::tuple<std::string, Vec3, Vec3>> placements(const ModelSpec& s) {
+/// Every instrument placement of a campaign: [(name, xyz_mm, abc_deg)], its base_in_instrument (name
+/// "") when it has no setups.
+std::vector<std::tuple<std::string, Vec3, Vec3>> placements(const Campaign& s) {
   std::vector<std::tuple<std::string, Vec3, Vec3>> out;
   if (s.setups.empty()) out.emplace_back("", s.base_in_instrument.xyz, s.base_in_instrument.abc);
   for (const SetupFrame& f : s.setups) out.emplace_back(f.name, f.base_in_instrument.xyz, f.base_in_instrument.abc);
@@ -172,7 +172,7 @@ void define_identify_functions(py::module_& m) {
         o.noise_mm = noise_mm, o.orientation_noise_deg = orientation_noise_deg;
         o.outlier_fraction = outlier_fraction, o.outlier_mm = outlier_mm;
         o.targets = targets_from(targets), o.effects = effect_values_from(effects), o.t_ref = t_ref;
-        return measurements_to_dict(simulate(*truth.calibrated(), o), truth.calibrated()->dof());
+        return measurements_to_dict(simulate(*truth.calibrated(), o, truth.campaign()), truth.calibrated()->dof());
       },
       py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
       py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
@@ -184,7 +184,7 @@ void define_identify_functions(py::module_& m) {
   m.def(
       "point_errors",
       [](const Robot& r, const RowMatrix& targets, const py::dict& d, const std::vector<StationValue>& stations) {
-        const auto e = point_errors(*r.calibrated(), targets_from(targets), measurements_from_dict(d, r.calibrated()->dof()),
+        const auto e = point_errors(*r.calibrated(), r.campaign(), targets_from(targets), measurements_from_dict(d, r.calibrated()->dof()),
                                     stations);
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
@@ -203,7 +203,7 @@ void define_identify_functions(py::module_& m) {
   m.def(
       "orientation_errors",
       [](const Robot& r, const py::dict& d) {
-        const auto e = orientation_errors(*r.calibrated(), measurements_from_dict(d, r.calibrated()->dof()));
+        const auto e = orientation_errors(*r.calibrated(), r.campaign(), measurements_from_dict(d, r.calibrated()->dof()));
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("data"),
@@ -406,9 +406,9 @@ void define_identify_result(py::module_& m) {
       .def_property_readonly("t_ref", [](const PyIdentifyResult& r) { return r.r.t_ref; })
       .def_property_readonly("t_mean_s", [](const PyIdentifyResult& r) { return r.r.t_mean_s; },
                              "reference time of the drift (s): the data's mean time")
-      .def_property_readonly("setups", [](const PyIdentifyResult& r) { return placements(r.r.calibrated); },
+      .def_property_readonly("setups", [](const PyIdentifyResult& r) { return placements(r.r.campaign); },
                              "every instrument placement: (name, xyz_mm, abc_deg); name '' for a single one")
-      .def_property_readonly("nominal_setups", [](const PyIdentifyResult& r) { return placements(r.r.nominal_fitted); },
+      .def_property_readonly("nominal_setups", [](const PyIdentifyResult& r) { return placements(r.r.nominal_campaign); },
                              "the placements fitted on the nominal geometry")
       .def_property_readonly("iterations", [](const PyIdentifyResult& r) { return r.r.iterations; })
       .def_property_readonly("initial_cost", [](const PyIdentifyResult& r) { return r.r.initial_cost; })
@@ -457,9 +457,10 @@ void define_identify_call(py::module_& m) {
         const MeasurementSet data = measurements_from_dict(d, nominal.dof());
         IdentifyOptions o = core_options(options, nominal);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
-        PyIdentifyResult out{identify(nominal, data, o), Robot{}, Robot{}};
-        out.robot = Robot{robot.nominal(), std::make_shared<const Model>(out.r.calibrated)};
-        out.nominal_fitted = Robot{robot.nominal(), std::make_shared<const Model>(out.r.nominal_fitted)};
+        PyIdentifyResult out{identify(nominal, data, o, campaign_of(robot, from_calibrated)), Robot{}, Robot{}};
+        out.robot = Robot{robot.nominal(), std::make_shared<const Model>(out.r.calibrated), out.r.campaign};
+        out.nominal_fitted =
+            Robot{robot.nominal(), std::make_shared<const Model>(out.r.nominal_fitted), out.r.nominal_campaign};
         return out;
       },
       py::arg("robot"), py::arg("data"), py::arg("options") = IdentifyOptions{}, py::arg("progress") = py::none(),

@@ -64,7 +64,7 @@ void define_kinematics_frames(py::module_& m) {
         for (Eigen::Index i = 0; i < q_deg.rows(); ++i) {
           const VecQ q = q_deg.row(i).transpose() * kDeg;
           Eigen::Isometry3d t = fk_model(md, q, context_of(md, dir, temperature_c, i));
-          if (instrument) t = md.base_in_instrument() * t;
+          if (instrument) t = campaign_of(r, calibrated).base() * t;
           const Pose6 p = iso_to_pose(t);
           out.row(i) << p.xyz.transpose(), p.abc.transpose();
         }

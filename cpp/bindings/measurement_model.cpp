@@ -14,16 +14,22 @@ using namespace kincal;
 
 namespace {
 
-/// The setup names of a PointModel: those given, else the model's own setups (a calibrated model
+/// The setup names of a PointModel: those given, else the campaign's own setups (a calibrated model
 /// identified on several setups predicts them with their frames).
-std::vector<std::string> setup_names_or_model(const std::optional<std::vector<std::string>>& given, const Model& m) {
+std::vector<std::string> setup_names_or_model(const std::optional<std::vector<std::string>>& given,
+                                              const Campaign& c) {
   if (given) return *given;
   std::vector<std::string> names;
-  for (const SetupFrame& f : m.spec().setups) names.push_back(f.name);
+  for (const SetupFrame& f : c.setups) names.push_back(f.name);
   return names;
 }
 
 }  // namespace
+
+const Campaign& campaign_of(const Robot& robot, bool calibrated) {
+  static const Campaign none;
+  return calibrated || !robot.identified() ? robot.campaign() : none;
+}
 
 namespace {
 
@@ -31,6 +37,7 @@ namespace {
 // model built from them; residuals() builds one for the data's payloads
 struct PyPointModel {
   std::shared_ptr<const Model> model;
+  Campaign reference;  ///< the placements the layout's are relative to
   LayoutOptions options;
   PointModel pm;
 };
@@ -83,15 +90,16 @@ void define_point_model(py::module_& m) {
                        bool from_calibrated, const std::optional<std::vector<std::string>>& setups,
                        std::optional<double> t_mean_s, bool fit_gravity, const ParamLayout* stations_of) {
              std::shared_ptr<const Model> m = from_calibrated ? r.calibrated() : r.nominal();
-             LayoutOptions o{n_targets, effects, t_ref, setup_names_or_model(setups, *m),
-                             t_mean_s ? *t_mean_s : m->spec().t_mean_s, fit_gravity};
+             const Campaign& c = campaign_of(r, from_calibrated);
+             LayoutOptions o{n_targets, effects, t_ref, setup_names_or_model(setups, c),
+                             t_mean_s ? *t_mean_s : c.t_mean_s, fit_gravity};
              if (stations_of) {
                o.station_names = stations_of->station_names;
                o.station_kinds = stations_of->station_kinds;
                o.station_normals = stations_of->station_normals;
              }
-             PointModel pm(*m, o);
-             return new PyPointModel{std::move(m), std::move(o), std::move(pm)};
+             PointModel pm(*m, o, nullptr, c);
+             return new PyPointModel{std::move(m), c, std::move(o), std::move(pm)};
            }),
            py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
            py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
@@ -116,7 +124,7 @@ void define_point_model(py::module_& m) {
             if (!L.setup_names.empty() && data.setup_names != L.setup_names)
               throw InputError(data.source + ": the data's setups are not the layout's (" +
                                std::to_string(L.n_setups) + " setups in that order)");
-            const PointState at = PointModel(*p.model, p.options, &data).at(x);
+            const PointState at = PointModel(*p.model, p.options, &data, p.reference).at(x);
             const size_t n = residual_size(residual_kind(data)) * data.rows.size();
             const size_t na = artifact ? data.artifact.size() : 0;
             std::vector<int> cols(L.size);

@@ -23,12 +23,12 @@ void define_robot_calibration(py::class_<Robot>& robot) {
           "placements",
           [](const Robot& r) {
             std::vector<std::tuple<std::string, Vec3, Vec3>> out;
-            const ModelSpec& s = r.calibrated()->spec();
+            const Campaign& s = r.campaign();
             if (s.setups.empty()) out.emplace_back("", s.base_in_instrument.xyz, s.base_in_instrument.abc);
             for (const SetupFrame& f : s.setups) out.emplace_back(f.name, f.base_in_instrument.xyz, f.base_in_instrument.abc);
             return out;
           },
-          "the instrument placements the calibrated model knows: (name, xyz_mm, abc_deg) per setup; one\n"
+          "the instrument placements the robot's campaign knows: (name, xyz_mm, abc_deg) per setup; one\n"
           "named '' (its base_in_instrument) without setups. fk and compensate use the first.")
       .def_property_readonly("nominal_spec", [](const Robot& r) { return r.nominal()->spec(); })
       .def_property_readonly("calibrated_spec", [](const Robot& r) { return r.calibrated()->spec(); })
@@ -38,47 +38,49 @@ void define_robot_calibration(py::class_<Robot>& robot) {
             ModelSpec s = r.calibrated()->spec();
             s.tool = Pose6{xyz_mm, abc_deg};
             s.tcp = tcp;
-            return Robot{r.nominal(), std::make_shared<Model>(s)};
+            return Robot{r.nominal(), std::make_shared<Model>(s), r.campaign()};
           },
           py::arg("xyz_mm"), py::arg("abc_deg"), py::arg("tcp"),
           "The robot whose calibrated model has this tool frame, its origin recorded as tcp ('measured', "
           "'tool-targets', 'nominal')")
-      .def("nominal_only", [](const Robot& r) { return Robot{r.nominal(), r.nominal()}; },
-           "The robot with its nominal model as its calibrated one (not identified)")
-      .def_property_readonly("t_mean_s", [](const Robot& r) { return r.calibrated()->spec().t_mean_s; },
-                             "the drift's reference time (s), when the model carries a drift")
+      .def("nominal_only",
+           [](const Robot& r) { return r.identified() ? Robot{r.nominal(), r.nominal()} : r; },
+           "The robot with its nominal model as its calibrated one (not identified; the campaign that\n"
+           "calibrated it left out)")
+      .def_property_readonly("t_mean_s", [](const Robot& r) { return r.campaign().t_mean_s; },
+                             "the drift's reference time (s), when the campaign's instrument drifts")
       .def(
           "with_placements",
           [](const Robot& r, const std::vector<std::tuple<std::string, Vec3, Vec3>>& setups) {
             if (setups.empty()) throw InputError("with_placements: at least one placement");
-            ModelSpec s = r.calibrated()->spec();
-            s.base_in_instrument = Pose6{std::get<1>(setups[0]), std::get<2>(setups[0])};
-            s.setups.clear();
+            Campaign c = r.campaign();
+            c.base_in_instrument = Pose6{std::get<1>(setups[0]), std::get<2>(setups[0])};
+            c.setups.clear();
             if (setups.size() > 1)
-              for (const auto& [name, xyz, abc] : setups) s.setups.push_back(SetupFrame{name, Pose6{xyz, abc}});
-            return Robot{r.nominal(), std::make_shared<Model>(s)};
+              for (const auto& [name, xyz, abc] : setups) c.setups.push_back(SetupFrame{name, Pose6{xyz, abc}});
+            return Robot{r.nominal(), r.calibrated(), c};
           },
           py::arg("setups"),
-          "The robot with its calibrated model seen from these placements: (name, xyz_mm, abc_deg) per\n"
-          "setup, the first its base_in_instrument (one: no setups)")
+          "The robot with its campaign seen from these placements: (name, xyz_mm, abc_deg) per setup, the\n"
+          "first its base_in_instrument (one: no setups)")
       .def_property_readonly("tcp", [](const Robot& r) { return r.calibrated()->spec().tcp; },
                              "where the calibrated model's tool frame comes from: 'measured' (6-D rows), "
                              "'tool-targets', 'nominal' (reflectors only), '' when not recorded")
       .def("tcp_warning", [](const Robot& r, const std::string& source) { return tcp_warning(r, source); },
            py::arg("source"),
            "The one warning line for a model whose TCP is nominal (not measured), naming source; '' otherwise")
-      .def_property_readonly("fitted_ranges_deg", [](const Robot& r) { return r.calibrated()->spec().fitted_deg; },
+      .def_property_readonly("fitted_ranges_deg", [](const Robot& r) { return r.campaign().fitted_deg; },
                              "per joint, the angles the identification saw ([lo, hi] deg); empty when unknown")
       .def(
           "with_fitted_ranges",
           [](const Robot& r, const std::vector<JointRange>& ranges) {
             if (!r.identified()) throw InputError("with_fitted_ranges: a nominal robot was fitted on nothing");
-            ModelSpec s = r.calibrated()->spec();
             if (!ranges.empty()) check_joint_ranges(ranges, r.calibrated()->dof(), "with_fitted_ranges");
-            s.fitted_deg = ranges;
-            return Robot{r.nominal(), std::make_shared<Model>(s)};
+            Campaign c = r.campaign();
+            c.fitted_deg = ranges;
+            return Robot{r.nominal(), r.calibrated(), c};
           },
-          py::arg("ranges"), "The robot whose calibrated model records the angles its fit saw (joint_ranges())")
+          py::arg("ranges"), "The robot whose campaign records the angles its fit saw (joint_ranges())")
       .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated()->needs_dir(); },
                              "backlash: the direction of motion into each pose is needed")
       .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated()->needs_temperature(); },
@@ -87,22 +89,28 @@ void define_robot_calibration(py::class_<Robot>& robot) {
           "with_effects",
           [](const Robot& r, const std::vector<std::pair<Effect, std::vector<double>>>& effects, double t_ref) {
             std::vector<EffectValue> ev;
-            for (const auto& [e, p] : effects) ev.push_back(EffectValue{e, p});
-            return Robot{r.nominal(), std::make_shared<Model>(with_effects(r.calibrated()->spec(), ev, t_ref))};
+            Campaign c = r.campaign();
+            for (const auto& [e, p] : effects) {
+              ev.push_back(EffectValue{e, p});
+              if (e.kind().of_instrument()) c.drift = ev.back();  // the campaign's instrument drifts
+            }
+            return Robot{r.nominal(), std::make_shared<Model>(with_effects(r.calibrated()->spec(), ev, t_ref)), c};
           },
           py::arg("effects"), py::arg("t_ref") = 20.0,
-          "The robot with effects (Effect, values in core units) added to its calibrated model")
+          "The robot with effects (Effect, values in core units) added to its calibrated model (a drift\n"
+          "to its campaign)")
       .def(
           "with_calibrated",
           [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance,
              std::optional<std::array<double, 6>> instrument) {
             ModelSpec s = perturbed_spec(r.nominal()->spec(), seed, sigma_mm, sigma_deg, compliance);
+            Campaign c;
             if (instrument) {
               const auto& v = *instrument;
-              s.base_in_instrument.xyz = Vec3(v[0], v[1], v[2]);
-              s.base_in_instrument.abc = Vec3(v[3], v[4], v[5]);
+              c.base_in_instrument.xyz = Vec3(v[0], v[1], v[2]);
+              c.base_in_instrument.abc = Vec3(v[3], v[4], v[5]);
             }
-            return Robot{r.nominal(), std::make_shared<Model>(s)};
+            return Robot{r.nominal(), std::make_shared<Model>(s), c};
           },
           py::arg("seed"), py::arg("sigma_mm") = 1.0, py::arg("sigma_deg") = 0.05, py::arg("compliance") = 0.0,
           py::arg("base_in_instrument") = py::none(),
@@ -134,7 +142,6 @@ void define_specs(py::module_& m) {
       .def_property_readonly("payload_com_mm", [](const ModelSpec& s) { return Vec3(s.payload_com); },
                              "in the tool frame")
       .def_property_readonly("gravity", [](const ModelSpec& s) { return Vec3(s.gravity); }, "base frame, m/s^2")
-      .def_readonly("base_in_instrument", &ModelSpec::base_in_instrument)
       .def_readonly("home_deg", &ModelSpec::home_deg)
       .def_readonly("joint_convention", &ModelSpec::joint_convention)
       .def_readonly("tcp", &ModelSpec::tcp, "where the tool frame comes from ('' when not recorded)");
@@ -208,7 +215,8 @@ void define_model(py::module_& m) {
         if (q_deg.rows() > 0 && q_deg.cols() != r.calibrated()->dof())
           throw InputError("extrapolated: " + std::to_string(q_deg.cols()) + " joint columns for a robot of " +
                            std::to_string(r.calibrated()->dof()));
-        return extrapolated(r.calibrated()->spec(), q_deg.data(), q_deg.rows(), r.calibrated()->dof());
+        return extrapolated(r.calibrated()->spec(), r.campaign().fitted_deg, q_deg.data(), q_deg.rows(),
+                            r.calibrated()->dof());
       },
       py::arg("robot"), py::arg("q_deg"),
       "The joints whose periodic effects (transmission_error, joint_map) rows of joint angles (deg) take\n"

@@ -66,14 +66,14 @@ TEST(Coverage, OutsideCountsTurnsAndTheMargin) {
 
 TEST(Coverage, ModelJsonCarriesTheRangesAndRejectsBadOnes) {
   KINCAL_SEED_TRACE(3);
-  ModelSpec s = perturbed_spec(kr500_spec(), test::test_seed(3), 1.0, 0.05, 0.003);
-  s.fitted_deg = {{-170.0, 160.0}, {-120.0, -60.0}, {-80.0, 130.0}, {25.0, 370.0}, {-100.0, 100.0}, {-180.0, 180.0}};
-  const Robot r{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(s)};
+  const ModelSpec s = perturbed_spec(kr500_spec(), test::test_seed(3), 1.0, 0.05, 0.003);
+  Campaign c;
+  c.fitted_deg = {{-170.0, 160.0}, {-120.0, -60.0}, {-80.0, 130.0}, {25.0, 370.0}, {-100.0, 100.0}, {-180.0, 180.0}};
+  const Robot r{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(s), c};
   const std::string text = robot_to_json(r);
   EXPECT_NE(text.find("fitted_joint_ranges_deg"), std::string::npos);
   const Robot back = robot_from_json(text, "m.json");
-  EXPECT_EQ(back.calibrated()->spec().fitted_deg, s.fitted_deg);
-  EXPECT_TRUE(back.nominal()->spec().fitted_deg.empty());  // the nominal model was fitted on nothing
+  EXPECT_EQ(back.campaign().fitted_deg, c.fitted_deg);  // the campaign's: the angles it saw
   auto bad = [&](const std::string& from, const std::string& to) {
     std::string t = text;
     const size_t at = t.find(from);
@@ -83,7 +83,7 @@ TEST(Coverage, ModelJsonCarriesTheRangesAndRejectsBadOnes) {
       robot_from_json(t, "m.json");
       ADD_FAILURE() << "accepted " << to;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("m.json: calibrated.fitted_joint_ranges_deg"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("m.json: campaign.fitted_joint_ranges_deg"), std::string::npos) << e.what();
     }
   };
   bad("-120.0,\n        -60.0", "200.0,\n        210.0");   // lo beyond 180
@@ -102,11 +102,11 @@ TEST(Coverage, ExtrapolatedNamesTheJointsOfPeriodicEffectsOnly) {
   // q1 = row index - 10 (-10..9), q2 = 0 (joint 2 carries a transmission error), q3 = 200 (backlash only)
   std::vector<double> q;
   for (int i = 0; i < 20; ++i) q.insert(q.end(), {i - 10.0, 0.0, 200.0, 0.0, 0.0, 0.0});
-  EXPECT_TRUE(extrapolated(s, q.data(), 20, 6).empty());  // no ranges: nothing claimed
-  s.fitted_deg = std::vector<JointRange>(6, JointRange{-50.0, 50.0});
-  s.fitted_deg[1] = {-30.0, -3.0};  // joint 2's rows at 0 deg: every one outside (3 deg away)
-  s.fitted_deg[2] = {-30.0, 30.0};  // joint 3 outside too, but backlash does not depend on the angle
-  const auto e = extrapolated(s, q.data(), 20, 6);
+  EXPECT_TRUE(extrapolated(s, {}, q.data(), 20, 6).empty());  // no ranges: nothing claimed
+  std::vector<JointRange> fitted(6, JointRange{-50.0, 50.0});
+  fitted[1] = {-30.0, -3.0};  // joint 2's rows at 0 deg: every one outside (3 deg away)
+  fitted[2] = {-30.0, 30.0};  // joint 3 outside too, but backlash does not depend on the angle
+  const auto e = extrapolated(s, fitted, q.data(), 20, 6);
   ASSERT_EQ(e.size(), 1u);
   EXPECT_EQ(e[0].joint, 2);
   EXPECT_EQ(e[0].effects, "transmission_error(joint 2)");

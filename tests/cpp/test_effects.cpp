@@ -98,12 +98,12 @@ TEST(Effects, RegistryNamesEveryEffectOnce) {
   }
 }
 
-TEST(Effects, ModelJsonVersion2RoundTripAndVersion1Reads) {
+TEST(Effects, ModelJsonVersion3RoundTripAndVersion1Reads) {
   KINCAL_SEED_TRACE(11, 3);
   auto nom = std::make_shared<Model>(kr500_spec());
   auto cal = std::make_shared<Model>(effects_spec());
   const std::string text = robot_to_json(Robot{nom, cal});
-  EXPECT_NE(text.find("\"version\": 2"), std::string::npos);
+  EXPECT_NE(text.find("\"version\": 3"), std::string::npos);
   const Robot back = robot_from_json(text, "t.json");
   ASSERT_EQ(back.calibrated()->spec().effects.size(), cal->spec().effects.size());
   for (size_t i = 0; i < cal->spec().effects.size(); ++i) {
@@ -113,11 +113,18 @@ TEST(Effects, ModelJsonVersion2RoundTripAndVersion1Reads) {
   }
   for (int j = 0; j < 6; ++j)
     EXPECT_EQ(back.calibrated()->spec().joints[j].compliance_deg_per_knm, cal->spec().joints[j].compliance_deg_per_knm);
-  // a version 1 file (no effects, no reference temperature) still reads
+  // a version 1 file (no effects, no reference temperature; the campaign's placement in the
+  // model's section) still reads
   std::string v1 = robot_to_json(Robot{nom, std::make_shared<Model>(perturbed_spec(kr500_spec(), test::test_seed(3)))});
-  v1.replace(v1.find("\"version\": 2"), 12, "\"version\": 1");
+  v1.replace(v1.find("\"version\": 3"), 12, "\"version\": 1");
+  const size_t campaign = v1.find(",\n  \"campaign\"");
+  ASSERT_NE(campaign, std::string::npos);
+  v1.erase(campaign, v1.find("\n  }", campaign) + 4 - campaign);
+  for (size_t at = v1.find("\"gravity_m_s2\""); at != std::string::npos; at = v1.find("\"gravity_m_s2\"", at + 80))
+    v1.insert(at, "\"base_in_instrument\": {\"xyz_mm\": [1, 2, 3], \"abc_deg\": [0, 0, 90]},\n    ");
   const Robot r1 = robot_from_json(v1, "v1.json");
   EXPECT_TRUE(r1.calibrated()->spec().effects.empty());
+  EXPECT_EQ(r1.campaign().base_in_instrument.xyz, Vec3(1, 2, 3));  // the calibrated section's
   // joint_map is written with its order and read back from it; without it, an error naming where
   EXPECT_NE(text.find("\"order\": 5"), std::string::npos);
   std::string no_order = text;

@@ -28,9 +28,9 @@ double rms(const std::vector<double>& e) {
 std::pair<MeasurementSet, MeasurementSet> fit_and_held(const Model& truth, SimulationOptions so, unsigned a,
                                                        unsigned b) {
   so.seed = test::test_seed(a);
-  MeasurementSet fit = simulate(truth, so);
+  MeasurementSet fit = simulate(truth, so, test::truth_campaign());
   so.seed = test::test_seed(b);
-  return {std::move(fit), simulate(truth, so)};
+  return {std::move(fit), simulate(truth, so, test::truth_campaign())};
 }
 
 }  // namespace
@@ -51,8 +51,8 @@ TEST(Identify, NoiseFreeGeometricErrorsFittedExactly) {
   opt.loss = Loss::none;
   const IdentifyResult r = identify(nominal, fit, opt);
   const Model cal(r.calibrated);
-  const double before = rms(point_errors(nominal, {Vec3::Zero()}, held));
-  const double after = rms(point_errors(cal, r.targets, held));
+  const double before = rms(point_errors(nominal, Campaign{}, {Vec3::Zero()}, held));
+  const double after = rms(point_errors(cal, r.campaign, r.targets, held));
   EXPECT_LT(after, 1e-6) << r.termination;
   EXPECT_GT(before, 1.0);
   int fixed = 0;
@@ -76,12 +76,12 @@ TEST(Identify, Kr500WithComplianceReachesTheNoiseFloor) {
   const double floor = 0.02 * std::sqrt(3.0);
   IdentifyOptions opt;
   const IdentifyResult r = identify(nominal, fit, opt);
-  const double after = rms(point_errors(Model(r.calibrated), r.targets, held));
+  const double after = rms(point_errors(Model(r.calibrated), r.campaign, r.targets, held));
   EXPECT_LT(after, 1.2 * floor) << r.termination;
   // without the compliance parameters a gap remains
   opt.compliance = false;
   const IdentifyResult rg = identify(nominal, fit, opt);
-  const double geometric_only = rms(point_errors(Model(rg.calibrated), rg.targets, held));
+  const double geometric_only = rms(point_errors(Model(rg.calibrated), rg.campaign, rg.targets, held));
   EXPECT_GT(geometric_only, 1.5 * floor);
   // the compliances of A2..A5 are recovered within 3 standard deviations; A6 carries no gravity
   // torque (the head's centre of mass is on its axis), so its compliance is held and named
@@ -108,18 +108,18 @@ TEST(Identify, RobustLossIgnoresGrossOutliers) {
   so.poses = 150;
   so.targets = kTargets;
   so.seed = test::test_seed(7);
-  const MeasurementSet clean = simulate(truth, so);
+  const MeasurementSet clean = simulate(truth, so, test::truth_campaign());
   so.outlier_fraction = 0.05;
   so.outlier_mm = 5.0;
-  const MeasurementSet dirty = simulate(truth, so);
+  const MeasurementSet dirty = simulate(truth, so, test::truth_campaign());
   so.outlier_fraction = 0;
   so.seed = test::test_seed(8);
-  const MeasurementSet held = simulate(truth, so);
+  const MeasurementSet held = simulate(truth, so, test::truth_campaign());
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
   auto held_rms = [&](const MeasurementSet& d, const IdentifyOptions& o) {
     const IdentifyResult r = identify(nominal, d, o);
-    return rms(point_errors(Model(r.calibrated), r.targets, held));
+    return rms(point_errors(Model(r.calibrated), r.campaign, r.targets, held));
   };
   const double e_clean = held_rms(clean, opt);
   const double e_dirty = held_rms(dirty, opt);
@@ -135,7 +135,7 @@ TEST(Identify, TooFewMeasurementsIsAnInputError) {
   SimulationOptions so;
   so.seed = test::test_seed(1);  // the simulator's default
   so.poses = 5;
-  const MeasurementSet d = simulate(Model(truth_spec(1, 0)), so);
+  const MeasurementSet d = simulate(Model(truth_spec(1, 0)), so, test::truth_campaign());
   EXPECT_THROW(identify(nominal, d, IdentifyOptions()), InputError);
 }
 
@@ -155,14 +155,14 @@ TEST(Identify, HiddenTransmissionErrorIsRecovered) {
   so.effects.push_back(te);
   so.seed = test::test_seed(11);
   const Model truth(truth_spec(41, 0.003));
-  const MeasurementSet fit = simulate(truth, so);
+  const MeasurementSet fit = simulate(truth, so, test::truth_campaign());
   so.seed = test::test_seed(12);
-  const MeasurementSet held = simulate(truth, so);
+  const MeasurementSet held = simulate(truth, so, test::truth_campaign());
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
   opt.effects = {{"transmission_error", 1}};
   const IdentifyResult r = identify(nominal, fit, opt);
-  const double after = rms(point_errors(Model(r.calibrated), r.targets, held));
+  const double after = rms(point_errors(Model(r.calibrated), r.campaign, r.targets, held));
   EXPECT_LT(after, 1.2 * 0.02 * std::sqrt(3.0));
   ASSERT_EQ(r.effects.size(), 1u);
   const int c = r.layout.effect_offset[0];
@@ -184,14 +184,14 @@ TEST(Identify, SixDimensionalPosesDetermineTheToolOrientation) {
   so.targets = {Vec3(0, 0, 0)};
   so.seed = test::test_seed(21);
   const Model truth(truth_spec(51, 0.003));
-  const MeasurementSet fit = simulate(truth, so);
+  const MeasurementSet fit = simulate(truth, so, test::truth_campaign());
   so.seed = test::test_seed(22);
-  const MeasurementSet held = simulate(truth, so);
+  const MeasurementSet held = simulate(truth, so, test::truth_campaign());
   const Model nominal(kr500_spec());
-  auto orientation_rms_deg = [&](const Model& cal) {
+  auto orientation_rms_deg = [&](const Model& cal, const Campaign& c) {
     double ss = 0;
     for (const auto& row : held.rows) {
-      const Mat3 rm = cal.base_in_instrument().linear() * fk_compliant(cal, row.q_deg * kDeg).linear();
+      const Mat3 rm = c.base().linear() * fk_compliant(cal, row.q_deg * kDeg).linear();
       const double e = Eigen::AngleAxisd(abc_to_rotation(row.abc).transpose() * rm).angle() / kDeg;
       ss += e * e;
     }
@@ -202,12 +202,12 @@ TEST(Identify, SixDimensionalPosesDetermineTheToolOrientation) {
   const IdentifyResult r6 = identify(nominal, fit, opt);
   const Model cal6(r6.calibrated);
   const double noise_deg = 0.005 * std::sqrt(3.0);
-  EXPECT_LT(orientation_rms_deg(cal6), 1.3 * noise_deg);
-  EXPECT_LT(rms(point_errors(cal6, r6.targets, held)), 1.2 * 0.02 * std::sqrt(3.0));
+  EXPECT_LT(orientation_rms_deg(cal6, r6.campaign), 1.3 * noise_deg);
+  EXPECT_LT(rms(point_errors(cal6, r6.campaign, r6.targets, held)), 1.2 * 0.02 * std::sqrt(3.0));
   MeasurementSet points = fit;
   points.orientation = false;
   const IdentifyResult r3 = identify(nominal, points, IdentifyOptions());
-  EXPECT_GT(orientation_rms_deg(Model(r3.calibrated)), 3 * noise_deg);
+  EXPECT_GT(orientation_rms_deg(Model(r3.calibrated), r3.campaign), 3 * noise_deg);
 }
 
 TEST(Identify, NoiseFreeSixDimensionalPosesIdentifyTheToolFrame) {
@@ -237,13 +237,13 @@ TEST(Identify, NoiseFreeSixDimensionalPosesIdentifyTheToolFrame) {
   }
   EXPECT_EQ(r.calibrated.tcp, "measured");
   const Model cal(r.calibrated);
-  const std::vector<double> ep = point_errors(cal, {Vec3::Zero()}, held);  // the tool frame's origin
+  const std::vector<double> ep = point_errors(cal, r.campaign, {Vec3::Zero()}, held);  // the tool frame's origin
   EXPECT_LT(*std::max_element(ep.begin(), ep.end()), 1e-4) << r.termination;
-  const std::vector<double> eo = orientation_errors(cal, held);
+  const std::vector<double> eo = orientation_errors(cal, r.campaign, held);
   ASSERT_EQ(eo.size(), held.rows.size());
   EXPECT_LT(*std::max_element(eo.begin(), eo.end()), 1e-6);
   // the nominal geometry (its base and tool frames fitted) is off by more than 1 mm RMS
-  EXPECT_GT(rms(point_errors(Model(r.nominal_fitted), {Vec3::Zero()}, held)), 1.0);
+  EXPECT_GT(rms(point_errors(Model(r.nominal_fitted), r.nominal_campaign, {Vec3::Zero()}, held)), 1.0);
 }
 
 TEST(Identify, SixDimensionalRowsWithReflectorsKeepTheReflectorsOffsetsInTheToolFrame) {
@@ -272,9 +272,9 @@ TEST(Identify, SixDimensionalRowsWithReflectorsKeepTheReflectorsOffsetsInTheTool
   ASSERT_EQ(r.targets.size(), 3u);
   for (int t = 0; t < 3; ++t) EXPECT_LT((r.targets[t] - kTargets[t]).norm(), 1e-6) << t;
   const Model cal(r.calibrated);
-  const std::vector<double> e = point_errors(cal, r.targets, held);
+  const std::vector<double> e = point_errors(cal, r.campaign, r.targets, held);
   EXPECT_LT(*std::max_element(e.begin(), e.end()), 1e-4);
-  const std::vector<double> eo = orientation_errors(cal, held);
+  const std::vector<double> eo = orientation_errors(cal, r.campaign, held);
   EXPECT_EQ(eo.size(), 200u);  // the 6-D rows only
   EXPECT_LT(*std::max_element(eo.begin(), eo.end()), 1e-6);
   // 6-D rows of two targets claim two tool frames: an error naming both
@@ -301,7 +301,7 @@ TEST(Identify, ReflectorsAloneLeaveTheTcpNominal) {
   IdentifyOptions opt;
   opt.compliance = false;
   opt.loss = Loss::none;
-  const IdentifyResult r = identify(Model(kr500_spec()), simulate(truth, so), opt);
+  const IdentifyResult r = identify(Model(kr500_spec()), simulate(truth, so, test::truth_campaign()), opt);
   EXPECT_EQ(r.calibrated.tcp, "nominal");
   for (int i = r.layout.tool; i < r.layout.tool + 6; ++i) EXPECT_TRUE(r.fixed[i]) << r.layout.names[i];
 }
@@ -326,11 +326,11 @@ TEST(Identify, GravityWithoutAMassTablePredictsAsTheTrueMasses) {
   const IdentifyResult rf = identify(Model(massless), fit, opt);
   EXPECT_FALSE(rm.layout.fit_gravity);
   ASSERT_TRUE(rf.layout.fit_gravity);
-  const double e_masses = rms(point_errors(Model(rm.calibrated), rm.targets, held));
-  const double e_fitted = rms(point_errors(Model(rf.calibrated), rf.targets, held));
+  const double e_masses = rms(point_errors(Model(rm.calibrated), rm.campaign, rm.targets, held));
+  const double e_fitted = rms(point_errors(Model(rf.calibrated), rf.campaign, rf.targets, held));
   opt.compliance = false;
   const IdentifyResult rr = identify(Model(massless), fit, opt);
-  const double e_rigid = rms(point_errors(Model(rr.calibrated), rr.targets, held));
+  const double e_rigid = rms(point_errors(Model(rr.calibrated), rr.campaign, rr.targets, held));
   std::printf("held-out RMS: true masses %.4f mm, fitted moments %.4f mm, no compliance %.4f mm (%s)\n", e_masses,
               e_fitted, e_rigid, rf.termination.c_str());
   EXPECT_LT(e_fitted, 1.10 * e_masses);

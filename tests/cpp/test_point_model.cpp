@@ -51,7 +51,7 @@ MeasurementSet small_campaign(const Model& truth, const std::vector<Vec3>& targe
   so.noise_mm = 0;
   so.targets = targets;
   so.orientation_noise_deg = orientation_noise;
-  return simulate(truth, so);
+  return simulate(truth, so, test::truth_campaign());
 }
 
 }  // namespace
@@ -100,7 +100,7 @@ TEST(PointModel, JacobianMatchesFiniteDifferencesWithEffects) {
   so.poses = 30;
   so.noise_mm = 0;
   so.targets = kTargets;
-  const MeasurementSet d = simulate(Model(truth_spec(5, 0.003)), so);
+  const MeasurementSet d = simulate(Model(truth_spec(5, 0.003)), so, test::truth_campaign());
   const Model nominal(kr500_spec());
   const std::vector<Effect> eff = {{"transmission_error", 2}, {"backlash", 1}, {"thermal_expansion", -1}, joint_map(4, 6)};
   PointModel pm(nominal, {3, eff, 24.0});
@@ -127,7 +127,7 @@ TEST(PointModel, OrientationJacobianMatchesFiniteDifferences) {
   so.noise_mm = 0.02;
   so.orientation_noise_deg = 0.01;
   so.targets = {Vec3(0, 0, 0)};
-  const MeasurementSet d = simulate(Model(truth_spec(6, 0.003)), so);
+  const MeasurementSet d = simulate(Model(truth_spec(6, 0.003)), so, test::truth_campaign());
   ASSERT_TRUE(d.orientation);
   const Model nominal(kr500_spec());
   const std::vector<Effect> eff = {{"transmission_error", 3}, {"thermal_expansion", -1}};
@@ -236,7 +236,7 @@ TEST(PointModel, FittedGravityOrientationJacobianAndWrittenModel) {
   so.noise_mm = 0.02;
   so.orientation_noise_deg = 0.01;
   so.targets = {Vec3(0, 0, 0)};
-  const MeasurementSet d = simulate(Model(truth_spec(6, 0.003)), so);
+  const MeasurementSet d = simulate(Model(truth_spec(6, 0.003)), so, test::truth_campaign());
   const Model nominal(massless_kr500());
   PointModel pm(nominal, {1, {}, 20.0, {}, 0, true});
   const ParamLayout& L = pm.layout();
@@ -270,7 +270,7 @@ TEST(PointModel, FittedGravityOrientationJacobianAndWrittenModel) {
   const PointState at_x = pm.at(x);
   const Model written(at_x.spec());
   const std::vector<Vec3> targets = {Vec3(x[L.targets], x[L.targets + 1], x[L.targets + 2])};
-  const std::vector<double> e = point_errors(written, targets, d);
+  const std::vector<double> e = point_errors(written, at_x.campaign(), targets, d);
   ASSERT_EQ(e.size(), d.rows.size());
   for (size_t i = 0; i < d.rows.size(); ++i)
     EXPECT_NEAR(e[i], (at_x.predict(d.rows[i], nullptr) - d.rows[i].xyz).norm(), 1e-9);

@@ -59,9 +59,10 @@ Robot every_effect_robot() {
   s.effects.push_back({Effect{"backlash", 0, {}}, {-2e-4}});
   s.effects.push_back({Effect{"backlash", 2, {}}, {-3e-4}});
   s.effects.push_back({Effect{"thermal_expansion", -1, {}}, {1.2e-5}});
-  s.fitted_deg.assign(6, JointRange{-180.0, 180.0});
-  s.fitted_deg[1] = JointRange{-50.0, -45.0};
-  return Robot{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(s)};
+  Campaign c;
+  c.fitted_deg.assign(6, JointRange{-180.0, 180.0});
+  c.fitted_deg[1] = JointRange{-50.0, -45.0};
+  return Robot{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(s), c};
 }
 
 // A path of n poses out and back (every joint turns around), in a program's words.

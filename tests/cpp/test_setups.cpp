@@ -14,6 +14,7 @@
 #include "identify_test_util.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -110,7 +111,7 @@ TEST(Setups, JacobianOfSetupsAndDriftMatchesFiniteDifferences) {
     so.targets = six_d ? std::vector<Vec3>{Vec3::Zero()} : kTargets;
     so.duration_s = 3 * 3600;
     so.orientation_noise_deg = six_d ? 0.01 : -1;
-    MeasurementSet d = simulate(Model(truth_spec(7, 0.003)), so);
+    MeasurementSet d = simulate(Model(truth_spec(7, 0.003)), so, test::truth_campaign());
     d.setup_names = {"A", "B"};
     for (auto& r : d.rows) r.setup = r.pose % 2;
     const Model nominal(kr500_spec());
@@ -169,7 +170,7 @@ TEST(Setups, OneSetupNamedIsTheLayoutWithoutSetups) {
   so.seed = test::test_seed(1);  // the simulator's default
   so.poses = 10;
   so.targets = kTargets;
-  const MeasurementSet d = simulate(Model(truth_spec(3, 0.003)), so);
+  const MeasurementSet d = simulate(Model(truth_spec(3, 0.003)), so, test::truth_campaign());
   const Model nominal(kr500_spec());
   PointModel a(nominal, {3}), b(nominal, {3, {}, 20.0, {"only"}});
   EXPECT_EQ(a.layout().names, b.layout().names);
@@ -180,53 +181,106 @@ TEST(Setups, OneSetupNamedIsTheLayoutWithoutSetups) {
   for (const auto& r : d.rows) EXPECT_EQ(a_x.predict(r, nullptr), b_x.predict(r, nullptr));
 }
 
-TEST(Setups, DriftIsCarriedInertAndPlacementsRoundTrip) {
-  KINCAL_SEED_TRACE(5, 3);
-  // a model carrying a drift and two setups: FK and compensation are those of the same model
-  // without them (bit for bit); the measurement side (point_errors) applies them; JSON keeps them
-  ModelSpec plain = truth_spec(5, 0.003);
-  ModelSpec carried = plain;
-  carried.effects.push_back({Effect{"drift", -1, {}}, tracker_drift()});
+TEST(Setups, DriftAndPlacementsAreTheCampaignsAndRoundTrip) {
+  KINCAL_SEED_TRACE(5);
+  // a campaign carrying a drift and two setups: the model is the robot's alone (a drift among a
+  // model's effects is refused: the campaign carries it); the measurement side (simulate_point)
+  // applies them; the model JSON keeps them in its campaign section
+  const Model a(truth_spec(5, 0.003));
+  const Campaign plain = test::truth_campaign();
+  Campaign carried = plain;
+  carried.drift = EffectValue{Effect{"drift", -1, {}}, tracker_drift()};
   carried.t_mean_s = 5400;
   carried.setups = {{"A", plain.base_in_instrument}, {"B", second_placement()}};
-  const Model a(plain), b(carried);
-  ASSERT_NE(b.drift(), nullptr);
-  std::mt19937_64 rng(test::test_seed(3));
-  std::uniform_real_distribution<double> u(-60, 60);
-  for (int k = 0; k < 50; ++k) {
-    VecQ q(6);
-    for (int j = 0; j < 6; ++j) q[j] = u(rng) * kDeg;
-    EXPECT_EQ(fk_model(a, q, {}).matrix(), fk_model(b, q, {}).matrix());
-    Vec6 q6 = q / kDeg;
-    const Pose6 want = iso_to_pose(fk_model(a, q, {}));
-    Vec6 start = q6;
-    start[1] += 0.5;
-    const CompensationResult ca = compensate(a, want, start), cb = compensate(b, want, start);
-    EXPECT_EQ(ca.q_deg, cb.q_deg);
-  }
-  // the measurement side: a row at the campaign's mean time sees the placement itself, one an
-  // hour later the placement moved by one hour of drift
+  ModelSpec drifting = a.spec();
+  drifting.effects.push_back(*carried.drift);
+  EXPECT_NE(test::error_of([&] { Model m(drifting); }).find("the campaign carries it"), std::string::npos);
+  // a row at the campaign's mean time sees the placement itself, one an hour later the placement
+  // moved by one hour of drift
   Measurement row;
   row.q_deg = VecQ::Zero(6);
   row.q_deg[1] = -90;
   row.q_deg[2] = 90;
   row.time_s = 5400;
-  const Vec3 p0 = simulate_point(a, row, Vec3::Zero());
-  EXPECT_LT((simulate_point(b, row, Vec3::Zero()) - p0).norm(), 1e-9);
+  const Vec3 p0 = simulate_point(a, plain, row, Vec3::Zero());
+  EXPECT_LT((simulate_point(a, carried, row, Vec3::Zero()) - p0).norm(), 1e-9);
   row.time_s = 5400 + 3600;
   const auto& v = tracker_drift();
-  const Vec3 tb = a.base_in_instrument().translation();  // the rotation turns about the base's origin
+  const Vec3 tb = plain.base().translation();  // the rotation turns about the base's origin
   const Vec3 expect = so3::exp(Vec3(v[3], v[4], v[5])) * (p0 - tb) + tb + Vec3(v[0], v[1], v[2]);
-  EXPECT_LT((simulate_point(b, row, Vec3::Zero()) - expect).norm(), 1e-9);
-  // JSON: the setups and the drift's reference time come back
+  EXPECT_LT((simulate_point(a, carried, row, Vec3::Zero()) - expect).norm(), 1e-9);
+  // JSON: the setups, the drift and its reference time come back
   auto nom = std::make_shared<Model>(kr500_spec());
-  const Robot back = robot_from_json(robot_to_json(Robot{nom, std::make_shared<Model>(carried)}), "m.json");
-  ASSERT_EQ(back.calibrated()->spec().setups.size(), 2u);
-  EXPECT_EQ(back.calibrated()->spec().setups[1].name, "B");
-  EXPECT_LT((back.calibrated()->spec().setups[1].base_in_instrument.xyz - second_placement().xyz).norm(), 1e-12);
-  EXPECT_EQ(back.calibrated()->spec().t_mean_s, 5400);
-  ASSERT_NE(back.calibrated()->drift(), nullptr);
-  for (int k = 0; k < 6; ++k) EXPECT_NEAR(back.calibrated()->drift()->p[k], v[k], 1e-18);
+  const Robot back =
+      robot_from_json(robot_to_json(Robot{nom, std::make_shared<Model>(a.spec()), carried}), "m.json");
+  ASSERT_EQ(back.campaign().setups.size(), 2u);
+  EXPECT_EQ(back.campaign().setups[1].name, "B");
+  EXPECT_LT((back.campaign().setups[1].base_in_instrument.xyz - second_placement().xyz).norm(), 1e-12);
+  EXPECT_EQ(back.campaign().t_mean_s, 5400);
+  ASSERT_TRUE(back.campaign().drift.has_value());
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(back.campaign().drift->p[k], v[k], 1e-18);
+  EXPECT_TRUE(back.calibrated()->spec().effects.empty());  // the model's own effects: none
+}
+
+/// A version 3 model file rewritten in version 2's layout (kincal up to the twentieth session): the
+/// campaign's keys inside the calibrated model's section, its drift among that model's effects, the
+/// nominal section with the identity placement.
+std::string as_version2(const std::string& v3) {
+  nlohmann::json o = nlohmann::json::parse(v3);
+  nlohmann::json c = o["campaign"];
+  o.erase("campaign");
+  o["version"] = 2;
+  nlohmann::json& cal = o["calibrated"];
+  o["nominal"]["base_in_instrument"] = {{"xyz_mm", {0.0, 0.0, 0.0}}, {"abc_deg", {0.0, 0.0, 0.0}}};
+  cal["base_in_instrument"] = c["base_in_instrument"];
+  for (const char* key : {"setups", "t_mean_s", "fitted_joint_ranges_deg"})
+    if (c.contains(key)) cal[key] = c[key];
+  if (c.contains("drift")) cal["effects"].push_back(c["drift"]);
+  return o.dump(2);
+}
+
+TEST(Setups, ModelFilesOfVersions3And2ReadTheSame) {
+  KINCAL_SEED_TRACE(5);
+  // a calibrated kr500 (seed 5) with a transmission error, its campaign with a drift, two setups and
+  // fitted ranges: written (version 3: a campaign section), rewritten in version 2's layout, both
+  // read back to the same models and campaign, value for value
+  ModelSpec cs = truth_spec(5, 0.003);
+  cs.effects.push_back({Effect{"transmission_error", 1, {1, 2}}, {3e-4, -2e-4, 1e-4, 0.0}});
+  Campaign c = test::truth_campaign();
+  c.drift = EffectValue{Effect{"drift", -1, {}}, tracker_drift()};
+  c.t_mean_s = 5400;
+  c.setups = {{"A", c.base_in_instrument}, {"B", second_placement()}};
+  c.fitted_deg.assign(6, JointRange{-170.0, 170.0});
+  const std::string v3 = robot_to_json(Robot{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(cs), c});
+  EXPECT_NE(v3.find("\"version\": 3"), std::string::npos);
+  EXPECT_NE(v3.find("\"campaign\""), std::string::npos);
+  const std::string v2 = as_version2(v3);
+  const Robot a = robot_from_json(v3, "v3.json"), b = robot_from_json(v2, "v2.json");
+  for (const Robot* r : {&a, &b}) {
+    const Campaign& rc = r->campaign();
+    EXPECT_EQ(rc.base_in_instrument.xyz, c.base_in_instrument.xyz);
+    EXPECT_EQ(rc.base_in_instrument.abc, c.base_in_instrument.abc);
+    ASSERT_EQ(rc.setups.size(), 2u);
+    EXPECT_EQ(rc.setups[1].name, "B");
+    EXPECT_EQ(rc.setups[1].base_in_instrument.xyz, second_placement().xyz);
+    EXPECT_EQ(rc.t_mean_s, 5400);
+    ASSERT_TRUE(rc.drift.has_value());
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(rc.drift->p[k], tracker_drift()[static_cast<size_t>(k)], 1e-18);
+    EXPECT_EQ(rc.fitted_deg, c.fitted_deg);
+    const ModelSpec& rs = r->calibrated()->spec();
+    ASSERT_EQ(rs.effects.size(), 1u);  // the robot's own effect; the drift is the campaign's
+    EXPECT_EQ(rs.effects[0].effect.name, "transmission_error");
+    for (int j = 0; j < 6; ++j) {
+      EXPECT_EQ(rs.joints[j].point, a.calibrated()->spec().joints[j].point);
+      EXPECT_EQ(rs.joints[j].compliance_deg_per_knm, cs.joints[j].compliance_deg_per_knm);
+    }
+  }
+  // the same file written again from either: version 3, byte for byte
+  EXPECT_EQ(robot_to_json(b), v3);
+  // version 1 (the layout of version 2) still reads
+  std::string v1 = v2;
+  v1.replace(v1.find("\"version\": 2"), 12, "\"version\": 1");
+  EXPECT_EQ(robot_to_json(robot_from_json(v1, "v1.json")), v3);
 }
 
 TEST(Setups, HiddenDriftIsRecoveredWithinItsUncertainty) {
@@ -244,7 +298,7 @@ TEST(Setups, HiddenDriftIsRecoveredWithinItsUncertainty) {
   so.effects = {{Effect{"drift", -1, {}}, tracker_drift()}};
   so.seed = test::test_seed(5);
   const Model truth(truth_spec(31, 0.003));
-  const MeasurementSet fit = simulate(truth, so);
+  const MeasurementSet fit = simulate(truth, so, test::truth_campaign());
   const Model nominal(kr500_spec());
   IdentifyOptions opt;
   opt.effects = {Effect{"drift", -1, {}}};
@@ -257,8 +311,8 @@ TEST(Setups, HiddenDriftIsRecoveredWithinItsUncertainty) {
     ASSERT_FALSE(r.fixed[i]) << r.layout.names[i] << ": " << r.fixed_reason[i];
     EXPECT_LT(std::abs(r.x[i] - v[k]), 4 * r.stddev[i]) << r.layout.names[i] << " " << r.x[i] << " +- " << r.stddev[i];
   }
-  const Model cal(r.calibrated);
-  ASSERT_NE(cal.drift(), nullptr);
+  ASSERT_TRUE(r.campaign.drift.has_value());
+  EXPECT_NEAR(r.campaign.t_mean_s, 5400, 1e-9);
   // the rows of the fit: at the noise floor with the drift, clearly above without it
   const double floor = 0.02 * std::sqrt(3.0);
   EXPECT_LT(r.rms_mm, 1.1 * floor);
@@ -274,33 +328,32 @@ TEST(Setups, TwoSetupsIdentifiedJointly) {
   // the relative placement of the two instruments (B's frame seen from A's, which the robot's
   // gauge cannot change) maps the workspace within 0.02 mm of the truth's, and held-out campaigns
   // from each placement are predicted at the noise floor.
-  const Model truth_a(truth_spec(41, 0.003));
-  ModelSpec sb = truth_spec(41, 0.003);
-  sb.base_in_instrument = second_placement();
-  const Model truth_b(sb);
+  const Model truth(truth_spec(41, 0.003));
+  Campaign campaign_b;
+  campaign_b.base_in_instrument = second_placement();
   SimulationOptions so;
   so.poses = 80;
   so.noise_mm = 0.02;
   so.targets = kTargets;
   so.seed = test::test_seed(1);
-  const MeasurementSet a = simulate(truth_a, so);
+  const MeasurementSet a = simulate(truth, so, test::truth_campaign());
   so.seed = test::test_seed(2);
-  const MeasurementSet data = two_setups(a, simulate(truth_b, so));
+  const MeasurementSet data = two_setups(a, simulate(truth, so, campaign_b));
   const Model nominal(kr500_spec());
   const IdentifyResult r = identify(nominal, data, IdentifyOptions{});
-  ASSERT_EQ(r.calibrated.setups.size(), 2u);
+  ASSERT_EQ(r.campaign.setups.size(), 2u);
   const Model cal(r.calibrated);
-  const Eigen::Isometry3d ia = pose_to_iso(r.calibrated.setups[0].base_in_instrument);
-  const Eigen::Isometry3d ib = pose_to_iso(r.calibrated.setups[1].base_in_instrument);
-  const Eigen::Isometry3d ta = truth_a.base_in_instrument(), tb = truth_b.base_in_instrument();
+  const Eigen::Isometry3d ia = pose_to_iso(r.campaign.setups[0].base_in_instrument);
+  const Eigen::Isometry3d ib = pose_to_iso(r.campaign.setups[1].base_in_instrument);
+  const Eigen::Isometry3d ta = test::truth_campaign().base(), tb = campaign_b.base();
   double worst = 0;  // B's instrument coordinates of the measured points, mapped into A's
   for (const auto& row : data.rows)
     if (row.setup == 1) worst = std::max(worst, ((ia * ib.inverse()) * row.xyz - (ta * tb.inverse()) * row.xyz).norm());
   EXPECT_LT(worst, 0.02);
   so.seed = test::test_seed(3);
-  const MeasurementSet held_a = simulate(truth_a, so);
+  const MeasurementSet held_a = simulate(truth, so, test::truth_campaign());
   so.seed = test::test_seed(4);
-  const MeasurementSet held = two_setups(held_a, simulate(truth_b, so));
+  const MeasurementSet held = two_setups(held_a, simulate(truth, so, campaign_b));
   const double floor = 0.02 * std::sqrt(3.0);
-  EXPECT_LT(rms(point_errors(cal, r.targets, held)), 1.2 * floor);
+  EXPECT_LT(rms(point_errors(cal, r.campaign, r.targets, held)), 1.2 * floor);
 }

@@ -1,5 +1,5 @@
 """Where a model's periodic effects are extrapolated: the joint ranges a fit saw (model.json's
-calibrated.fitted_joint_ranges_deg), `kincal validate`'s warning when new data leave them, and the
+campaign.fitted_joint_ranges_deg), `kincal validate`'s warning when new data leave them, and the
 warning of `kincal compensate` and `kincal-compensate` when a program does.
 
 Truth of the end-to-end case: kr500 with 1 mm / 0.05 deg geometric errors and 0.003 deg/kN m joint
@@ -65,7 +65,7 @@ def half_fit(tmp_path_factory):
 
 def test_validate_warns_where_a_periodic_effect_is_extrapolated(half_fit):
     tmp_path, data, low = half_fit
-    ranges = json.loads((tmp_path / "model.json").read_text())["calibrated"]["fitted_joint_ranges_deg"]
+    ranges = json.loads((tmp_path / "model.json").read_text())["campaign"]["fitted_joint_ranges_deg"]
     fit_q = data["q_deg"][low]
     assert len(ranges) == 6
     assert np.allclose(ranges[1], [fit_q[:, 1].min(), fit_q[:, 1].max()])

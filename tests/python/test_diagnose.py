@@ -138,7 +138,7 @@ def test_cli_writes_diagnosis_report_and_model(tmp_path):
     assert np.allclose(model["identification"]["targets_mm"], ident.DEFAULT_TARGETS[:3])
     # the final model (TCP placed from --tool-targets) records the angles it was fitted on: every row
     data = ident.read_measurements(str(tmp_path / "m.csv"), robot)
-    assert np.allclose(model["calibrated"]["fitted_joint_ranges_deg"], _core.joint_ranges(data["q_deg"]))
+    assert np.allclose(model["campaign"]["fitted_joint_ranges_deg"], _core.joint_ranges(data["q_deg"]))
     page = (tmp_path / "d" / "report.html").read_text()
     assert "gap.png" in page and "residual_map.png" in page
     assert "model.json was written" in page

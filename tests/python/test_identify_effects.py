@@ -198,17 +198,18 @@ def test_typed_result(te_backlash_campaign, kr500):
 
 
 def test_version_1_model_json_still_loads(kr500):
-    """A model file of version 1 (no effects, no t_ref_c) reads, and its FK is the version 2 file's."""
+    """A model file of version 1 (no effects, no t_ref_c; the instrument's placement inside each
+    model's section) reads, and its FK (in the instrument's frame too) is the version 3 file's."""
     robot = kr500.with_calibrated(2, 1.0, 0.05, 0.003, ident.DEFAULT_INSTRUMENT)
     doc = json.loads(robot.to_json())
-    assert doc["version"] == 2
+    assert doc["version"] == 3
     doc["version"] = 1
+    placement = doc.pop("campaign")["base_in_instrument"]
     for part in ("nominal", "calibrated"):
         if isinstance(doc.get(part), dict):
             doc[part].pop("effects", None)
             doc[part].pop("t_ref_c", None)
-    doc.pop("effects", None)
-    doc.pop("t_ref_c", None)
+            doc[part]["base_in_instrument"] = placement
     old = _core.Robot.from_json(json.dumps(doc), "v1.json")
     assert old.effects == [] and old.identified
     q = np.random.default_rng(1).uniform(-60, 60, (50, 6))

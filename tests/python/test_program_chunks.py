@@ -39,7 +39,7 @@ def _every_effect_model(calibrated: kincal.Robot, path: Path) -> Path:
         {"effect": "thermal_expansion", "joint": None,
          "parameters": [{"name": "thermal_expansion", "unit": "1/degC", "value": 1.2e-5}]},
     ]
-    c["fitted_joint_ranges_deg"] = [[-180.0, 180.0], [-50.0, -45.0]] + [[-180.0, 180.0]] * 4
+    m["campaign"]["fitted_joint_ranges_deg"] = [[-180.0, 180.0], [-50.0, -45.0]] + [[-180.0, 180.0]] * 4
     path.write_text(json.dumps(m))
     return path
 

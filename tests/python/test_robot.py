@@ -70,8 +70,8 @@ def test_model_json_round_trip_and_version(tmp_path, calibrated):
     assert json.loads(text)["format"] == "kincal-model"
     assert kincal.Robot.from_json(text).to_json() == text
     doc = json.loads(text)
-    doc["version"] = 3
-    with pytest.raises(ValueError, match="model version 3 is not supported"):
+    doc["version"] = 4
+    with pytest.raises(ValueError, match="model version 4 is not supported"):
         kincal.Robot.from_json(json.dumps(doc), "future.json")
 
 

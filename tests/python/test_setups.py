@@ -105,7 +105,8 @@ def test_two_setups_identified_jointly(kr500, truth):
     assert vj["rms_mm"] < 1.1 * vs["rms_mm"] and vj["rms_mm"] < 1.25 * NOISE, (vj["rms_mm"], vs["rms_mm"])
     doc = json.loads(joint.model_json())
     assert [s["name"] for s in doc["identification"]["setups"]] == ["A", "B"]
-    assert doc["calibrated"]["base_in_instrument"] == doc["identification"]["setups"][0]["base_in_instrument"]
+    assert doc["campaign"]["base_in_instrument"] == doc["identification"]["setups"][0]["base_in_instrument"]
+    assert [s["name"] for s in doc["campaign"]["setups"]] == ["A", "B"]
 
 
 def test_validate_command_on_a_moved_instrument(tmp_path, kr500, truth):
@@ -212,10 +213,10 @@ def test_drift_is_identified_reported_and_never_compensated(tmp_path, kr500, tru
     assert rep["t_mean_s"] == pytest.approx(5400)
     for p, want in zip(rep["parameters"], DRIFT_FILE):
         assert abs(p["value"] - want) < 4 * p["stddev"], (p, want)
-    assert any(e["effect"] == "drift" for e in doc["calibrated"]["effects"])
+    assert doc["campaign"]["drift"]["effect"] == "drift"  # the campaign's, not the robot's
+    assert all(e["effect"] != "drift" for e in doc["calibrated"]["effects"])
     plain = json.loads(json.dumps(doc))
-    plain["calibrated"]["effects"] = [e for e in plain["calibrated"]["effects"] if e["effect"] != "drift"]
-    del plain["calibrated"]["t_mean_s"]
+    del plain["campaign"]["drift"], plain["campaign"]["t_mean_s"]
     (tmp_path / "plain.json").write_text(json.dumps(plain))
     q = data["q_deg"][::10]
     (tmp_path / "q.csv").write_text("q1,q2,q3,q4,q5,q6\n" + "".join(",".join(map(str, x)) + "\n" for x in q))

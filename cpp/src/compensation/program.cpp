@@ -170,7 +170,7 @@ PoseSolution solve_pose(const Robot& robot, const ProgramOptions& opt, const Pos
                         const EffectContext& ctx) {
   if (robot.nominal()->dof() != 6) return failed("programs need a 6-joint robot");
   Pose6 pose = pose_in;
-  if (opt.instrument_frame) pose = iso_to_pose(robot.calibrated()->base_in_instrument().inverse() * pose_to_iso(pose_in));
+  if (opt.instrument_frame) pose = iso_to_pose(robot.campaign().base().inverse() * pose_to_iso(pose_in));
   if (robot.ik().structure().spherical_wrist_parallel_23) return solve_closed_form(robot, opt, pose, ref, ctx);
   return solve_numeric(robot, opt, pose, ref, ctx);
 }
@@ -320,11 +320,11 @@ ProgramResult compensate_poses(const Robot& robot, const std::vector<Pose6>& pos
     res = run(motion_directions(first.q_deg, {})[0]);
   }
   // the poses that take a joint's periodic effects outside the angles they were fitted on
-  if (opt.compensate && !res.q_deg.empty() && !cal.spec().fitted_deg.empty()) {
+  if (opt.compensate && !res.q_deg.empty() && !robot.campaign().fitted_deg.empty()) {
     std::vector<double> q;
     q.reserve(res.q_deg.size() * 6);
     for (const Vec6& v : res.q_deg) q.insert(q.end(), v.data(), v.data() + 6);
-    for (const Extrapolation& e : extrapolated(cal.spec(), q.data(), res.q_deg.size(), 6))
+    for (const Extrapolation& e : extrapolated(cal.spec(), robot.campaign().fitted_deg, q.data(), res.q_deg.size(), 6))
       res.warnings.push_back(where_i(e.first) + ": " + extrapolation_message(e, res.q_deg.size(), "poses compensated"));
   }
   return res;

@@ -183,7 +183,7 @@ ProgramResult compensate_program_file(const Robot& robot, const std::string& in_
   // the joints whose periodic effects were fitted on a range of angles (compensate_poses' warnings)
   std::vector<Extrapolation> periodic;
   if (opt.compensate)
-    for (const Extrapolation& e : periodic_joints(cal.spec()))
+    for (const Extrapolation& e : periodic_joints(cal.spec(), robot.campaign().fitted_deg))
       if (e.joint <= 6) periodic.push_back(e);
   const ProgramFile f{robot, opt, in_path, needs_dir, needs_t, std::move(periodic)};
   auto write = [&](const Vec6& dir0) {

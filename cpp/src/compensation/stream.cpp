@@ -83,7 +83,7 @@ constexpr const char* kBrokenQuote = "a quoted field is not closed, or text foll
 StreamCompensator::StreamCompensator(Robot robot, ProgramOptions opt)
     : robot_(std::move(robot)), opt_(std::move(opt)), cursor_(robot_, opt_, stream_directions(robot_, opt_)) {
   warning_.reserve(512);
-  if (opt_.compensate) periodic_ = periodic_joints(robot_.calibrated()->spec());
+  if (opt_.compensate) periodic_ = periodic_joints(robot_.calibrated()->spec(), robot_.campaign().fitted_deg);
 }
 
 Vec6 StreamCompensator::solve(const Pose6& p, double temperature_c) {

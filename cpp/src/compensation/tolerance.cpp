@@ -95,7 +95,7 @@ ToleranceResult compensate_with_tolerance(const Robot& robot, const std::vector<
   std::vector<std::string> label = r.where;  // per pose: the input line it belongs to
   std::vector<double> temps(poses.size(), opt.temperature_c);
   for (size_t i = 0; i < temperature_c.size() && i < poses.size(); ++i) temps[i] = temperature_c[i];
-  const Eigen::Isometry3d to_base = opt.instrument_frame ? robot.calibrated()->base_in_instrument().inverse()
+  const Eigen::Isometry3d to_base = opt.instrument_frame ? robot.campaign().base().inverse()
                                                          : Eigen::Isometry3d::Identity();
   constexpr int kMaxRounds = 20;
   for (int round = 0;; ++round) {

@@ -250,10 +250,11 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
   const PointState fitted = pm.at(x);
   res.nominal_fitted = fitted.spec();
   res.nominal_fitted.name = nominal.spec().name;
+  res.nominal_campaign = fitted.campaign();
   if (L.drift >= 0) {  // the "before" model sees the points from the same drifting instrument
-    res.nominal_fitted.effects.push_back({Effect{effect_kind(EffectId::drift).name, -1, {}},
-                                          std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)});
-    res.nominal_fitted.t_mean_s = L.t_mean;
+    res.nominal_campaign.drift = EffectValue{Effect{effect_kind(EffectId::drift).name, -1, {}},
+                                             std::vector<double>(x.begin() + L.drift, x.begin() + L.drift + 6)};
+    res.nominal_campaign.t_mean_s = L.t_mean;
   }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
   res.nominal_stations = fitted.stations();
@@ -273,6 +274,7 @@ void store_solution(const PointModel& pm, const Model& nominal, const Measuremen
   res.x = x;
   const PointState solution = pm.at(x);
   res.calibrated = solution.spec();
+  res.campaign = solution.campaign();
   res.calibrated.name = nominal.spec().name + "-calibrated";
   // 6-D rows measured the tool frame; reflectors alone leave it where it started (redundant with
   // their offsets): every pose then carries the tool's error
@@ -285,11 +287,18 @@ void store_solution(const PointModel& pm, const Model& nominal, const Measuremen
     const auto first = x.begin() + L.effect_offset[e];
     res.effects.push_back({L.effect_list[e], std::vector<double>(first, first + L.effect_list[e].size())});
   }
-  res.calibrated.effects = res.effects;  // the model carries every identified effect (the drift inert)
+  // the model carries every identified effect of the robot, the campaign the instrument's drift
+  res.calibrated.effects.clear();
+  for (const EffectValue& ev : res.effects) {
+    if (ev.effect.kind().of_instrument())
+      res.campaign.drift = ev;
+    else
+      res.calibrated.effects.push_back(ev);
+  }
   res.calibrated.t_ref_c = L.t_ref;
-  res.calibrated.t_mean_s = L.t_mean;
+  res.campaign.t_mean_s = L.t_mean;
   // a probe row's error is along its constraint, with the campaign's stations (not in the model)
-  const std::vector<double> e = point_errors(Model(res.calibrated), res.targets, data, res.stations);
+  const std::vector<double> e = point_errors(Model(res.calibrated), res.campaign, res.targets, data, res.stations);
   double ss = 0;
   for (double v : e) ss += v * v, res.max_mm = std::max(res.max_mm, v);
   res.rms_mm = std::sqrt(ss / e.size());
@@ -408,7 +417,8 @@ class Stage2 {
 
 }  // namespace
 
-IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, const IdentifyOptions& opt) {
+IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, const IdentifyOptions& opt,
+                        const Campaign& reference) {
   check_rows(nominal, all_data);
   MeasurementSet copy;
   const MeasurementSet& data = measured_artifact(all_data, copy);
@@ -421,7 +431,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   lo.station_names = data.station_names;
   lo.station_kinds = data.station_kinds;
   lo.target_start = opt.target_start;
-  const PointModel pm(nominal, lo, &data);
+  const PointModel pm(nominal, lo, &data, reference);
   IdentifyResult res(pm.layout());
   res.start = pm.start(data, opt.target_start);
   res.fixed.assign(res.layout.size, false);

@@ -27,7 +27,8 @@ Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>&
   const PointState at = pm.at(x);
   const ModelSpec& s = at.spec();
   Eigen::VectorXd v = Eigen::VectorXd::Zero(L.size);
-  const Vec3 o = pose_to_iso(s.base_in_instrument).translation();
+  const Campaign& c = at.campaign();
+  const Vec3 o = c.base().translation();
   for (int j = 0; j < L.dof; ++j) {
     const Vec3 w = s.joints[j].axis, p = s.joints[j].point;
     const Vec3 u = w.unitOrthogonal(), vv = w.cross(u);  // (the layout's own directions are its nominal's; a
@@ -40,7 +41,7 @@ Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>&
   for (int k = 0; k < 3; ++k) v[L.tool + k] = t[k];
   for (int i = L.targets; i < L.effects; ++i) v[i] = x[i];
   for (int st = 1; st < L.n_setups; ++st) {
-    const Vec3 ts = pose_to_iso(s.setups[static_cast<size_t>(st)].base_in_instrument).translation() - o;
+    const Vec3 ts = pose_to_iso(c.setups[static_cast<size_t>(st)].base_in_instrument).translation() - o;
     for (int k = 0; k < 3; ++k) v[L.base + 6 * st + k] = ts[k];
   }
   const std::vector<StationValue> sv = at.stations();

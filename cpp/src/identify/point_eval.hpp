@@ -18,8 +18,10 @@ namespace kincal::detail {
 /// axis, each setup's reference frame, the fitted gravity's zero-moment centres of mass and the
 /// payloads that get a model of their own.
 struct PointStructure {
-  /// data: its payloads get their model variants, its planes their reference normals.
-  PointStructure(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data);
+  /// data: its payloads get their model variants, its planes their reference normals; reference:
+  /// the placements the setups' corrections are relative to.
+  PointStructure(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data,
+                 const Campaign& reference);
   const Model& nominal;
   ParamLayout layout;
   std::vector<Vec3> u, v;
@@ -78,6 +80,7 @@ class PointEval {
   const PointStructure& structure() const { return *s_; }
   const std::vector<double>& x() const { return x_; }
   const ModelSpec& spec() const { return spec_; }
+  const Campaign& campaign() const { return campaign_; }
   Vec3 predict(const Measurement& m, double* jac, Mat3* rot, double* jac_rot) const;
   int probe_residuals(const Measurement& m, int size, double* r, double* J) const;
   double artifact_residual(const ArtifactTerm& a, double* J) const;
@@ -92,6 +95,7 @@ class PointEval {
   std::shared_ptr<const FlangeCache> flanges_;  ///< set: frames only
   const FlangeCache::Flange* cached_flange(const Measurement& m) const;
   ModelSpec spec_;
+  Campaign campaign_;  ///< the placements at these parameters
   std::shared_ptr<const Model> current_;
   std::vector<std::pair<double, std::shared_ptr<const Model>>> payload_models_;
   /// One instrument placement at the current parameters: its frame (r, t) and the right Jacobian

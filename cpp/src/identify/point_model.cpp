@@ -107,14 +107,15 @@ ParamLayout::ParamLayout(const Model& nominal, const LayoutOptions& o)
 
 namespace detail {
 
-PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, const MeasurementSet* data)
+PointStructure::PointStructure(const Model& nom, const LayoutOptions& options, const MeasurementSet* data,
+                               const Campaign& reference)
     : nominal(nom), layout(nom, options) {
   const int n = nominal.dof();
   // every setup's corrections are relative to the model's frame of that name, or its base frame
   for (int s = 0; s < layout.n_setups; ++s) {
-    Eigen::Isometry3d f = nominal.base_in_instrument();
+    Eigen::Isometry3d f = reference.base();
     if (!layout.setup_names.empty())
-      for (const SetupFrame& sf : nominal.spec().setups)
+      for (const SetupFrame& sf : reference.setups)
         if (sf.name == layout.setup_names[static_cast<size_t>(s)]) f = pose_to_iso(sf.base_in_instrument);
     r0.push_back(f.linear());
     t0.push_back(f.translation());
@@ -166,7 +167,7 @@ PointEval::PointEval(std::shared_ptr<const PointStructure> s, const std::vector<
   t.linear() = rm_;
   t.translation() = tm_;
   spec_.tool = iso_to_pose(t);
-  spec_.setups.clear();
+  campaign_.setups.clear();
   place_.resize(static_cast<size_t>(layout_.n_setups));
   for (int s = 0; s < layout_.n_setups; ++s) {
     Placement& b = place_[static_cast<size_t>(s)];
@@ -178,8 +179,8 @@ PointEval::PointEval(std::shared_ptr<const PointStructure> s, const std::vector<
     t.linear() = b.r;
     t.translation() = b.t;
     // the first setup's frame is the model's base_in_instrument; several are listed by name
-    if (s == 0) spec_.base_in_instrument = iso_to_pose(t);
-    if (!layout_.setup_names.empty()) spec_.setups.push_back({layout_.setup_names[static_cast<size_t>(s)], iso_to_pose(t)});
+    if (s == 0) campaign_.base_in_instrument = iso_to_pose(t);
+    if (!layout_.setup_names.empty()) campaign_.setups.push_back({layout_.setup_names[static_cast<size_t>(s)], iso_to_pose(t)});
   }
   current_ = std::make_shared<const Model>(spec_);
   for (double pay : s_->payloads) {
@@ -413,8 +414,9 @@ void PointEval::effect_columns(const Measurement& m, const VecQ& q, const Mat3& 
 
 }  // namespace detail
 
-PointModel::PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data)
-    : s_(std::make_shared<const detail::PointStructure>(nominal, options, data)) {}
+PointModel::PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data,
+                       const Campaign& reference)
+    : s_(std::make_shared<const detail::PointStructure>(nominal, options, data, reference)) {}
 
 std::vector<double> PointModel::start(const MeasurementSet& data, const std::vector<Vec3>& targets) const {
   const ParamLayout& L = s_->layout;
@@ -452,6 +454,7 @@ PointState PointModel::at_frames_only(const std::vector<double>& x, const Measur
 const ParamLayout& PointState::layout() const { return e_->structure().layout; }
 const std::vector<double>& PointState::x() const { return e_->x(); }
 const ModelSpec& PointState::spec() const { return e_->spec(); }
+const Campaign& PointState::campaign() const { return e_->campaign(); }
 PointState PointState::with_params(const std::vector<double>& x) const {
   return PointState(std::make_shared<const detail::PointEval>(e_->structure_ptr(), x, e_->flanges()));
 }

@@ -25,19 +25,19 @@ EffectContext row_context(const Measurement& row) {
 
 }  // namespace
 
-std::vector<Eigen::Isometry3d> setup_frames(const Model& model, const MeasurementSet& data) {
-  const auto& known = model.spec().setups;
+std::vector<Eigen::Isometry3d> setup_frames(const Campaign& campaign, const MeasurementSet& data) {
+  const auto& known = campaign.setups;
   std::vector<Eigen::Isometry3d> out;
   if (known.empty()) {
     if (data.setup_names.size() > 1)
       throw InputError(data.source + ": " + std::to_string(data.setup_names.size()) +
                        " setups but the model knows one instrument placement (identify them together, or "
                        "validate, which refits the placements)");
-    out.push_back(model.base_in_instrument());
+    out.push_back(campaign.base());
     return out;
   }
   if (data.setup_names.empty()) {
-    out.push_back(model.base_in_instrument());  // a set without a setup column: the first placement
+    out.push_back(campaign.base());  // a set without a setup column: the first placement
     return out;
   }
   for (const std::string& name : data.setup_names) {
@@ -52,39 +52,41 @@ std::vector<Eigen::Isometry3d> setup_frames(const Model& model, const Measuremen
   return out;
 }
 
-Eigen::Isometry3d drifted(const Model& model, const Eigen::Isometry3d& frame, double time_s) {
-  const EffectValue* d = model.drift();
-  if (!d) return frame;
+Eigen::Isometry3d drifted(const Campaign& campaign, const Eigen::Isometry3d& frame, double time_s) {
+  if (!campaign.drift) return frame;
+  const EffectValue* d = &*campaign.drift;
   if (std::isnan(time_s)) throw InputError("the model's drift needs the time of every measured point (time_s)");
-  const double tau = (time_s - model.spec().t_mean_s) / 3600.0;
+  const double tau = (time_s - campaign.t_mean_s) / 3600.0;
   Eigen::Isometry3d out = frame;
   out.linear() = so3::exp(tau * Vec3(d->p[3], d->p[4], d->p[5])) * frame.linear();
   out.translation() += tau * Vec3(d->p[0], d->p[1], d->p[2]);
   return out;
 }
 
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target, const Eigen::Isometry3d& base) {
+Vec3 simulate_point(const Model& truth, const Campaign& campaign, const Measurement& row, const Vec3& target,
+                    const Eigen::Isometry3d& base) {
   const EffectContext ctx = row_context(row);
   const Eigen::Isometry3d tool = fk(truth, joint_angles(truth, row.q_deg * kDeg, ctx));
   // thermal expansion: every length of the robot, the target's offset included, scales
-  return drifted(truth, base, row.time_s) * (length_scale(truth, ctx) * (tool * target));
+  return drifted(campaign, base, row.time_s) * (length_scale(truth, ctx) * (tool * target));
 }
 
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target) {
-  return simulate_point(truth, row, target, truth.base_in_instrument());
+Vec3 simulate_point(const Model& truth, const Campaign& campaign, const Measurement& row, const Vec3& target) {
+  return simulate_point(truth, campaign, row, target, campaign.base());
 }
 
 ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref) {
   ModelSpec s = truth;
-  if (effects.empty()) return s;
   bool thermal = false;
   for (const auto& e : s.effects) thermal = thermal || e.effect.kind().scales_lengths();
-  if (!thermal) s.t_ref_c = t_ref;
-  for (const auto& e : effects) s.effects.push_back(e);
+  bool added = false;
+  for (const auto& e : effects)
+    if (!e.effect.kind().of_instrument()) s.effects.push_back(e), added = true;  // a drift: the campaign's
+  if (added && !thermal) s.t_ref_c = t_ref;
   return s;
 }
 
-MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
+MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt, const Campaign& campaign_in) {
   if (opt.poses < 1) throw InputError("simulate: the number of poses must be positive");
   if (!(opt.duration_s >= 0) || !std::isfinite(opt.duration_s))
     throw InputError("simulate: the campaign's duration must be a finite non-negative number of seconds");
@@ -92,10 +94,14 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
   for (const auto& e : opt.effects) hidden_drift = hidden_drift || e.effect.kind().of_instrument();
   // a drift hidden without a duration: the campaign lasts 3 h; the drift is centred on its mean time
   const double duration = opt.duration_s > 0 ? opt.duration_s : (hidden_drift ? kDefaultDriftDuration_s : 0.0);
-  ModelSpec truth_spec = with_effects(truth_in.spec(), opt.effects, opt.t_ref);
-  if (hidden_drift && !truth_in.drift()) truth_spec.t_mean_s = 0.5 * duration;
-  const Model truth(truth_spec);
-  if (truth.drift() && duration <= 0)
+  const Model truth(with_effects(truth_in.spec(), opt.effects, opt.t_ref));
+  Campaign campaign = campaign_in;  // a hidden drift: the truth's instrument drifts
+  for (const auto& e : opt.effects)
+    if (e.effect.kind().of_instrument()) {
+      if (!campaign.drift) campaign.t_mean_s = 0.5 * duration;
+      campaign.drift = e;
+    }
+  if (campaign.drift && duration <= 0)
     throw InputError("simulate: the truth drifts: the campaign needs a duration (time_s)");
   if (opt.targets.empty()) throw InputError("simulate: at least one target");
   MeasurementSet m;
@@ -123,14 +129,14 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt) {
     if (duration > 0) row.time_s = duration * frac;  // drawn from nothing: the noise stream is unchanged
     for (int t = 0; t < m.n_targets; ++t) {
       row.target = t;
-      row.xyz = simulate_point(truth, row, opt.targets[t]);
+      row.xyz = simulate_point(truth, campaign, row, opt.targets[t]);
       row.xyz += Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
       row.has_abc = false;  // the row of the pose's previous target may have been the 6-D one
       row.abc = Vec3::Zero();
       if (opt.orientation_noise_deg >= 0 && t == 0) {
         // the measured frame (a 6-D probe, the first target; the others are reflectors, points): the
         // tool frame moved by that target's offset, truth orientation, then a small random rotation
-        const Mat3 r = drifted(truth, truth.base_in_instrument(), row.time_s).linear() *
+        const Mat3 r = drifted(campaign, campaign.base(), row.time_s).linear() *
                        fk_model(truth, row.q_deg * kDeg, row_context(row)).linear();
         const Vec3 e = Vec3(nd(rng), nd(rng), nd(rng)) * opt.orientation_noise_deg * kDeg;
         row.has_abc = true;
@@ -168,35 +174,36 @@ const Eigen::Isometry3d& row_frame(const std::vector<Eigen::Isometry3d>& frames,
 
 }  // namespace
 
-std::vector<double> orientation_errors(const Model& model, const MeasurementSet& data) {
-  const std::vector<Eigen::Isometry3d> frames = setup_frames(model, data);
+std::vector<double> orientation_errors(const Model& model, const Campaign& campaign, const MeasurementSet& data) {
+  const std::vector<Eigen::Isometry3d> frames = setup_frames(campaign, data);
   std::map<double, std::shared_ptr<const Model>> variants;
   std::vector<double> e;
   e.reserve(data.rows.size());
   for (const auto& r : data.rows) {
     if (!r.has_abc) continue;  // a reflector row among 6-D rows
     const Model& m = payload_model(model, r.payload_kg, variants);
-    const Mat3 rot = drifted(m, row_frame(frames, data, r), r.time_s).linear() *
+    const Mat3 rot = drifted(campaign, row_frame(frames, data, r), r.time_s).linear() *
                      fk_model(m, r.q_deg * kDeg, row_context(r)).linear();
     e.push_back(so3::log(abc_to_rotation(r.abc).transpose() * rot).norm() / kDeg);
   }
   return e;
 }
 
-std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data) {
-  return point_errors(model, targets, data, {});
+std::vector<double> point_errors(const Model& model, const Campaign& campaign, const std::vector<Vec3>& targets,
+                                 const MeasurementSet& data) {
+  return point_errors(model, campaign, targets, data, {});
 }
 
-std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
-                                 const std::vector<StationValue>& stations) {
-  const std::vector<Eigen::Isometry3d> frames = setup_frames(model, data);
+std::vector<double> point_errors(const Model& model, const Campaign& campaign, const std::vector<Vec3>& targets,
+                                 const MeasurementSet& data, const std::vector<StationValue>& stations) {
+  const std::vector<Eigen::Isometry3d> frames = setup_frames(campaign, data);
   std::vector<double> e;
   e.reserve(data.rows.size());
   std::map<double, std::shared_ptr<const Model>> variants;
   for (const auto& r : data.rows) {
     const Model& m = payload_model(model, r.payload_kg, variants);
     const Vec3 t = r.target < static_cast<int>(targets.size()) ? targets[r.target] : Vec3::Zero();
-    const Vec3 y = simulate_point(m, r, t, row_frame(frames, data, r));
+    const Vec3 y = simulate_point(m, campaign, r, t, row_frame(frames, data, r));
     if (!is_probe(r.kind)) {
       e.push_back((y - r.xyz).norm());
       continue;

@@ -63,22 +63,29 @@ json spec_json(const ModelSpec& s) {
          {"tool", pose_json(s.tool)},
          {"payload", json{{"mass_kg", s.payload_kg}, {"com_mm", v3(s.payload_com)}}},
          {"gravity_m_s2", v3(s.gravity)},
-         {"base_in_instrument", pose_json(s.base_in_instrument)},
          {"home_deg", s.home_deg},
          {"effects", effects_json(s)},
          {"t_ref_c", s.t_ref_c}};
-  // the measurement's side, only when there is one: the placements of several setups, the drift's centre
-  if (!s.setups.empty()) {
+  return o;
+}
+
+/// Version 3's "campaign" section: the instrument's placement, every setup's when there are several,
+/// its drift and the drift's centre when it drifts, the joint ranges the identification saw.
+json campaign_json(const Campaign& c) {
+  json o{{"base_in_instrument", pose_json(c.base_in_instrument)}};
+  if (!c.setups.empty()) {
     json setups = json::array();
-    for (const SetupFrame& f : s.setups)
+    for (const SetupFrame& f : c.setups)
       setups.push_back(json{{"name", f.name}, {"base_in_instrument", pose_json(f.base_in_instrument)}});
     o["setups"] = setups;
   }
-  for (const EffectValue& ev : s.effects)
-    if (ev.effect.kind().of_instrument()) o["t_mean_s"] = s.t_mean_s;
-  if (!s.fitted_deg.empty()) {
+  if (c.drift) {
+    o["drift"] = effect_json(c.drift->effect, c.drift->p);
+    o["t_mean_s"] = c.t_mean_s;
+  }
+  if (!c.fitted_deg.empty()) {
     json r = json::array();
-    for (const JointRange& j : s.fitted_deg) r.push_back(json::array({j[0], j[1]}));
+    for (const JointRange& j : c.fitted_deg) r.push_back(json::array({j[0], j[1]}));
     o["fitted_joint_ranges_deg"] = r;
   }
   return o;
@@ -150,7 +157,6 @@ struct Reader {
     s.payload_kg = num(pl, "mass_kg", where + ".payload");
     s.payload_com = vec(pl, "com_mm", where + ".payload");
     s.gravity = vec(o, "gravity_m_s2", where);
-    s.base_in_instrument = pose(o, "base_in_instrument", where);
     const json& home = at(o, "home_deg", where);
     if (!home.is_array()) fail(where + ".home_deg", "needs a list");
     for (const json& h : home) {
@@ -158,7 +164,19 @@ struct Reader {
       s.home_deg.push_back(h.get<double>());
     }
     if (o.contains("t_ref_c")) s.t_ref_c = num(o, "t_ref_c", where);
-    if (o.contains("t_mean_s")) s.t_mean_s = num(o, "t_mean_s", where);
+    if (o.contains("effects")) {
+      const json& effs = o["effects"];
+      if (!effs.is_array()) fail(where + ".effects", "needs a list");
+      for (size_t i = 0; i < effs.size(); ++i) s.effects.push_back(effect(effs[i], where + ".effects[" + std::to_string(i) + "]"));
+    }
+    return s;
+  }
+  /// The campaign's keys of an object: version 3's "campaign" section, or (`legacy`, versions 1 and 2)
+  /// the model's own section, whose drift sits among its effects (moved out of *legacy here).
+  Campaign campaign(const json& o, const std::string& where, int dof, ModelSpec* legacy) const {
+    Campaign c;
+    c.base_in_instrument = pose(o, "base_in_instrument", where);
+    if (o.contains("t_mean_s")) c.t_mean_s = num(o, "t_mean_s", where);
     if (o.contains("setups")) {
       const json& setups = o["setups"];
       if (!setups.is_array()) fail(where + ".setups", "needs a list");
@@ -166,7 +184,7 @@ struct Reader {
         const std::string w = where + ".setups[" + std::to_string(i) + "]";
         const json& name = at(setups[i], "name", w);
         if (!name.is_string()) fail(w + ".name", "not a string");
-        s.setups.push_back(SetupFrame{name.get<std::string>(), pose(setups[i], "base_in_instrument", w)});
+        c.setups.push_back(SetupFrame{name.get<std::string>(), pose(setups[i], "base_in_instrument", w)});
       }
     }
     if (o.contains("fitted_joint_ranges_deg")) {
@@ -177,16 +195,22 @@ struct Reader {
         const json& j = r[i];
         if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
           fail(w + "[" + std::to_string(i) + "]", "needs [lo, hi] (deg)");
-        s.fitted_deg.push_back({j[0].get<double>(), j[1].get<double>()});
+        c.fitted_deg.push_back({j[0].get<double>(), j[1].get<double>()});
       }
-      check_joint_ranges(s.fitted_deg, static_cast<int>(s.joints.size()), source + ": " + w);
+      check_joint_ranges(c.fitted_deg, dof, source + ": " + w);
     }
-    if (o.contains("effects")) {
-      const json& effs = o["effects"];
-      if (!effs.is_array()) fail(where + ".effects", "needs a list");
-      for (size_t i = 0; i < effs.size(); ++i) s.effects.push_back(effect(effs[i], where + ".effects[" + std::to_string(i) + "]"));
+    if (legacy) {
+      std::vector<EffectValue> robot;
+      for (EffectValue& ev : legacy->effects)
+        if (ev.effect.kind().of_instrument())
+          c.drift = ev;
+        else
+          robot.push_back(ev);
+      legacy->effects = robot;
+    } else if (o.contains("drift")) {
+      c.drift = effect(o["drift"], where + ".drift");
     }
-    return s;
+    return c;
   }
   EffectValue effect(const json& eo, const std::string& w) const {
     EffectValue ev;
@@ -248,8 +272,9 @@ struct Reader {
 std::string spec_to_json(const ModelSpec& spec) { return spec_json(spec).dump(2); }
 
 std::string robot_to_json(const Robot& robot) {
-  json o{{"format", "kincal-model"}, {"version", 2}, {"nominal", spec_json(robot.nominal()->spec())}};
+  json o{{"format", "kincal-model"}, {"version", 3}, {"nominal", spec_json(robot.nominal()->spec())}};
   if (robot.identified()) o["calibrated"] = spec_json(robot.calibrated()->spec());
+  o["campaign"] = campaign_json(robot.campaign());
   if (!robot.nominal()->spec().joint_convention.empty()) o["joint_convention"] = robot.nominal()->spec().joint_convention;
   if (!robot.calibrated()->spec().tcp.empty()) o["tcp"] = robot.calibrated()->spec().tcp;
   return o.dump(2) + "\n";
@@ -284,10 +309,12 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
   if (!o.is_object() || !o.contains("format") || o["format"] != "kincal-model")
     throw InputError(source + ": not a kincal model (\"format\": \"kincal-model\" missing)");
   if (!o.contains("version") || !o["version"].is_number_integer() || o["version"].get<int>() < 1 ||
-      o["version"].get<int>() > 2)
+      o["version"].get<int>() > 3)
     throw InputError(source + ": model version " + (o.contains("version") ? o["version"].dump() : "missing") +
-                     " is not supported (this kincal reads versions 1 and 2)");
+                     " is not supported (this kincal reads versions 1 to 3)");
+  const bool legacy = o["version"].get<int>() < 3;  // the campaign inside the model's sections
   ModelPtr nominal, calibrated;
+  Campaign campaign;
   std::string convention;  // the controller's joint numbers (joint_convention.hpp)
   if (o.contains("joint_convention")) {
     if (!o["joint_convention"].is_string()) throw InputError(source + ": joint_convention: not a string");
@@ -301,16 +328,27 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
     tcp = t.get<std::string>();
   }
   try {
-    ModelSpec ns = with_joint_convention(r.spec(r.at(o, "nominal", "model"), "nominal"), convention);
+    const json& no = r.at(o, "nominal", "model");
+    ModelSpec ns = r.spec(no, "nominal");
+    // versions 1 and 2: the campaign in the model's section (the calibrated one's when there is one)
+    if (legacy) {
+      Campaign nc = r.campaign(no, "nominal", static_cast<int>(ns.joints.size()), &ns);
+      if (!o.contains("calibrated")) campaign = nc;
+    }
+    ns = with_joint_convention(ns, convention);
     if (!o.contains("calibrated")) ns.tcp = tcp;  // one model: the key is its
     nominal = std::make_shared<Model>(ns);
     if (o.contains("calibrated")) {
-      ModelSpec cs = with_joint_convention(r.spec(o["calibrated"], "calibrated"), convention);
+      ModelSpec cs = r.spec(o["calibrated"], "calibrated");
+      if (legacy) campaign = r.campaign(o["calibrated"], "calibrated", static_cast<int>(cs.joints.size()), &cs);
+      cs = with_joint_convention(cs, convention);
       cs.tcp = tcp;
       calibrated = std::make_shared<Model>(cs);
     } else {
       calibrated = nominal;
     }
+    if (!legacy && o.contains("campaign"))
+      campaign = r.campaign(o["campaign"], "campaign", calibrated->dof(), nullptr);
   } catch (const InputError& e) {
     const std::string m = e.what();
     if (m.rfind(source, 0) == 0) throw;
@@ -318,7 +356,11 @@ Robot robot_from_json(const std::string& text, const std::string& source) {
   }
   if (calibrated->dof() != nominal->dof())
     throw InputError(source + ": nominal and calibrated models have different joint counts");
-  return Robot{nominal, calibrated};
+  try {
+    return Robot{nominal, calibrated, campaign};
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
 }
 
 Robot load_robot(const std::string& name) {

@@ -64,24 +64,25 @@ void check_joint_ranges(const std::vector<JointRange>& ranges, int dof, const st
   }
 }
 
-std::vector<Extrapolation> periodic_joints(const ModelSpec& calibrated) {
+std::vector<Extrapolation> periodic_joints(const ModelSpec& calibrated, const std::vector<JointRange>& fitted) {
   std::vector<Extrapolation> out;
-  for (size_t j = 0; j < calibrated.fitted_deg.size(); ++j) {
+  for (size_t j = 0; j < fitted.size(); ++j) {
     Extrapolation e;
     for (const EffectValue& ev : calibrated.effects)
       if (ev.effect.harmonic() && ev.effect.joint == static_cast<int>(j))
         e.effects += (e.effects.empty() ? "" : ", ") + ev.effect.label();
     if (e.effects.empty()) continue;
     e.joint = static_cast<int>(j) + 1;
-    e.fitted = calibrated.fitted_deg[j];
+    e.fitted = fitted[j];
     out.push_back(e);
   }
   return out;
 }
 
-std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const double* q_deg, size_t rows, int dof) {
+std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const std::vector<JointRange>& fitted,
+                                        const double* q_deg, size_t rows, int dof) {
   std::vector<Extrapolation> out;
-  for (Extrapolation e : periodic_joints(calibrated)) {
+  for (Extrapolation e : periodic_joints(calibrated, fitted)) {
     if (e.joint > dof) continue;
     for (size_t i = 0; i < rows; ++i)
       if (outside_range(q_deg[i * static_cast<size_t>(dof) + static_cast<size_t>(e.joint - 1)], e.fitted)) {

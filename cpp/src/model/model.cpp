@@ -60,10 +60,10 @@ void Model::take_effects(const std::string& who) {
       continue;
     }
     rest.push_back(ev);
+    if (kind.of_instrument())  // the measurement's: a Campaign carries it (campaign.hpp)
+      throw InputError(who + ev.effect.label() + " is the instrument's, not the robot's: the campaign carries it");
     if (kind.scales_lengths()) {
       thermal_alpha_ = ev.p[0];
-    } else if (kind.of_instrument()) {
-      drift_ = static_cast<int>(rest.size()) - 1;  // carried for the measurement, never applied
     } else {
       joint_effects_.push_back(ev);
       needs_dir_ = needs_dir_ || kind.reads_dir();
@@ -71,19 +71,10 @@ void Model::take_effects(const std::string& who) {
   }
   spec_.effects = rest;
   if (!std::isfinite(spec_.t_ref_c)) throw InputError(who + "the reference temperature is NaN or infinite");
-  if (!std::isfinite(spec_.t_mean_s)) throw InputError(who + "the drift's reference time is NaN or infinite");
 }
 
-// The setups, joints, tool, payload, gravity and base: finite, consistent; the joints' axes and points
+// The joints, tool, payload and gravity: finite, consistent; the joints' axes and points
 void Model::check_values(const std::string& who) {
-  for (size_t i = 0; i < spec_.setups.size(); ++i) {
-    const SetupFrame& f = spec_.setups[i];
-    if (f.name.empty()) throw InputError(who + "setup " + std::to_string(i + 1) + " has no name");
-    if (!finite(f.base_in_instrument.xyz) || !finite(f.base_in_instrument.abc))
-      throw InputError(who + "setup '" + f.name + "': a value is NaN or infinite");
-    for (size_t k = 0; k < i; ++k)
-      if (spec_.setups[k].name == f.name) throw InputError(who + "setup '" + f.name + "' is given twice");
-  }
   for (int j = 0; j < n_; ++j) {
     const JointSpec& js = spec_.joints[j];
     const std::string jn = who + "joint " + std::to_string(j + 1) + ": ";
@@ -98,14 +89,12 @@ void Model::check_values(const std::string& who) {
     k_[j] = js.compliance_deg_per_knm * kDeg / 1e6;  // deg per kN m -> rad per N mm
   }
   if (!finite(spec_.tool.xyz) || !finite(spec_.tool.abc) || !finite(spec_.gravity) || !finite(spec_.payload_com) ||
-      !std::isfinite(spec_.payload_kg) || !finite(spec_.base_in_instrument.xyz) ||
-      !finite(spec_.base_in_instrument.abc))
-    throw InputError(who + "a tool, payload, gravity or base value is NaN or infinite");
+      !std::isfinite(spec_.payload_kg))
+    throw InputError(who + "a tool, payload or gravity value is NaN or infinite");
   if (!spec_.home_deg.empty() && static_cast<int>(spec_.home_deg.size()) != n_)
     throw InputError(who + "home has " + std::to_string(spec_.home_deg.size()) + " angles for " +
                      std::to_string(n_) + " joints");
   tool_ = pose_to_iso(spec_.tool);
-  base_in_instrument_ = pose_to_iso(spec_.base_in_instrument);
   g_ = spec_.gravity;
 }
 

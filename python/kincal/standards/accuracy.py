@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import csv
 import itertools
-import json
 import math
 import re
 from typing import TYPE_CHECKING, Any, Optional, Sequence, TypeVar
@@ -165,9 +164,8 @@ def placement(model_path: str) -> tuple[FloatArray, FloatArray]:
     robot = _core.Robot.load(model_path)
     if not robot.identified:
         raise ValueError(f"{model_path}: --frame instrument needs an identified model (kincal identify)")
-    with open(model_path) as f:
-        b = json.load(f)["calibrated"]["base_in_instrument"]
-    return _core.abc_to_rotation(np.asarray(b["abc_deg"], dtype=float)), np.asarray(b["xyz_mm"], dtype=float)
+    _, xyz, abc = robot.placements[0]  # the campaign's (first) placement
+    return _core.abc_to_rotation(np.asarray(abc, dtype=float)), np.asarray(xyz, dtype=float)
 
 
 def to_base(runs: dict[str, Any], model_path: str) -> dict[str, Any]:

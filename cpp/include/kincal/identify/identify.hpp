@@ -73,7 +73,8 @@ struct IdentifyResult {
   std::vector<double> start, x, stddev;   ///< stddev NaN for fixed parameters
   std::vector<double> nominal_x;          ///< nominal geometry with the fitted base frame and targets
   double nominal_rms_mm = 0, nominal_max_mm = 0;  ///< on the fitted rows, nominal geometry
-  ModelSpec nominal_fitted;               ///< nominal geometry, fitted base frame
+  ModelSpec nominal_fitted;               ///< nominal geometry (fitted with the frames alone)
+  Campaign nominal_campaign;              ///< its fitted placements (and drift)
   std::vector<Vec3> nominal_targets;      ///< targets fitted with the nominal geometry
   std::vector<StationValue> nominal_stations;  ///< the probe stations fitted with the nominal geometry
   std::vector<bool> fixed;                ///< held at its start value
@@ -88,6 +89,7 @@ struct IdentifyResult {
   double loss_scale_mm = 0;               ///< the robust loss's scale used in the final fit (0: no robust loss)
   std::vector<std::string> fixed_reason;  ///< why it is held ("" when free)
   ModelSpec calibrated;
+  Campaign campaign;                      ///< the calibrated model's campaign: placements, drift, fitted ranges
   std::vector<Vec3> targets;
   std::vector<StationValue> stations;     ///< the probe stations (the campaign's, not the robot's)
   std::vector<EffectValue> effects;       ///< identified values of the extra effects
@@ -122,7 +124,10 @@ struct IdentifyResult {
 
 /// Identify the parameters from measurements (rows of the set). Throws InputError when the data
 /// are too few for the free parameters.
-IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt);
+/// `reference`: the placements the fitted ones are relative to (a calibrated robot's campaign when
+/// refitting it; the identity by default).
+IdentifyResult identify(const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
+                        const Campaign& reference = Campaign{});
 
 /// InputError unless the effects are valid for the robot and the data carry the columns they read
 /// (the registry's needs: temperature_c, time_s, dir1..dirN), naming the file and line of the first

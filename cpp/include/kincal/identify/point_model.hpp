@@ -136,8 +136,10 @@ class PointModel {
  public:
   /// nominal: must outlive the model and its states. data: the payloads named in its rows' payload_kg
   /// column get their model variants (a row with another payload is refused), its planes their
-  /// reference normals (without it: the z axis).
-  PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data = nullptr);
+  /// reference normals (without it: the z axis). reference: the placements every setup's correction
+  /// is relative to (the setup of that name, or its base_in_instrument; the identity by default).
+  PointModel(const Model& nominal, const LayoutOptions& options, const MeasurementSet* data = nullptr,
+             const Campaign& reference = Campaign{});
   const ParamLayout& layout() const;
   /// The model at parameters x (size layout().size).
   PointState at(const std::vector<double>& x) const;
@@ -166,8 +168,10 @@ class PointState {
  public:
   const ParamLayout& layout() const;
   const std::vector<double>& x() const;
-  /// The geometry at these parameters as a model spec (base_in_instrument, setups and tool included).
+  /// The geometry at these parameters as a model spec (tool included).
   const ModelSpec& spec() const;
+  /// The instrument's placements at these parameters (base_in_instrument, one per named setup).
+  const Campaign& campaign() const;
   /// The same model (frames-only mode and its cached flange frames included) at parameters x.
   PointState with_params(const std::vector<double>& x) const;
   /// Predicted point (instrument frame) of measurement m; jac (3 x size, row-major) when not null.

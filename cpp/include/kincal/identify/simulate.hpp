@@ -62,36 +62,40 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
 constexpr double kDefaultDriftDuration_s = 3 * 3600.0;
 
 /// The base frame seen from the instrument for each setup of a measurement set (by code): the
-/// model's setup of the same name, or its base_in_instrument when the model has no setups (then the
-/// set may have at most one). InputError naming the setup the model does not know.
-std::vector<Eigen::Isometry3d> setup_frames(const Model& model, const MeasurementSet& data);
-/// A placement at the time a row was measured: frame moved by the model's drift (effects.hpp's
-/// definition: rotation Exp(tau w) R, translation t + tau v, tau in hours from the model's
-/// t_mean_s); the frame itself
-/// without a drift. InputError when the model drifts and the time is unknown (NaN).
-Eigen::Isometry3d drifted(const Model& model, const Eigen::Isometry3d& frame, double time_s);
+/// campaign's setup of the same name, or its base_in_instrument when it has no setups (then the
+/// set may have at most one). InputError naming the setup the campaign does not know.
+std::vector<Eigen::Isometry3d> setup_frames(const Campaign& campaign, const MeasurementSet& data);
+/// A placement at the time a row was measured: frame moved by the campaign's drift (effects.hpp's
+/// definition: rotation Exp(tau w) R, translation t + tau v, tau in hours from its t_mean_s); the
+/// frame itself without a drift. InputError when the instrument drifts and the time is unknown (NaN).
+Eigen::Isometry3d drifted(const Campaign& campaign, const Eigen::Isometry3d& frame, double time_s);
 
 /// The point of target t (tool frame) in the instrument frame for the row's commanded joint angles
-/// on a model, every effect it carries acting (the row's dir and temperature), without noise.
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target);
-/// The same seen from the placement `base` (a setup's frame), the model's drift acting.
-Vec3 simulate_point(const Model& truth, const Measurement& row, const Vec3& target, const Eigen::Isometry3d& base);
-/// A campaign on the truth: its own effects and opt.effects (hidden) act.
-MeasurementSet simulate(const Model& truth, const SimulationOptions& opt);
-/// The truth's spec with the hidden effects of opt added (t_ref from opt when the truth has none).
+/// on a model, every effect it carries acting (the row's dir and temperature), seen from the
+/// campaign's placement, without noise.
+Vec3 simulate_point(const Model& truth, const Campaign& campaign, const Measurement& row, const Vec3& target);
+/// The same seen from the placement `base` (a setup's frame), the campaign's drift acting.
+Vec3 simulate_point(const Model& truth, const Campaign& campaign, const Measurement& row, const Vec3& target,
+                    const Eigen::Isometry3d& base);
+/// A campaign on the truth seen from `campaign`'s placement (by default the base frame itself): its
+/// own effects and opt.effects (hidden; a hidden drift drifts the instrument) act.
+MeasurementSet simulate(const Model& truth, const SimulationOptions& opt, const Campaign& campaign = Campaign{});
+/// The truth's spec with the hidden robot effects of opt added (t_ref from opt when the truth has
+/// none); a drift among them is left to the campaign.
 ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref);
 
 /// Position errors (mm) of every row of data predicted by a model (every effect it carries acting,
 /// each row seen from its setup's placement, the model's drift at the row's time) with the given
 /// targets.
-std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data);
+std::vector<double> point_errors(const Model& model, const Campaign& campaign, const std::vector<Vec3>& targets,
+                                 const MeasurementSet& data);
 /// The same with probe rows: their error along the constraint against their station among `stations`
 /// (stations.hpp; NaN for a station not among them).
-std::vector<double> point_errors(const Model& model, const std::vector<Vec3>& targets, const MeasurementSet& data,
-                                 const std::vector<StationValue>& stations);
+std::vector<double> point_errors(const Model& model, const Campaign& campaign, const std::vector<Vec3>& targets,
+                                 const MeasurementSet& data, const std::vector<StationValue>& stations);
 /// Orientation errors (deg) of every 6-D row of a set, in order (rows without a measured orientation
 /// are left out): the angle between the measured tool frame and the model's (every effect acting,
 /// seen from the row's placement at its time).
-std::vector<double> orientation_errors(const Model& model, const MeasurementSet& data);
+std::vector<double> orientation_errors(const Model& model, const Campaign& campaign, const MeasurementSet& data);
 
 }  // namespace kincal

@@ -1,5 +1,7 @@
-// kincal: the model JSON file (contract: "format": "kincal-model", "version" 1 or 2; written as
-// version 2) of a Robot or a ModelSpec, and load_robot (a built-in name or a model JSON path).
+// kincal: the model JSON file (contract: "format": "kincal-model", "version" 1 to 3; written as
+// version 3: the robot's sections "nominal" and "calibrated", the campaign's in "campaign"; versions 1
+// and 2 carry the campaign inside the model's section) of a Robot, and load_robot (a built-in name
+// or a model JSON path).
 #pragma once
 
 #include "kincal/model/model.hpp"

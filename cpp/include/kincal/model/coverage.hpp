@@ -43,13 +43,14 @@ struct Extrapolation {
   size_t first = 0;         ///< the first of them (0-based)
 };
 
-/// The joints of a calibrated model's periodic effects with a fitted range (rows 0), in joint order;
-/// none when the model carries no fitted ranges.
-std::vector<Extrapolation> periodic_joints(const ModelSpec& calibrated);
+/// The joints of a calibrated model's periodic effects with a fitted range (its campaign's `fitted`,
+/// one per joint; rows 0), in joint order; none without fitted ranges.
+std::vector<Extrapolation> periodic_joints(const ModelSpec& calibrated, const std::vector<JointRange>& fitted);
 
 /// The joints of a calibrated model's periodic effects that rows of joint angles (deg, row-major)
-/// leave, in joint order; none when the model carries no fitted ranges.
-std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const double* q_deg, size_t rows, int dof);
+/// leave, in joint order; none without fitted ranges.
+std::vector<Extrapolation> extrapolated(const ModelSpec& calibrated, const std::vector<JointRange>& fitted,
+                                        const double* q_deg, size_t rows, int dof);
 
 /// "joint 1 is outside the -180..-45 deg its joint_map(joint 1) was fitted on (angles modulo 360 deg)"
 std::string leaving_message(const Extrapolation& e);

@@ -22,6 +22,7 @@
 
 #include "kincal/core/types.hpp"
 #include "kincal/effects/effects.hpp"
+#include "kincal/model/campaign.hpp"
 
 namespace KDL {
 class Chain;
@@ -40,16 +41,6 @@ struct JointSpec {
   double compliance_deg_per_knm = 0;  ///< joint deflection per gravity torque (deg per kN m)
 };
 
-/// One instrument placement of a campaign measured from several (the `setup` column): its name
-/// and the robot base frame seen from the instrument there.
-struct SetupFrame {
-  std::string name;
-  Pose6 base_in_instrument;
-};
-
-/// A joint's fitted range of angles (deg): [lo, hi], lo in [-180, 180), hi - lo its arc (coverage.hpp)
-using JointRange = std::array<double, 2>;
-
 /// Everything that defines one robot geometry; plain data, checked when a Model is built from it.
 struct ModelSpec {
   std::string name = "robot";
@@ -58,24 +49,15 @@ struct ModelSpec {
   double payload_kg = 0;
   Vec3 payload_com = Vec3::Zero(); ///< payload centre of mass in the tool frame (mm)
   Vec3 gravity = Vec3(0, 0, -9.81);///< gravity in the base frame (m/s^2)
-  Pose6 base_in_instrument;        ///< robot base frame seen from the measuring instrument
   std::vector<double> home_deg;    ///< preferred configuration for the first pose of a program
   /// non-geometric effects besides the joints' compliance (effects.hpp): transmission error,
   /// backlash, thermal expansion, with their values in core units (a joint_compliance entry sets the
-  /// joint's compliance_deg_per_knm)
+  /// joint's compliance_deg_per_knm); the instrument's drift is the campaign's (campaign.hpp)
   std::vector<EffectValue> effects;
   double t_ref_c = 20.0;           ///< reference temperature of thermal_expansion (deg C)
-  /// The measurement's side, carried for predicting measured points and never applied by FK or
-  /// compensation: every instrument placement of a campaign with several (by name; empty for one:
-  /// base_in_instrument, which is also the first's), and the time drift's centre (the drift effect).
-  std::vector<SetupFrame> setups;
-  double t_mean_s = 0;             ///< the drift's reference time (s, the campaign's mean time)
   /// How the controller numbers the joints (kincal/model/joint_convention.hpp): "" its own angles are
   /// the model's; "fanuc": the controller's J3 is the forearm's angle to the horizontal
   std::string joint_convention;
-  /// Per joint, the angles the identification saw (coverage.hpp); empty when unknown (a nominal model,
-  /// a model written before they were recorded)
-  std::vector<JointRange> fitted_deg;
   /// Where the tool frame (TCP) comes from, as the identification knows it: "measured" (6-D rows
   /// measured the tool frame itself), "tool-targets" (placed from known target offsets), "nominal"
   /// (reflectors only: the tool frame stayed at its start value, its error in every pose); "" when
@@ -104,13 +86,9 @@ class Model {
   bool needs_dir() const { return needs_dir_; }                  ///< backlash: dir1..dirN needed
   bool needs_temperature() const { return thermal_alpha_ != 0; }  ///< thermal expansion: T needed
   double thermal_alpha() const { return thermal_alpha_; }         ///< 1/degC (0: none)
-  /// The instrument's drift (a property of the measurement, never applied by FK or compensation):
-  /// translation mm/h and rotation rad/h (instrument frame), null without one.
-  const EffectValue* drift() const { return drift_ < 0 ? nullptr : &spec_.effects[static_cast<size_t>(drift_)]; }
   const Vec3& axis(int j) const { return w_[j]; }
   const Vec3& point(int j) const { return p_[j]; }
   const Eigen::Isometry3d& tool() const { return tool_; }
-  const Eigen::Isometry3d& base_in_instrument() const { return base_in_instrument_; }
   bool within_limits_deg(const VecQ& q_deg, double tol_deg = 1e-9) const;
 
   // --- compiled evaluator data (read by kinematics.cpp) ---
@@ -149,10 +127,9 @@ class Model {
   std::vector<EffectValue> joint_effects_;
   bool needs_dir_ = false;
   double thermal_alpha_ = 0;
-  int drift_ = -1;  ///< index of the drift in spec_.effects
   std::array<Vec3, kMaxJoints> w_, p_;
   std::array<double, kMaxJoints> k_{};
-  Eigen::Isometry3d tool_, base_in_instrument_;
+  Eigen::Isometry3d tool_;
   Mat3 c0_r_;
   Vec3 c0_t_;
   // the compiled chain on cache-line boundaries: FK, Jacobians and compensation walk it every call
@@ -166,18 +143,21 @@ using ModelPtr = std::shared_ptr<const Model>;
 
 class IkSolver;  // kincal/ik/ik.hpp
 
-/// A robot as users name it: the nominal geometry (for the closed-form IK start) and the
-/// calibrated one (for FK and compensation). For a nominal robot both are the same object. The
-/// nominal model's IK solver is built once with the Robot (src/model/robot.cpp), so that programs
-/// do not rebuild it per pose; set the models through the constructor only.
+/// A robot as users name it: the nominal geometry (for the closed-form IK start), the calibrated one
+/// (for FK and compensation) and the campaign that calibrated it (campaign.hpp: the instrument's
+/// placements and drift, the fitted joint ranges; empty for a nominal robot unless its file gives a
+/// placement). For a nominal robot both models are the same object. The nominal model's IK solver is
+/// built once with the Robot (src/model/robot.cpp), so that programs do not rebuild it per pose.
 class Robot {
  public:
   Robot() = default;  ///< no models (to be assigned a whole Robot)
-  Robot(ModelPtr nominal_model, ModelPtr calibrated_model);
-  /// The models are fixed at construction (a new Robot for new models): the IK below always follows
+  /// InputError when the campaign does not fit the models (campaign.hpp's check)
+  Robot(ModelPtr nominal_model, ModelPtr calibrated_model, Campaign campaign = {});
+  /// Everything is fixed at construction (a new Robot for new models): the IK below always follows
   /// the nominal model it was built from
   const ModelPtr& nominal() const { return nominal_; }
   const ModelPtr& calibrated() const { return calibrated_; }
+  const Campaign& campaign() const { return *campaign_; }
   bool identified() const { return nominal_ != calibrated_; }
   /// the nominal model's closed-form IK (ik/ik.hpp); only on a Robot built with its models
   const IkSolver& ik() const { return *ik_; }
@@ -185,6 +165,7 @@ class Robot {
  private:
   ModelPtr nominal_;
   ModelPtr calibrated_;
+  std::shared_ptr<const Campaign> campaign_ = std::make_shared<const Campaign>();
   std::shared_ptr<const IkSolver> ik_;
 };
 

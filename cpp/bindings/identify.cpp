@@ -190,7 +190,7 @@ void define_identify_functions(py::module_& m) {
       },
       py::arg("robot"), py::arg("targets"), py::arg("data"), py::arg("stations") = std::vector<StationValue>{},
       "Distance (mm) between every measured point and the calibrated model's prediction (its effects acting,\n"
-      "each row seen from its setup's placement, the model's drift at the row's time); a probe row's error\n"
+      "each row seen from its setup's placement, the campaign's drift at the row's time); a probe row's error\n"
       "along its constraint against its station among `stations` (NaN when not among them)");
   m.def(
       "check_effect_columns",

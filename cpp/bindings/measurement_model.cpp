@@ -104,9 +104,9 @@ void define_point_model(py::module_& m) {
            py::arg("robot"), py::arg("n_targets"), py::arg("effects") = std::vector<Effect>{},
            py::arg("t_ref") = 20.0, py::arg("from_calibrated") = false, py::arg("setups") = py::none(),
            py::arg("t_mean_s") = py::none(), py::arg("fit_gravity") = false, py::arg("stations_of") = nullptr,
-           "setups: the data's setup names (default: the model's setups); stations_of: a layout whose probe\n"
+           "setups: the data's setup names (default: the campaign's setups); stations_of: a layout whose probe\n"
            "stations (names, kinds, reference normals) this one has too; t_mean_s: the drift's reference\n"
-           "time (default: the model's); fit_gravity: the compliances' torques from fitted mass moments\n"
+           "time (default: the campaign's); fit_gravity: the compliances' torques from fitted mass moments\n"
            "(parameters of kind 'gravity_moment', 2 per link) instead of the model's masses")
       .def_property_readonly("layout", [](const PyPointModel& p) -> const ParamLayout& { return p.pm.layout(); },
                              py::return_value_policy::reference_internal)

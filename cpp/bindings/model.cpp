@@ -15,8 +15,8 @@ using namespace kincal;
 
 namespace {
 
-// What a robot's calibrated model carries besides its geometry (placements, tool frame, the angles
-// its fit saw, effects' data needs), and the robots made from one with those changed.
+// What a robot's calibrated model and its campaign carry besides the geometry (placements, tool
+// frame, the angles its fit saw, effects' data needs), and the robots made from one with those changed.
 void define_robot_calibration(py::class_<Robot>& robot) {
   robot.def_property_readonly("t_ref_c", [](const Robot& r) { return r.calibrated()->spec().t_ref_c; })
       .def_property_readonly(
@@ -58,7 +58,9 @@ void define_robot_calibration(py::class_<Robot>& robot) {
             c.setups.clear();
             if (setups.size() > 1)
               for (const auto& [name, xyz, abc] : setups) c.setups.push_back(SetupFrame{name, Pose6{xyz, abc}});
-            return Robot{r.nominal(), r.calibrated(), c};
+            // a nominal robot seen from placements becomes a calibrated one (as it always did): its
+            // nominal model keeps the identity placement
+            return Robot{r.nominal(), r.identified() ? r.calibrated() : std::make_shared<Model>(r.calibrated()->spec()), c};
           },
           py::arg("setups"),
           "The robot with its campaign seen from these placements: (name, xyz_mm, abc_deg) per setup, the\n"
@@ -92,7 +94,9 @@ void define_robot_calibration(py::class_<Robot>& robot) {
             Campaign c = r.campaign();
             for (const auto& [e, p] : effects) {
               ev.push_back(EffectValue{e, p});
-              if (e.kind().of_instrument()) c.drift = ev.back();  // the campaign's instrument drifts
+              if (!e.kind().of_instrument()) continue;  // the campaign's instrument drifts
+              if (c.drift) throw InputError("with_effects: the instrument's drift is given twice");
+              c.drift = ev.back();
             }
             return Robot{r.nominal(), std::make_shared<Model>(with_effects(r.calibrated()->spec(), ev, t_ref)), c};
           },
@@ -104,7 +108,7 @@ void define_robot_calibration(py::class_<Robot>& robot) {
           [](const Robot& r, unsigned seed, double sigma_mm, double sigma_deg, double compliance,
              std::optional<std::array<double, 6>> instrument) {
             ModelSpec s = perturbed_spec(r.nominal()->spec(), seed, sigma_mm, sigma_deg, compliance);
-            Campaign c;
+            Campaign c = campaign_of(r, false);  // the nominal model's placement, unless given
             if (instrument) {
               const auto& v = *instrument;
               c.base_in_instrument.xyz = Vec3(v[0], v[1], v[2]);
@@ -180,9 +184,11 @@ void define_model(py::module_& m) {
           [](const Robot& r) {
             py::list l;
             for (const auto& ev : r.calibrated()->spec().effects) l.append(py::make_tuple(ev.effect, ev.p));
+            if (r.campaign().drift) l.append(py::make_tuple(r.campaign().drift->effect, r.campaign().drift->p));
             return l;
           },
-          "the calibrated model's effects besides compliance: (Effect, values in core units)");
+          "the calibrated model's effects besides compliance, then its campaign's drift: (Effect, values in\n"
+          "core units)");
   define_robot_calibration(robot);
   m.def("builtin_names", &builtin_names);
 

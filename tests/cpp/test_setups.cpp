@@ -271,8 +271,10 @@ TEST(Setups, ModelFilesOfVersions3And2ReadTheSame) {
     ASSERT_EQ(rs.effects.size(), 1u);  // the robot's own effect; the drift is the campaign's
     EXPECT_EQ(rs.effects[0].effect.name, "transmission_error");
     for (int j = 0; j < 6; ++j) {
-      EXPECT_EQ(rs.joints[j].point, a.calibrated()->spec().joints[j].point);
+      EXPECT_EQ(rs.joints[j].point, cs.joints[j].point);
+      EXPECT_EQ(rs.joints[j].axis, cs.joints[j].axis);
       EXPECT_EQ(rs.joints[j].compliance_deg_per_knm, cs.joints[j].compliance_deg_per_knm);
+      EXPECT_EQ(r->nominal()->spec().joints[j].point, kr500_spec().joints[j].point);
     }
   }
   // the same file written again from either: version 3, byte for byte
@@ -356,4 +358,35 @@ TEST(Setups, TwoSetupsIdentifiedJointly) {
   const MeasurementSet held = two_setups(held_a, simulate(truth, so, campaign_b));
   const double floor = 0.02 * std::sqrt(3.0);
   EXPECT_LT(rms(point_errors(cal, r.campaign, r.targets, held)), 1.2 * floor);
+}
+
+TEST(Setups, ACampaignIsCheckedWhereItEntersARobotOrASimulation) {
+  // every value a campaign carries is checked when a Robot is built with it (and a hidden drift when
+  // a simulation adds it): one InputError naming the cause
+  auto m = std::make_shared<Model>(kr500_spec());
+  auto refused = [&](const Campaign& c) { return test::error_of([&] { Robot r(m, m, c); }); };
+  Campaign twice;
+  twice.setups = {{"A", Pose6{}}, {"A", second_placement()}};
+  EXPECT_NE(refused(twice).find("setup 'A' is given twice"), std::string::npos);
+  Campaign nan_base;
+  nan_base.base_in_instrument.xyz[1] = std::nan("");
+  EXPECT_NE(refused(nan_base).find("NaN or infinite"), std::string::npos);
+  Campaign short_drift;
+  short_drift.drift = EffectValue{Effect{"drift", -1, {}}, {0.1, 0.2}};
+  EXPECT_NE(refused(short_drift).find("2 values for 6 parameters"), std::string::npos);
+  Campaign not_a_drift;
+  not_a_drift.drift = EffectValue{Effect{"backlash", 1, {}}, {0.001}};
+  EXPECT_NE(refused(not_a_drift).find("not the instrument's drift"), std::string::npos);
+  Campaign ranges;
+  ranges.fitted_deg.assign(5, JointRange{-10.0, 10.0});
+  EXPECT_NE(refused(ranges).find("5 ranges for 6 joints"), std::string::npos);
+  Campaign drifting;
+  drifting.drift = EffectValue{Effect{"drift", -1, {}}, tracker_drift()};
+  SimulationOptions so;
+  so.poses = 3;
+  so.duration_s = 600;
+  so.effects = {{Effect{"drift", -1, {}}, tracker_drift()}};
+  EXPECT_NE(test::error_of([&] { simulate(*m, so, drifting); }).find("drift is given twice"), std::string::npos);
+  so.effects = {{Effect{"drift", -1, {}}, {0.1}}};
+  EXPECT_NE(test::error_of([&] { simulate(*m, so); }).find("1 values for 6 parameters"), std::string::npos);
 }

@@ -484,6 +484,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   res.converged = s2.converged();
   res.stop_reason = s2.stop_reason();
   store_solution(pm, nominal, data, x, res);
+  // the joint ranges the starting campaign recorded stay with the refitted one (its caller records new ones)
+  res.campaign.fitted_deg = res.nominal_campaign.fitted_deg = reference.fitted_deg;
   observability(pm, data, opt, res);
   if (s2.free() == free_idx) covariance(s2.problem(), s2.rows(), s2.summary, free_idx, opt, res);
   else res.stddev.assign(res.layout.size, std::nan(""));

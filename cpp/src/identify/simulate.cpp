@@ -79,10 +79,9 @@ ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& e
   ModelSpec s = truth;
   bool thermal = false;
   for (const auto& e : s.effects) thermal = thermal || e.effect.kind().scales_lengths();
-  bool added = false;
   for (const auto& e : effects)
-    if (!e.effect.kind().of_instrument()) s.effects.push_back(e), added = true;  // a drift: the campaign's
-  if (added && !thermal) s.t_ref_c = t_ref;
+    if (!e.effect.kind().of_instrument()) s.effects.push_back(e);  // a drift: the campaign's
+  if (!effects.empty() && !thermal) s.t_ref_c = t_ref;
   return s;
 }
 
@@ -98,9 +97,11 @@ MeasurementSet simulate(const Model& truth_in, const SimulationOptions& opt, con
   Campaign campaign = campaign_in;  // a hidden drift: the truth's instrument drifts
   for (const auto& e : opt.effects)
     if (e.effect.kind().of_instrument()) {
-      if (!campaign.drift) campaign.t_mean_s = 0.5 * duration;
+      if (campaign.drift) throw InputError("simulate: the instrument's drift is given twice");
+      campaign.t_mean_s = 0.5 * duration;
       campaign.drift = e;
     }
+  campaign.check(truth.dof(), "simulate: ");
   if (campaign.drift && duration <= 0)
     throw InputError("simulate: the truth drifts: the campaign needs a duration (time_s)");
   if (opt.targets.empty()) throw InputError("simulate: at least one target");

@@ -202,10 +202,12 @@ struct Reader {
     if (legacy) {
       std::vector<EffectValue> robot;
       for (EffectValue& ev : legacy->effects)
-        if (ev.effect.kind().of_instrument())
-          c.drift = ev;
-        else
+        if (!ev.effect.kind().of_instrument())
           robot.push_back(ev);
+        else if (c.drift)
+          fail(where + ".effects", "the instrument's drift is given twice");
+        else
+          c.drift = ev;
       legacy->effects = robot;
     } else if (o.contains("drift")) {
       c.drift = effect(o["drift"], where + ".drift");

@@ -85,7 +85,7 @@ MeasurementSet simulate(const Model& truth, const SimulationOptions& opt, const 
 ModelSpec with_effects(const ModelSpec& truth, const std::vector<EffectValue>& effects, double t_ref);
 
 /// Position errors (mm) of every row of data predicted by a model (every effect it carries acting,
-/// each row seen from its setup's placement, the model's drift at the row's time) with the given
+/// each row seen from its setup's placement, the campaign's drift at the row's time) with the given
 /// targets.
 std::vector<double> point_errors(const Model& model, const Campaign& campaign, const std::vector<Vec3>& targets,
                                  const MeasurementSet& data);

@@ -82,8 +82,12 @@ void define_robot_calibration(py::class_<Robot>& robot) {
             c.fitted_deg = ranges;
             return Robot{r.nominal(), r.calibrated(), c};
           },
-          py::arg("ranges"), "The robot whose campaign records the angles its fit saw (joint_ranges())")
-      .def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated()->needs_dir(); },
+          py::arg("ranges"), "The robot whose campaign records the angles its fit saw (joint_ranges())");
+}
+
+// What the calibrated model's effects need, and the robots made with effects or errors added.
+void define_robot_effects(py::class_<Robot>& robot) {
+  robot.def_property_readonly("needs_dir", [](const Robot& r) { return r.calibrated()->needs_dir(); },
                              "backlash: the direction of motion into each pose is needed")
       .def_property_readonly("needs_temperature", [](const Robot& r) { return r.calibrated()->needs_temperature(); },
                              "thermal expansion: the temperature is needed")
@@ -190,6 +194,7 @@ void define_model(py::module_& m) {
           "the calibrated model's effects besides compliance, then its campaign's drift: (Effect, values in\n"
           "core units)");
   define_robot_calibration(robot);
+  define_robot_effects(robot);
   m.def("builtin_names", &builtin_names);
 
   py::class_<Extrapolation>(m, "Extrapolation",

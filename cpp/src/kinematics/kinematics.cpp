@@ -145,25 +145,29 @@ void gravity_torque(const Model& m, const VecQ& q, VecQ& tau, MatQ* dtau) {
     return;
   }
   const int n = m.dof();
-  std::array<Vec3, kMaxJoints> z, o;
-  std::array<Vec3, kMaxJoints + 1> S;  // link k's first moment about the base origin, then carried sums
-  std::array<double, kMaxJoints + 1> M;
+  std::array<Vec3, kMaxJoints> z, o, mc;
+  std::array<double, kMaxJoints> mass;
   Mat3 r;
   Vec3 t;
   walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
     z[j] = rj.col(2);
     o[j] = tj;
     const Model::Link& l = m.link(j);
-    M[j] = l.m;
-    S[j] = rj * l.mc + l.m * tj;
+    mass[j] = l.m;
+    mc[j] = rj * l.mc + l.m * tj;  // first moment about the base origin
   });
-  S[n].setZero();  // the payload is in the last link's mass table
-  M[n] = 0;
-  detail::carried_loads(n, S, M);
+  // what joint j carries, summed from the tip in the same pass as its torque (the payload is in the
+  // last link's mass table)
   const Vec3& g = m.gravity();
   tau.resize(n);
   std::array<Vec3, kMaxJoints> arm;
-  for (int j = 0; j < n; ++j) tau[j] = detail::weight_torque(z[j], o[j], S[j], M[j], g, arm[j]);
+  Vec3 s = Vec3::Zero();
+  double msum = 0;
+  for (int j = n - 1; j >= 0; --j) {
+    s += mc[j];
+    msum += mass[j];
+    tau[j] = detail::weight_torque(z[j], o[j], s, msum, g, arm[j]);
+  }
   if (dtau) {
     // i <= j: the whole sub-chain rotates about z_i, d tau_j / d q_i = g . (z_i x (z_j x arm_j));
     // i > j: only the part beyond joint i moves, g . (z_j x (z_i x arm_i)). Both are u_k . h_l with

@@ -114,8 +114,8 @@ def figaroh_inputs(case_robot: str, kincal_csv: Path, out_csv: Path, out_urdf: P
     out_urdf.write_text(spec_urdf(spec, case_robot))
     joints = [j["name"] for j in spec["joints"]]
     data = ident.read_measurements(str(kincal_csv), robot, None)
-    q = _core.joints_from_controller(robot, data["q_deg"])  # the model's angles (the file: the controller's)
-    pose, target, xyz = data["pose"], data["target"], data["xyz"]
+    q = _core.joints_from_controller(robot, data.q_deg)  # the model's angles (the file: the controller's)
+    pose, target, xyz = data.pose, data.target, data.xyz
     markers = int(target.max()) + 1
     rows = []
     for p in np.unique(pose):

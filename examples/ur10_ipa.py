@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import kincal
+from kincal import _core
 from kincal.io import datasets
 from kincal import diagnose
 from kincal.calibration import setups
@@ -32,18 +33,18 @@ SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joi
           "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
 
 
-def with_setups(series: dict) -> dict:
+def with_setups(series: dict) -> _core.MeasurementSet:
     """The series as one campaign: a setup (tracker placement) per series, pose ids running on."""
     names = list(series)
     parts = []
     for k, name in enumerate(names):
-        d = dict(series[name])
-        d["setup"] = np.full(len(d["pose"]), k, dtype=np.int64)
-        d["pose"] = d["pose"] + sum(len(series[n]["pose"]) for n in names[:k])
+        d = series[name].columns()  # writable copies of its columns
+        d["setup"] = np.full(len(series[name]), k, dtype=np.int64)
+        d["pose"] = d["pose"] + sum(len(series[n]) for n in names[:k])
         parts.append(d)
     out = {key: np.concatenate([p[key] for p in parts]) for key, v in parts[0].items() if isinstance(v, np.ndarray)}
     out.update(source="UR10 series " + "".join(names), setup_names=names)
-    return out
+    return _core.MeasurementSet(out)
 
 
 def main() -> None:

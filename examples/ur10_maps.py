@@ -35,13 +35,12 @@ SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joi
 REACH = 2000.0  # mm: the reference points that recover each predicted point from its distances
 
 
-def predicted(model, targets, data: dict) -> np.ndarray:
+def predicted(model, targets, data: _core.MeasurementSet) -> np.ndarray:
     """The model's predicted points (instrument frame, n x 3), every effect acting: recovered from
     point_errors against four reference points (the origin and REACH along each axis)."""
-    d = dict(data)
     sq = []
     for off in (np.zeros(3), np.array([REACH, 0, 0]), np.array([0, REACH, 0]), np.array([0, 0, REACH])):
-        d["xyz"] = np.zeros_like(data["xyz"]) + off
+        d = data.with_columns(xyz=np.zeros_like(data.xyz) + off)
         sq.append(np.asarray(_core.point_errors(model, targets, d)) ** 2)
     return np.column_stack([(sq[0] - sq[k] + REACH ** 2) / (2 * REACH) for k in (1, 2, 3)])
 
@@ -85,8 +84,8 @@ def second_differences(knots: int) -> np.ndarray:
     return d.T @ d
 
 
-def with_q(data: dict, q: np.ndarray) -> dict:
-    return dict(data, q_deg=q)
+def with_q(data: _core.MeasurementSet, q: np.ndarray) -> _core.MeasurementSet:
+    return data.with_columns(q_deg=q)
 
 
 class Maps:
@@ -100,19 +99,19 @@ class Maps:
         self.loaded = [1, 2] if torque_knots else []
         self.ranges = ranges or {}
 
-    def torques(self, data: dict) -> np.ndarray:
-        return gravity_torques(self.robot, data["q_deg"]) / 1000.0  # kN m
+    def torques(self, data: _core.MeasurementSet) -> np.ndarray:
+        return gravity_torques(self.robot, data.q_deg) / 1000.0  # kN m
 
-    def fix_ranges(self, data: dict) -> None:
+    def fix_ranges(self, data: _core.MeasurementSet) -> None:
         tau = self.torques(data)
         self.ranges = {j: (float(tau[:, j].min()), float(tau[:, j].max())) for j in self.loaded}
 
-    def blocks(self, data: dict) -> list:
+    def blocks(self, data: _core.MeasurementSet) -> list:
         """Per joint, the basis (n x m_j) of its angle error."""
         tau = self.torques(data) if self.loaded else None
         out = []
-        for j in range(data["q_deg"].shape[1]):
-            b = basis(data["q_deg"][:, j], self.knots)
+        for j in range(data.q_deg.shape[1]):
+            b = basis(data.q_deg[:, j], self.knots)
             if j in self.loaded:
                 b = np.hstack([b, torque_basis(tau[:, j], *self.ranges[j], self.torque_knots)])
             out.append(b)
@@ -134,23 +133,23 @@ class Maps:
             k += len(m)
         return out
 
-    def corrected(self, data: dict, coef: np.ndarray) -> dict:
-        q, k = data["q_deg"].copy(), 0
+    def corrected(self, data: _core.MeasurementSet, coef: np.ndarray) -> _core.MeasurementSet:
+        q, k = data.q_deg.copy(), 0
         for j, b in enumerate(self.blocks(data)):
             q[:, j] += b @ coef[k:k + b.shape[1]]
             k += b.shape[1]
         return with_q(data, q)
 
-    def design(self, model, targets, data: dict) -> tuple:
+    def design(self, model, targets, data: _core.MeasurementSet) -> tuple:
         """The residual (3 per point) and the maps' columns (the points' derivatives, mm per deg)."""
         p0 = predicted(model, targets, data)
         cols = []
         for j, b in enumerate(self.blocks(data)):
-            q = data["q_deg"].copy()
+            q = data.q_deg.copy()
             q[:, j] += 1e-3
             jac = (predicted(model, targets, with_q(data, q)) - p0) / 1e-3
             cols.append((jac[:, :, None] * b[:, None, :]).reshape(-1, b.shape[1]))
-        return (data["xyz"] - p0).reshape(-1), np.hstack(cols)
+        return (data.xyz - p0).reshape(-1), np.hstack(cols)
 
 
 def cv_rms(a: np.ndarray, y: np.ndarray, pen: np.ndarray, masks: list) -> float:
@@ -182,9 +181,9 @@ def main() -> None:
     print(f"series {args.fit}, geometry + compliance: RMS {start.fit.rms_mm:.4f} mm (fitted)")
     folds = grouping.folds(fit_data, 5, 0)
     blocked = []
-    for j in range(fit_data["q_deg"].shape[1]):
-        edges = np.quantile(fit_data["q_deg"][:, j], np.linspace(0, 1, 6))
-        blocked += [(fit_data["q_deg"][:, j] >= edges[b]) & (fit_data["q_deg"][:, j] <= edges[b + 1]) for b in range(5)]
+    for j in range(fit_data.q_deg.shape[1]):
+        edges = np.quantile(fit_data.q_deg[:, j], np.linspace(0, 1, 6))
+        blocked += [(fit_data.q_deg[:, j] >= edges[b]) & (fit_data.q_deg[:, j] <= edges[b + 1]) for b in range(5)]
     scores = {}
     given = None
     if args.penalty:
@@ -210,7 +209,7 @@ def main() -> None:
         coef = coef + np.linalg.solve(a.T @ a + pen, a.T @ y)
     model = ident.identify(robot, maps.corrected(fit_data, coef), effects="joint_compliance", k_folds=0)
     print(f"series {args.fit} with the maps: RMS {model.fit.rms_mm:.4f} mm (fitted)")
-    shift = np.stack([maps.corrected(s_, coef)["q_deg"] - s_["q_deg"] for s_ in (fit_data,)])[0]
+    shift = np.stack([maps.corrected(s_, coef).q_deg - s_.q_deg for s_ in (fit_data,)])[0]
     for j in range(robot.dof):
         print(f"  joint {j + 1} correction on {args.fit}: {shift[:, j].min():+.4f} .. {shift[:, j].max():+.4f} deg")
     for k in sorted(SERIES):

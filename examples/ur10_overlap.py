@@ -52,17 +52,17 @@ def main() -> None:
     for a in SERIES:
         for b in SERIES:
             if a != b:
-                d = nearest_deg(series[b]["q_deg"], series[a]["q_deg"])
+                d = nearest_deg(series[b].q_deg, series[a].q_deg)
                 print(f"  {a} to {b}: {np.percentile(d, 10):6.1f} {np.median(d):6.1f} {np.percentile(d, 90):6.1f}"
                       f"   rows within 5 deg: {np.mean(d < 5.0):.1%}")
     robot = kincal.load_robot("ur10")
     a = series["A"]
     fit = ident.identify(robot, a, effects="joint_compliance", k_folds=0)
     _, _, _, _, cal = _refit_placements(fit.robot, a, "huber", 0.1)
-    r = a["xyz"] - predicted(cal.robot, cal.targets, a)
+    r = a.xyz - predicted(cal.robot, cal.targets, a)
     folds = grouping.folds(a, 5, 0)
     print(f"series A by itself, geometry + compliance: fitted 3-D RMS {np.sqrt(np.mean(np.sum(r ** 2, 1))):.3f} mm")
-    q = np.mod(a["q_deg"][:, :5], 360.0)
+    q = np.mod(a.q_deg[:, :5], 360.0)
     order = np.arange(len(r), dtype=float)[:, None]
     for k in (2, 4, 8):
         print(f"  less its k={k} nearest rows, grouped 5-fold: by joint angles {knn_cv(q, r, folds, k, boxsize=360.0):.3f} mm, "

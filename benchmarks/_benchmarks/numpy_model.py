@@ -13,7 +13,7 @@ import numpy as np
 from kincal import _core
 
 if TYPE_CHECKING:
-    from kincal._core import Measurements
+    from kincal._core import MeasurementSet
 
 
 def _unit_orthogonal(w: np.ndarray) -> np.ndarray:
@@ -80,7 +80,7 @@ class NumpyPointModel:
             gr.append(gr[-1] @ e)
         return gr, gt
 
-    def residuals(self, x: np.ndarray, data: Measurements) -> np.ndarray:
+    def residuals(self, x: np.ndarray, data: MeasurementSet) -> np.ndarray:
         x = np.asarray(x, float)
         n = self.n
         w = [(self.w0[j] + x[4 * j] * self.u[j] + x[4 * j + 1] * self.v[j]) for j in range(n)]
@@ -94,7 +94,7 @@ class NumpyPointModel:
         tb = self.tb0 + x[k + 6:k + 9]
         rb = self.rb0 @ _exp(x[k + 9:k + 12])
         targets = x[k + 12:].reshape(-1, 3)
-        q = np.radians(np.asarray(data["q_deg"], float))
+        q = np.radians(np.asarray(data.q_deg, float))
         if comp:
             # joint deflection under gravity at the commanded angles: tau_j = w_j . (arm_j x g)
             gr, gt = self._chain(q, w, p)
@@ -113,8 +113,8 @@ class NumpyPointModel:
                 q = q.copy()
                 q[:, j] += np.radians(c) / 1e6 * tau[:, j]
         gr, gt = self._chain(q, w, p)
-        tk = targets[np.asarray(data["target"], int)]
+        tk = targets[np.asarray(data.target, int)]
         x0 = (rm @ tk.T).T + tm
         pt = np.einsum("nij,nj->ni", gr[n], x0) + gt[n]
         y = (rb @ pt.T).T + tb
-        return (y - np.asarray(data["xyz"], float)).ravel()
+        return (y - np.asarray(data.xyz, float)).ravel()

@@ -7,6 +7,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <memory>
+
 namespace py = pybind11;
 
 namespace kincal {
@@ -32,9 +34,24 @@ void define_fivebar(py::module_& m);
 /// model). Fits start from it, fk(instrument=True) sees through it (measurement_model.cpp).
 const kincal::Campaign& campaign_of(const kincal::Robot& robot, bool calibrated);
 
-/// A measurement set as the dict of numpy arrays Python sees, and back (measurements.cpp).
+/// A measurement set as its columns (a dict of numpy arrays), and back (measurements.cpp).
 py::dict measurements_to_dict(const kincal::MeasurementSet& m, int dof);
 kincal::MeasurementSet measurements_from_dict(const py::dict& d, int dof);
+
+/// The class MeasurementSet of Python: the core's rows, never changed after construction, and their
+/// columns as read-only numpy arrays, made on first use (measurements.cpp). A dict of columns converts
+/// to it wherever a binding takes one.
+struct PyMeasurementSet {
+  std::shared_ptr<const kincal::MeasurementSet> set;
+  int dof = 0;                  ///< joint angles per row
+  mutable py::object columns;   ///< None until asked: the dict of read-only columns
+  /// The rows, for a robot of `robot_dof` joints: InputError naming the source when they have another count.
+  const kincal::MeasurementSet& of_dof(int robot_dof) const;
+};
+PyMeasurementSet measurement_set(kincal::MeasurementSet&& m, int dof);
+/// The set a binding is given: a MeasurementSet, or a dict of columns made into one here (so that
+/// the dict's errors, file and cause, reach Python as they are).
+PyMeasurementSet set_arg(const py::handle& data);
 
 inline void dict_put(py::dict&) {}
 

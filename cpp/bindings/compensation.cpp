@@ -184,9 +184,7 @@ void define_compensation_programs(py::module_& m) {
         if (in.empty()) throw InputError("--program: no input");
         WriterOptions w;
         w.format = format ? controller_format_named(*format) : controller_format_of_path(out);
-        if (targets != "joints" && targets != "filtered")
-          throw InputError("--targets " + targets + ": joints or filtered");
-        w.targets = targets == "filtered" ? TargetKind::Filtered : TargetKind::Joints;
+        w.targets = target_kind_named(targets);
         w.name = name;
         if (speed) w.speed = *speed;
         if (zone) w.zone = *zone;

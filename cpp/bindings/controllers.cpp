@@ -46,7 +46,7 @@ void define_controllers(py::module_& m) {
         std::vector<Vec6> qs;
         for (Eigen::Index i = 0; i < q.rows(); ++i) qs.push_back(q.row(i).transpose());
         py::list out;
-        for (const auto& t : controller_targets(r, qs, targets == "filtered" ? TargetKind::Filtered : TargetKind::Joints,
+        for (const auto& t : controller_targets(r, qs, target_kind_named(targets),
                                                 controller_format_named(format), {}))
           out.append(target_dict(t));
         return out;
@@ -84,7 +84,7 @@ void define_controllers(py::module_& m) {
          const std::string& name, std::optional<double> speed, std::optional<double> zone, int max_per_file) {
         WriterOptions w;
         w.format = controller_format_named(format);
-        w.targets = kind == "filtered" ? TargetKind::Filtered : TargetKind::Joints;
+        w.targets = target_kind_named(kind);
         w.name = name;
         if (speed) w.speed = *speed;
         if (zone) w.zone = *zone;

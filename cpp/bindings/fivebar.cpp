@@ -137,12 +137,23 @@ void define_fivebar_mechanism(py::module_& m) {
       .def_readonly("ny", &ErrorMatrix::ny);
   m.def(
       "fivebar_command",
-      [](const FiveBar& f, const ErrorMatrix* e, const Rows2& xy) {
+      [](const FiveBar& f, const ErrorMatrix* e, const Rows2& xy, const std::string& source,
+         const std::vector<long>& lines) {
         std::vector<Vec2> pts(static_cast<size_t>(xy.rows()));
         for (Eigen::Index i = 0; i < xy.rows(); ++i) pts[static_cast<size_t>(i)] = xy.row(i).transpose();
-        return rows_of(fivebar_commands(f, e, pts, [](size_t i) { return "row " + std::to_string(i + 1); }));
+        if (!lines.empty() && lines.size() != pts.size())
+          throw InputError("fivebar_command: " + std::to_string(lines.size()) + " lines for " +
+                           std::to_string(pts.size()) + " points");
+        // an error names the point's file:line when its lines are given, else its row (from 1)
+        return rows_of(fivebar_commands(f, e, pts, [&](size_t i) {
+          if (lines.empty()) return (source.empty() ? "" : source + ": ") + "row " + std::to_string(i + 1);
+          return source + ":" + std::to_string(lines[i]);
+        }));
       },
-      py::arg("model"), py::arg("matrix"), py::arg("xy"), "joint commands (deg) for desired points, in order");
+      py::arg("model"), py::arg("matrix"), py::arg("xy"), py::arg("source") = "",
+      py::arg("lines") = std::vector<long>{},
+      "joint commands (deg) for desired points, in order; an error names source:line of the point (lines: "
+      "the points' file lines) or its row");
 }
 
 void define_fivebar_files(py::module_& m) {

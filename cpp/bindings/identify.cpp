@@ -161,30 +161,47 @@ void define_identify_functions(py::module_& m) {
   m.def("default_prior_sd", &default_prior_sd,
         "The priors' default standard deviations by kind, in the core's units (mm, rad): the one home of "
         "these defaults");
+  py::class_<SimulationOptions>(m, "SimulationOptions", "A tracker campaign to simulate (simulate)")
+      .def(py::init<>())
+      .def_readwrite("poses", &SimulationOptions::poses, "random configurations within the joint limits")
+      .def_readwrite("seed", &SimulationOptions::seed)
+      .def_readwrite("noise_mm", &SimulationOptions::noise_mm, "Gaussian noise per coordinate (mm)")
+      .def_readwrite("outlier_fraction", &SimulationOptions::outlier_fraction, "share of rows with a gross error")
+      .def_readwrite("outlier_mm", &SimulationOptions::outlier_mm, "size of a gross error (mm)")
+      .def_property(
+          "targets", [](const SimulationOptions& o) { return targets_to(o.targets); },
+          [](SimulationOptions& o, const RowMatrix& t) {
+            if (t.cols() != 3 || t.rows() < 1) throw InputError("simulate: targets are rows of x, y, z (mm)");
+            o.targets = targets_from(t);
+          },
+          "target offsets in the tool frame (mm, one row each)")
+      .def_readwrite("limit_margin", &SimulationOptions::limit_margin, "poses drawn in this share of each range")
+      .def_property(
+          "effects", [](const SimulationOptions& o) { return effect_values_to(o.effects); },
+          [](SimulationOptions& o, const std::vector<std::pair<Effect, std::vector<double>>>& e) {
+            o.effects = effect_values_from(e);
+          },
+          "effects hidden in the truth: (Effect, values in core units)")
+      .def_readwrite("t_ref", &SimulationOptions::t_ref, "reference temperature of thermal_expansion (deg C)")
+      .def_readwrite("t_min", &SimulationOptions::t_min, "the temperature drifts from this (deg C) ...")
+      .def_readwrite("t_max", &SimulationOptions::t_max, "... to this over the campaign")
+      .def_readwrite("orientation_noise_deg", &SimulationOptions::orientation_noise_deg,
+                     ">= 0: the first target's rows are 6-D with this noise per axis (deg); -1: points")
+      .def_readwrite("duration_s", &SimulationOptions::duration_s,
+                     "> 0: rows get time_s, the campaign running from 0 to this (s)");
   m.def(
       "simulate",
-      [](const Robot& truth, int poses, unsigned seed, double noise_mm, double outlier_fraction, double outlier_mm,
-         const RowMatrix& targets, double limit_margin, const std::vector<std::pair<Effect, std::vector<double>>>& effects,
-         double t_ref, double orientation_noise_deg, double duration_s) {
-        SimulationOptions o;
-        o.duration_s = duration_s;
-        o.poses = poses, o.seed = seed, o.limit_margin = limit_margin;
-        o.noise_mm = noise_mm, o.orientation_noise_deg = orientation_noise_deg;
-        o.outlier_fraction = outlier_fraction, o.outlier_mm = outlier_mm;
-        o.targets = targets_from(targets), o.effects = effect_values_from(effects), o.t_ref = t_ref;
-        return measurements_to_dict(simulate(*truth.calibrated(), o, truth.campaign()), truth.calibrated()->dof());
+      [](const Robot& truth, const SimulationOptions& o) {
+        return measurement_set(simulate(*truth.calibrated(), o, truth.campaign()), truth.calibrated()->dof());
       },
-      py::arg("truth"), py::arg("poses"), py::arg("seed"), py::arg("noise_mm"), py::arg("outlier_fraction"),
-      py::arg("outlier_mm"), py::arg("targets"), py::arg("limit_margin") = 0.9,
-      py::arg("effects") = std::vector<std::pair<Effect, std::vector<double>>>{}, py::arg("t_ref") = 20.0,
-      py::arg("orientation_noise_deg") = -1.0, py::arg("duration_s") = 0.0,
-      "A measurement campaign on the calibrated (true) model of a robot; effects: (Effect, values in core\n"
-      "units) hidden in the truth. duration_s > 0: a time_s column, the campaign running from 0 to\n"
-      "duration_s in pose order (a hidden drift without it: 3 h, centred on the mean time)");
+      py::arg("truth"), py::arg("options") = SimulationOptions{},
+      "A measurement campaign on the calibrated (true) model of a robot, seen through its campaign (a\n"
+      "hidden drift without a duration: 3 h, centred on the mean time)");
   m.def(
       "point_errors",
-      [](const Robot& r, const RowMatrix& targets, const py::dict& d, const std::vector<StationValue>& stations) {
-        const auto e = point_errors(*r.calibrated(), r.campaign(), targets_from(targets), measurements_from_dict(d, r.calibrated()->dof()),
+      [](const Robot& r, const RowMatrix& targets, const py::object& d, const std::vector<StationValue>& stations) {
+        const auto e = point_errors(*r.calibrated(), r.campaign(), targets_from(targets),
+                                    set_arg(d).of_dof(r.calibrated()->dof()),
                                     stations);
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
@@ -194,16 +211,16 @@ void define_identify_functions(py::module_& m) {
       "along its constraint against its station among `stations` (NaN when not among them)");
   m.def(
       "check_effect_columns",
-      [](const Robot& r, const py::dict& d, const std::vector<Effect>& effects) {
-        check_effect_columns(*r.nominal(), measurements_from_dict(d, r.nominal()->dof()), effects);
+      [](const Robot& r, const py::object& d, const std::vector<Effect>& effects) {
+        check_effect_columns(*r.nominal(), set_arg(d).of_dof(r.nominal()->dof()), effects);
       },
       py::arg("robot"), py::arg("data"), py::arg("effects"),
       "ValueError (file:line of the first row without it) unless the data carry every column the effects\n"
       "read (the registry's needs: temperature_c, time_s, dir1..dirN)");
   m.def(
       "orientation_errors",
-      [](const Robot& r, const py::dict& d) {
-        const auto e = orientation_errors(*r.calibrated(), r.campaign(), measurements_from_dict(d, r.calibrated()->dof()));
+      [](const Robot& r, const py::object& d) {
+        const auto e = orientation_errors(*r.calibrated(), r.campaign(), set_arg(d).of_dof(r.calibrated()->dof()));
         return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(e.data(), e.size()));
       },
       py::arg("robot"), py::arg("data"),
@@ -404,7 +421,7 @@ void define_identify_result(py::module_& m) {
       .def_property_readonly("effects", [](const PyIdentifyResult& r) { return effect_values_to(r.r.effects); },
                              "(Effect, values in core units) of every extra effect")
       .def_property_readonly("t_ref", [](const PyIdentifyResult& r) { return r.r.t_ref; })
-      .def_property_readonly("t_mean_s", [](const PyIdentifyResult& r) { return r.r.t_mean_s; },
+      .def_property_readonly("t_mean_s", [](const PyIdentifyResult& r) { return r.r.campaign.t_mean_s; },
                              "reference time of the drift (s): the data's mean time")
       .def_property_readonly("setups", [](const PyIdentifyResult& r) { return placements(r.r.campaign); },
                              "every instrument placement: (name, xyz_mm, abc_deg); name '' for a single one")
@@ -451,10 +468,11 @@ void define_identify_result(py::module_& m) {
 void define_identify_call(py::module_& m) {
   m.def(
       "identify",
-      [](const Robot& robot, const py::dict& d, const IdentifyOptions& options, py::object progress,
+      [](const Robot& robot, const py::object& d, const IdentifyOptions& options, py::object progress,
          bool from_calibrated) {
         const Model& nominal = from_calibrated ? *robot.calibrated() : *robot.nominal();
-        const MeasurementSet data = measurements_from_dict(d, nominal.dof());
+        const PyMeasurementSet set = set_arg(d);
+        const MeasurementSet& data = set.of_dof(nominal.dof());
         IdentifyOptions o = core_options(options, nominal);
         if (!progress.is_none()) o.progress = [progress](int it, double cost) { progress(it, cost); };
         PyIdentifyResult out{identify(nominal, data, o, campaign_of(robot, from_calibrated)), Robot{}, Robot{}};

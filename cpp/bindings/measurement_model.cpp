@@ -77,7 +77,7 @@ void define_probe_stations(py::module_& m) {
   m.def(
       "simulate_probe",
       [](const Robot& truth, const ProbeSimulationOptions& o) {
-        return measurements_to_dict(simulate_probe(*truth.calibrated(), o), truth.calibrated()->dof());
+        return measurement_set(simulate_probe(*truth.calibrated(), o), truth.calibrated()->dof());
       },
       py::arg("truth"), py::arg("options"),
       "A probe campaign on the calibrated (true) model of a robot: every row's ball centre on its\n"
@@ -111,15 +111,16 @@ void define_point_model(py::module_& m) {
       .def_property_readonly("layout", [](const PyPointModel& p) -> const ParamLayout& { return p.pm.layout(); },
                              py::return_value_policy::reference_internal)
       .def_property_readonly("names", [](const PyPointModel& p) { return p.pm.layout().names; })
-      .def("start", [](const PyPointModel& p, const py::dict& d) {
-             return p.pm.start(measurements_from_dict(d, p.pm.layout().dof));
+      .def("start", [](const PyPointModel& p, const py::object& d) {
+             return p.pm.start(set_arg(d).of_dof(p.pm.layout().dof));
            }, py::arg("data"))
       .def(
           "residuals",
-          [](const PyPointModel& p, const std::vector<double>& x, const py::dict& d, bool jac, double weight,
+          [](const PyPointModel& p, const std::vector<double>& x, const py::object& d, bool jac, double weight,
              bool artifact, const std::optional<std::vector<int>>& columns) {
             const ParamLayout& L = p.pm.layout();
-            const MeasurementSet data = measurements_from_dict(d, L.dof);
+            const PyMeasurementSet set = set_arg(d);
+            const MeasurementSet& data = set.of_dof(L.dof);
             if (static_cast<int>(x.size()) != L.size) throw InputError("PointModel: wrong parameter count");
             if (!L.setup_names.empty() && data.setup_names != L.setup_names)
               throw InputError(data.source + ": the data's setups are not the layout's (" +

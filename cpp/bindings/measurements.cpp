@@ -1,5 +1,5 @@
-// Bindings of measurement files. A measurement set crosses the boundary as a dict of numpy arrays:
-// pose (n), q_deg (n x dof), xyz (n x 3), target (n), payload_kg (n, NaN for the model's payload),
+// Bindings of measurement files and of the class MeasurementSet. Its columns: pose (n), q_deg (n x
+// dof), xyz (n x 3), target (n), payload_kg (n, NaN for the model's payload),
 // line (n: source line, 0 when simulated), source; when the set has them also temperature_c (n),
 // abc (n x 3: the measured orientations), dir (n x dof: the joints' directions of motion), time_s
 // (n), config (n int64 codes) with config_names (the values by code, in order of first appearance)
@@ -243,35 +243,183 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
   return m;
 }
 
+const MeasurementSet& PyMeasurementSet::of_dof(int robot_dof) const {
+  if (dof != robot_dof && !set->rows.empty())
+    throw InputError(set->source + ": " + std::to_string(dof) + " joint angles per row but the robot has " +
+                     std::to_string(robot_dof));
+  return *set;
+}
+
+PyMeasurementSet measurement_set(MeasurementSet&& m, int dof) {
+  return PyMeasurementSet{std::make_shared<const MeasurementSet>(std::move(m)), dof, py::none()};
+}
+
+namespace {
+PyMeasurementSet from_columns(const py::dict& d, int dof);
+}  // namespace
+
+PyMeasurementSet set_arg(const py::handle& data) {
+  if (py::isinstance<py::dict>(data)) return from_columns(data.cast<py::dict>(), -1);
+  if (!py::isinstance<PyMeasurementSet>(data))
+    throw py::type_error("a MeasurementSet (or a dict of its columns) is needed, not " +
+                         py::str(py::type::of(data)).cast<std::string>());
+  return data.cast<PyMeasurementSet>();
+}
+
+namespace {
+
+/// The columns of a set, made once: numpy arrays marked read-only (the set never changes).
+py::dict columns_of(const PyMeasurementSet& s) {
+  if (s.columns.is_none()) {
+    py::dict d = measurements_to_dict(*s.set, s.dof);
+    for (auto item : d)
+      if (py::isinstance<py::array>(item.second)) item.second.attr("setflags")(py::arg("write") = false);
+    s.columns = d;
+  }
+  return s.columns.cast<py::dict>();
+}
+
+/// One column (a copy of a list of names, so that the set's own stays as it is), None when absent.
+py::object column(const PyMeasurementSet& s, const std::string& key) {
+  const py::dict d = columns_of(s);
+  if (!d.contains(key.c_str())) return py::none();
+  py::object v = d[key.c_str()];
+  return py::isinstance<py::list>(v) ? py::object(py::list(v)) : v;
+}
+
+/// A set from columns: dof -1 takes the joint count from q_deg.
+PyMeasurementSet from_columns(const py::dict& d, int dof) {
+  if (dof < 0) {
+    if (!d.contains("q_deg")) throw InputError("a measurement set needs q_deg (n x dof joint angles)");
+    py::array q = py::array::ensure(d["q_deg"]);
+    if (!q || q.ndim() != 2) throw InputError("a measurement set's q_deg is n x dof joint angles");
+    dof = static_cast<int>(q.shape(1));
+  }
+  return measurement_set(measurements_from_dict(d, dof), dof);
+}
+
+const char* const kColumns[] = {"pose", "q_deg", "xyz", "target", "payload_kg", "line", "source", "temperature_c",
+                                "abc", "dir", "time_s", "config", "config_names", "setup", "setup_names", "kind",
+                                "station", "station_names", "station_kinds", "radius_mm", "length_mm", "artifact"};
+
+void define_measurement_set(py::module_& m) {
+  auto c = py::class_<PyMeasurementSet>(
+      m, "MeasurementSet",
+      "A measurement set: rows of joint angles and what was measured, immutable. Every column is a\n"
+      "read-only numpy array (None when the set has no such column); subset() and with_columns() make new\n"
+      "sets. A dict of columns converts to it wherever the core takes one.");
+  c.def(py::init(&from_columns), py::arg("columns"), py::arg("dof") = -1,
+        "From columns (a dict: pose, q_deg, xyz, target and the optional ones); dof -1: q_deg's width")
+      .def_property_readonly("dof", [](const PyMeasurementSet& s) { return s.dof; }, "joint angles per row")
+      .def_property_readonly("n_targets", [](const PyMeasurementSet& s) { return s.set->n_targets; },
+                             "targets (reflectors) the rows name: the largest index + 1")
+      .def("__len__", [](const PyMeasurementSet& s) { return s.set->rows.size(); })
+      .def(
+          "subset",
+          [](const PyMeasurementSet& s, const py::array& rows) {
+            const MeasurementSet& a = *s.set;
+            const size_t n = a.rows.size();
+            std::vector<size_t> pick;
+            if (rows.dtype().kind() == 'b') {
+              const auto mask = py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(rows);
+              if (mask.ndim() != 1 || static_cast<size_t>(mask.size()) != n)
+                throw InputError(a.source + ": a mask of " + std::to_string(mask.size()) + " for " +
+                                 std::to_string(n) + " rows");
+              for (size_t i = 0; i < n; ++i)
+                if (mask.data()[i]) pick.push_back(i);
+            } else {
+              const auto idx = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(rows);
+              if (!idx || idx.ndim() != 1) throw InputError(a.source + ": rows are a mask or indices");
+              for (py::ssize_t k = 0; k < idx.size(); ++k) {
+                const int64_t i = idx.data()[k];
+                if (i < 0 || i >= static_cast<int64_t>(n))
+                  throw InputError(a.source + ": row " + std::to_string(i) + " of " + std::to_string(n));
+                pick.push_back(static_cast<size_t>(i));
+              }
+            }
+            return measurement_set(subset(a, pick), s.dof);
+          },
+          py::arg("rows"), "The rows `rows` (a boolean mask or indices, in that order) as a new set")
+      .def(
+          "columns",
+          [](const PyMeasurementSet& s) { return measurements_to_dict(*s.set, s.dof); },
+          "Every column as a new dict (its arrays writable copies)")
+      .def(
+          "with_columns",
+          [](const PyMeasurementSet& s, const py::kwargs& kw) {
+            py::dict d = measurements_to_dict(*s.set, s.dof);
+            for (auto item : kw) d[item.first] = item.second;
+            return from_columns(d, kw.contains("q_deg") ? -1 : s.dof);
+          },
+          "A new set: these columns given, the others as they are (e.g. with_columns(q_deg=q))")
+      // the dict of earlier versions, read-only: data["q_deg"], "abc" in data, keys(), iteration, items(), get()
+      .def(
+          "__getitem__",
+          [](const PyMeasurementSet& s, const std::string& key) {
+            py::object v = column(s, key);
+            if (v.is_none()) throw py::key_error(key);
+            return v;
+          },
+          py::arg("key"))
+      .def("__contains__",
+           [](const PyMeasurementSet& s, const std::string& key) { return columns_of(s).contains(key.c_str()); })
+      .def("keys", [](const PyMeasurementSet& s) { return columns_of(s).attr("keys")(); })
+      .def("__iter__", [](const PyMeasurementSet& s) { return py::iter(columns_of(s)); })
+      .def("items", [](const PyMeasurementSet& s) {
+        py::list out;
+        for (auto item : columns_of(s))
+          out.append(py::make_tuple(item.first, column(s, item.first.cast<std::string>())));
+        return out;
+      })
+      .def(
+          "get",
+          [](const PyMeasurementSet& s, const std::string& key, py::object fallback) {
+            py::object v = column(s, key);
+            return v.is_none() ? fallback : v;
+          },
+          py::arg("key"), py::arg("default") = py::none())
+      .def("__repr__", [](const PyMeasurementSet& s) {
+        return "<MeasurementSet " + s.set->source + ": " + std::to_string(s.set->rows.size()) + " rows, " +
+               std::to_string(s.dof) + " joints>";
+      });
+  for (const char* key : kColumns) {
+    const std::string k = key;
+    c.def_property_readonly(key, [k](const PyMeasurementSet& s) { return column(s, k); });
+  }
+}
+
+}  // namespace
+
 void define_measurements(py::module_& m) {
+  define_measurement_set(m);
   m.def(
       "read_measurements",
       [](const std::string& path, int dof, const Robot* robot) {
         MeasurementSet ms = read_measurements(path, dof);
         if (robot) measurements_from_controller(ms, robot->nominal()->spec());  // the controller's numbers
-        return measurements_to_dict(ms, dof);
+        return measurement_set(std::move(ms), dof);
       },
       py::arg("path"), py::arg("dof"), py::arg("robot") = nullptr);
   m.def(
       "parse_measurements",
       [](const std::string& text, const std::string& src, int dof) {
-        return measurements_to_dict(parse_measurements(text, src, dof), dof);
+        return measurement_set(parse_measurements(text, src, dof), dof);
       },
       py::arg("text"), py::arg("source") = "<text>", py::arg("dof") = 6);
   m.def(
       "format_measurements",
-      [](const py::dict& d, int dof) { return format_measurements(measurements_from_dict(d, dof), dof); },
+      [](const py::object& d, int dof) { return format_measurements(set_arg(d).of_dof(dof), dof); },
       py::arg("data"), py::arg("dof"));
   m.def(
       "read_artifact",
-      [](const std::string& path, const py::dict& d, int dof) {
-        MeasurementSet ms = measurements_from_dict(d, dof);
+      [](const std::string& path, const py::object& d, int dof) {
+        MeasurementSet ms = set_arg(d).of_dof(dof);
         read_artifact(path, ms);
-        return measurements_to_dict(ms, dof);
+        return measurement_set(std::move(ms), dof);
       },
       py::arg("path"), py::arg("data"), py::arg("dof"),
       "The data with the artifact file's known distances and angles between their stations");
   m.def(
-      "format_artifact", [](const py::dict& d, int dof) { return format_artifact(measurements_from_dict(d, dof)); },
+      "format_artifact", [](const py::object& d, int dof) { return format_artifact(set_arg(d).of_dof(dof)); },
       py::arg("data"), py::arg("dof"));
 }

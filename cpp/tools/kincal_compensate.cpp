@@ -209,7 +209,7 @@ kincal::ProgramOptions program_options(const Args& a) {
 kincal::WriterOptions writer_options(const Args& a) {
   kincal::WriterOptions w;
   w.format = a.format.empty() ? kincal::controller_format_of_path(a.out) : kincal::controller_format_named(a.format);
-  w.targets = a.targets == "filtered" ? kincal::TargetKind::Filtered : kincal::TargetKind::Joints;
+  w.targets = kincal::target_kind_named(a.targets);
   w.name = a.prog_name;
   if (a.speed) w.speed = *a.speed;
   if (a.zone) w.zone = *a.zone;

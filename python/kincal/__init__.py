@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._core import Robot
+from ._core import MeasurementSet, Robot
 from .io.urdf import urdf_model_json
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ def __getattr__(name: str) -> ModuleType:
     raise AttributeError(f"module 'kincal' has no attribute '{name}'")
 
 
-__all__ = ["Robot", "load_robot", "fk", "ik", "compensate", "run_program", "jacobian", "line_program", "__version__"]
+__all__ = ["Robot", "MeasurementSet", "load_robot", "fk", "ik", "compensate", "run_program", "jacobian", "line_program", "__version__"]
 __version__ = "0.1.0"
 
 ArrayLike = Union[np.ndarray, Sequence[Sequence[float]]]

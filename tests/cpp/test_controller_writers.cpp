@@ -380,4 +380,8 @@ TEST(ControllerWriters, BadNamesAndOptionsAreRefused) {
   EXPECT_EQ(controller_format_of_path("a/B.MODX"), ControllerFormat::Rapid);
   EXPECT_EQ(controller_format_of_path("prog.ngc"), ControllerFormat::Gcode);
   EXPECT_NE(error_of([] { controller_format_named("vplus"); }).find("not a format"), std::string::npos);
+  // the target kinds by name: any other word refused (it once fell back to joint targets silently)
+  EXPECT_EQ(target_kind_named("joints"), TargetKind::Joints);
+  EXPECT_EQ(target_kind_named("filtered"), TargetKind::Filtered);
+  EXPECT_EQ(error_of([] { target_kind_named("filterd"); }), "--targets filterd: joints or filtered");
 }

@@ -306,7 +306,6 @@ TEST(Setups, HiddenDriftIsRecoveredWithinItsUncertainty) {
   opt.effects = {Effect{"drift", -1, {}}};
   const IdentifyResult r = identify(nominal, fit, opt);
   ASSERT_GE(r.layout.drift, 0);
-  EXPECT_NEAR(r.t_mean_s, 5400, 1e-9);
   const auto& v = tracker_drift();
   for (int k = 0; k < 6; ++k) {
     const int i = r.layout.drift + k;

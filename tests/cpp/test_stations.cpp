@@ -87,6 +87,25 @@ TEST(Stations, CsvRowsAndRoundTrip) {
   EXPECT_EQ(probe.rows[0].kind, MeasureKind::sphere);
 }
 
+TEST(Stations, ASubsetKeepsTheStationsAndCountsItsOwnTargets) {
+  // kMixed: a point row of target 0, then probe rows; rows 3 and 1 picked in that order
+  MeasurementSet m = parse_measurements(kMixed, "m.csv", 6);
+  m.rows[0].target = 2;  // the point row names a third target
+  m.n_targets = 3;
+  const MeasurementSet s = subset(m, {3, 1});
+  ASSERT_EQ(s.rows.size(), 2u);
+  EXPECT_EQ(s.rows[0].line, m.rows[3].line);
+  EXPECT_EQ(s.rows[1].line, m.rows[1].line);
+  EXPECT_EQ(s.source, "m.csv");
+  EXPECT_EQ(s.station_names, m.station_names);
+  EXPECT_EQ(s.station_kinds, m.station_kinds);
+  EXPECT_EQ(s.n_targets, 1);  // the point row with target 2 left out
+  EXPECT_EQ(subset(m, {0}).n_targets, 3);
+  EXPECT_TRUE(without_rows(m).rows.empty());
+  EXPECT_EQ(without_rows(m).station_names, m.station_names);
+  EXPECT_THROW(subset(m, {5}), std::out_of_range);
+}
+
 TEST(Stations, CsvErrorsNameFileAndLine) {
   const std::string head = "pose,q1,q2,q3,q4,q5,q6,x,y,z,kind,station,radius,length\n";
   auto err = [&](const std::string& row) { return error_of([&] { parse_measurements(head + row, "m.csv", 6); }); };

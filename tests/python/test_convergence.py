@@ -39,7 +39,7 @@ def _campaign(robot, poses: int, seed: int) -> tuple:
             ident.simulate(truth, 200, seed=seed + 100, noise_mm=NOISE_MM, targets=3))
 
 
-def _rms(res: ident.Identification, data: dict) -> float:
+def _rms(res: ident.Identification, data: kincal.MeasurementSet) -> float:
     return float(np.sqrt(np.mean(np.asarray(_core.point_errors(res.robot, res.targets, data)) ** 2)))
 
 

@@ -142,6 +142,7 @@ def test_diagnose_on_task_data_holds_the_wrist_at_its_prior(tmp_path):
     d = {k: (np.repeat(v[:1], 60, axis=0) if isinstance(v, np.ndarray) else v) for k, v in d.items()}
     d.update(pose=np.arange(60), q_deg=q, line=np.arange(60) + 2)
     d["xyz"] = kincal.fk(truth, q, frame="instrument")[:, :3] + rng.normal(0.0, 0.02, (60, 3))
+    d = kincal.MeasurementSet(d)
     (tmp_path / "task.csv").write_text(ident.measurements_csv(d, kr500.dof))
     r = run("kincal", "diagnose", "--robot", "kr500", "--data", str(tmp_path / "task.csv"), "--out",
             str(tmp_path / "d"))

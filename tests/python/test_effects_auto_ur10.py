@@ -22,7 +22,7 @@ SERIES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joi
           "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
 
 
-def _draw(data: dict, seed: int) -> dict:
+def _draw(data: kincal.MeasurementSet, seed: int) -> kincal.MeasurementSet:
     cfg = grouping.configurations(data)
     keep = np.isin(cfg.codes, np.random.default_rng(seed).choice(cfg.count, 15, replace=False))
     return ident.subset(data, keep)

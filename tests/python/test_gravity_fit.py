@@ -33,7 +33,7 @@ def urdfs(tmp_path_factory, kr500):
     return d / "with.urdf", d / "without.urdf"
 
 
-def _held_out_rms(res: ident.Identification, data: dict) -> float:
+def _held_out_rms(res: ident.Identification, data: kincal.MeasurementSet) -> float:
     return float(np.sqrt(np.mean(np.asarray(_core.point_errors(res.robot, res.targets, data)) ** 2)))
 
 

@@ -31,7 +31,7 @@ def _repeated(config_column: bool = False) -> tuple[dict, np.ndarray]:
     rng = np.random.default_rng(7)
     reps = []
     for r in range(REPEATS):
-        d = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in base.items()}
+        d = base.columns()  # writable copies
         d["pose"] = d["pose"] + 1000 * r          # a new pose id for every repeat
         d["xyz"] = d["xyz"] + rng.normal(0.0, NOISE, d["xyz"].shape)
         reps.append(d)
@@ -42,7 +42,7 @@ def _repeated(config_column: bool = False) -> tuple[dict, np.ndarray]:
         # equal-angle rule): only the config column says they repeat one configuration
         data["q_deg"] = data["q_deg"] + rng.normal(0.0, 0.01, data["q_deg"].shape)
         data["config"] = truth_config.astype(np.int64)
-    return data, truth_config
+    return kincal.MeasurementSet(data), truth_config
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +79,7 @@ def test_folds_and_split_keep_configurations_whole(repeated):
 
 def test_config_column_groups_jittered_repeats():
     data, truth_config = _repeated(config_column=True)
-    assert grouping.configurations({k: v for k, v in data.items() if k != "config"}).count == CONFIGS * REPEATS
+    assert grouping.configurations(kincal.MeasurementSet({k: v for k, v in data.items() if k != "config"})).count == CONFIGS * REPEATS
     cfg = grouping.configurations(data)
     assert cfg.count == CONFIGS and "config" in cfg.rule
     for held in grouping.folds(data, 4):
@@ -143,7 +143,8 @@ def test_a_failed_fold_says_it_is_a_fold():
     def refuses(data, opts):
         raise ValueError(f"m.csv: the {len(data['pose'])} measured points of ...: too few or too similar poses")
 
-    data = {"pose": np.arange(10), "q_deg": np.zeros((10, 6)), "xyz": np.zeros((10, 3)), "target": np.zeros(10, int)}
+    data = kincal.MeasurementSet({"pose": np.arange(10), "q_deg": np.zeros((10, 6)), "xyz": np.zeros((10, 3)),
+                                  "target": np.zeros(10, int), "source": "m.csv"})
     held = [np.arange(10) < 2, np.arange(10) >= 2]
     with pytest.raises(ValueError, match=r"cross-validation fold 1 of 2 \(the model fitted without 2 held-out rows\): "
                                          r"m.csv: the 8 measured points"):

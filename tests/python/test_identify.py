@@ -248,7 +248,7 @@ def test_model_fitted_on_every_row_whatever_the_row_order():
     perm = rng.permutation(len(data["pose"]))
     shuffled = ident.subset(data, perm)
     new_id = rng.permutation(1000)[: int(np.max(data["pose"])) + 1] + 5000
-    shuffled["pose"] = new_id[shuffled["pose"]].astype(data["pose"].dtype)
+    shuffled = shuffled.with_columns(pose=new_id[shuffled["pose"]].astype(data["pose"].dtype))
     a = ident.identify(robot, data)
     b = ident.identify(robot, shuffled, seed=3)
     assert a.validation["fit_rows"] == b.validation["fit_rows"] == len(data["pose"])

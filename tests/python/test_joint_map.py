@@ -146,7 +146,7 @@ def test_what_remains_is_carried_by_its_variable(kr500):
     names = {s["variable"] for s in out["residual_variables"]}
     assert {"q1", "q6", "tau2", "temperature_c", "order", "dir1"} <= names
     quiet = ident.simulate(_truth(kr500), 250, seed=8, targets=3)
-    quiet["time_s"] = 12.0 * np.arange(len(quiet["pose"]), dtype=float)  # when each point was measured
+    quiet = quiet.with_columns(time_s=12.0 * np.arange(len(quiet), dtype=float))  # when each point was measured
     clean = dg.diagnose(kr500, quiet, max_steps=0)
     assert "time_s" in {s["variable"] for s in clean["residual_variables"]}
     print("nothing hidden:", [(s["variable"], round(s["share"], 3)) for s in clean["residual_variables"][:4]])

@@ -17,14 +17,14 @@ TARGETS = ident.DEFAULT_TARGETS[:3]
 NOISE = 0.02
 
 
-def _measure(truth, q: np.ndarray, noise: float, seed: int) -> dict:
+def _measure(truth, q: np.ndarray, noise: float, seed: int) -> kincal.MeasurementSet:
     """The truth's target points (instrument frame, every effect it carries) at q, plus noise."""
     pose = np.asarray(_core.fk(truth, q, True, True))
     R = np.stack([_core.abc_to_rotation(p[3:]) for p in pose])
     pts = (R[:, None] @ TARGETS[None, :, :, None])[..., 0] + pose[:, None, :3]
     d = plan._campaign(truth, q, TARGETS)
-    d["xyz"] = pts.reshape(-1, 3) + np.random.default_rng(seed).normal(0.0, noise, (len(q) * len(TARGETS), 3))
-    return d
+    return d.with_columns(xyz=pts.reshape(-1, 3) + np.random.default_rng(seed).normal(0.0, noise,
+                                                                                       (len(q) * len(TARGETS), 3)))
 
 
 def _held_rms(res, truth, q) -> float:

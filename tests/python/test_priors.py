@@ -28,14 +28,14 @@ def kr500():
     return kincal.load_robot("kr500")
 
 
-def _at(truth, q: np.ndarray, noise_mm: float, rng) -> dict:
+def _at(truth, q: np.ndarray, noise_mm: float, rng) -> kincal.MeasurementSet:
     """Measurements of the truth's tool point (one target at the tool frame's origin) at joint angles q."""
     d = ident.simulate(truth, 1, seed=1, noise_mm=0.0)
     n = len(q)
     d = {k: (np.repeat(v[:1], n, axis=0) if isinstance(v, np.ndarray) else v) for k, v in d.items()}
     d.update(pose=np.arange(n), q_deg=q, line=np.arange(n) + 2)
     d["xyz"] = kincal.fk(truth, q, frame="instrument")[:, :3] + rng.normal(0.0, noise_mm, (n, 3))
-    return d
+    return kincal.MeasurementSet(d)
 
 
 def _task(n: int, rng) -> np.ndarray:
@@ -107,14 +107,14 @@ def test_priors_never_worse_on_a_wide_campaign(kr500):
         assert with_priors <= 1.01 * without, (s, with_priors, without)
 
 
-def _gross(data: dict, share: float, rng) -> dict:
+def _gross(data: kincal.MeasurementSet, share: float, rng) -> kincal.MeasurementSet:
     """A share of the rows moved 3-6 mm in a random direction (gross errors: a beam break, a wrong
     reflector)."""
-    d = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in data.items()}
-    rows = rng.choice(len(d["pose"]), int(round(share * len(d["pose"]))), replace=False)
+    xyz = data.xyz.copy()
+    rows = rng.choice(len(data), int(round(share * len(data))), replace=False)
     u = rng.normal(size=(len(rows), 3))
-    d["xyz"][rows] += u / np.linalg.norm(u, axis=1)[:, None] * rng.uniform(3.0, 6.0, (len(rows), 1))
-    return d
+    xyz[rows] += u / np.linalg.norm(u, axis=1)[:, None] * rng.uniform(3.0, 6.0, (len(rows), 1))
+    return data.with_columns(xyz=xyz)
 
 
 def test_data_scaled_loss_on_clean_and_gross_errors(kr500):

@@ -325,7 +325,7 @@ def test_the_artifacts_uncertainty_weighs_its_lengths():
     from kincal.calibration.fitting import FitOptions
     kr500 = kincal.load_robot("kr500")
     data = simulation_of(ident.default_truth(kr500, seed=3), CASES["spheres"])
-    data["artifact"] = [(a, b, d + 0.05, ang, note) for a, b, d, ang, note in data["artifact"]]
+    data = data.with_columns(artifact=[(a, b, d + 0.05, ang, note) for a, b, d, ang, note in data["artifact"]])
     names = list(data["station_names"])
 
     def worst(fit: ident.Identification) -> float:

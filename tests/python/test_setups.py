@@ -253,5 +253,5 @@ def test_diagnosis_names_a_hidden_drift(kr500, truth, hide):
     else:
         assert "drift" not in named, out["steps"]
     # no time column, or a constant one: no drift candidate
-    still = dict(data, time_s=np.zeros(len(data["pose"])))
+    still = data.with_columns(time_s=np.zeros(len(data)))
     assert "drift" not in [c.name for c in dg.candidates(kr500, still)[0]]

@@ -107,7 +107,7 @@ def test_mixed_campaign_six_d_rows_and_reflectors(kr500, truth, tmp_path):
     assert dp < 1e-4 and da < 1e-5, (dp, da)
     assert res.validation["after_rms_mm"] < 1e-4 and res.validation["after_rms_deg"] < 1e-5
     # 6-D rows of two targets would be two tool frames: a clear error
-    two = dict(back, abc=np.where(np.isnan(back["abc"]), 0.0, back["abc"]))
+    two = back.with_columns(abc=np.where(np.isnan(back.abc), 0.0, back.abc))
     with pytest.raises(ValueError, match="6-D rows of target 0 and of target 1"):
         ident.identify(kr500, two, k_folds=0)
 

@@ -73,12 +73,11 @@ const MeasurementSet& measured_artifact(const MeasurementSet& data, MeasurementS
   return copy;
 }
 
-/// The extra effects: those asked for, then those the starting model carries (held at their values),
-/// but its drift: a property of the campaign it was measured on, not of the robot.
+/// The extra effects: those asked for, then those the starting model carries (held at their values;
+/// a model carries no drift: that is its campaign's, which a refit does not carry over).
 std::vector<Effect> effects_to_identify(const Model& nominal, const IdentifyOptions& opt) {
   std::vector<Effect> effects = opt.effects;
   for (const EffectValue& ev : nominal.spec().effects) {
-    if (ev.effect.kind().of_instrument()) continue;
     bool asked = false;
     for (const Effect& e : effects) asked = asked || same_effect(e, ev.effect);
     if (!asked) effects.push_back(ev.effect);
@@ -109,8 +108,7 @@ void start_carried_effects(const Model& nominal, const IdentifyOptions& opt, Ide
   const ParamLayout& L = res.layout;
   for (size_t e = 0; e < L.effect_list.size(); ++e)
     for (const EffectValue& ev : nominal.spec().effects)
-      if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size() &&
-          !ev.effect.kind().of_instrument()) {
+      if (same_effect(ev.effect, L.effect_list[e]) && static_cast<int>(ev.p.size()) == L.effect_list[e].size()) {
         const bool asked = e < opt.effects.size();
         for (size_t k = 0; k < ev.p.size(); ++k) {
           const int i = L.effect_offset[e] + static_cast<int>(k);

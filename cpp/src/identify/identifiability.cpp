@@ -187,13 +187,7 @@ MeasurementSet generic_campaign(const Model& nominal, const MeasurementSet& data
   const std::vector<bool> measured = measured_targets(data);
   std::vector<bool> six_d(data.n_targets, false);  // the target of the 6-D rows (the tool frame)
   for (const auto& r : data.rows) six_d[r.target] = six_d[r.target] || (data.orientation && r.has_abc);
-  MeasurementSet generic;
-  generic.n_targets = data.n_targets;
-  generic.orientation = data.orientation;
-  generic.setup_names = data.setup_names;
-  generic.station_names = data.station_names;
-  generic.station_kinds = data.station_kinds;
-  generic.artifact = data.artifact;
+  MeasurementSet generic = without_rows(data);
   std::mt19937_64 rng(12345);
   std::uniform_real_distribution<double> ud(-0.45, 0.45);
   for (int p = 0; p < 100; ++p) {

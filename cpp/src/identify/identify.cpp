@@ -282,7 +282,6 @@ void store_solution(const PointModel& pm, const Model& nominal, const Measuremen
   for (int t = 0; t < data.n_targets; ++t) res.targets.push_back(target_of(L, x, t));
   res.stations = solution.stations();
   res.t_ref = L.t_ref;
-  res.t_mean_s = L.t_mean;
   for (size_t e = 0; e < L.effect_list.size(); ++e) {
     const auto first = x.begin() + L.effect_offset[e];
     res.effects.push_back({L.effect_list[e], std::vector<double>(first, first + L.effect_list[e].size())});

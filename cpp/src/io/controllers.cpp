@@ -26,6 +26,12 @@ bool ends_with(const std::string& s, const std::string& e) {
 
 }  // namespace
 
+TargetKind target_kind_named(const std::string& name) {
+  if (name == "joints") return TargetKind::Joints;
+  if (name == "filtered") return TargetKind::Filtered;
+  throw InputError("--targets " + name + ": joints or filtered");
+}
+
 ControllerFormat controller_format_named(const std::string& name) {
   const std::string n = lower(name);
   if (n == "krl") return ControllerFormat::Krl;

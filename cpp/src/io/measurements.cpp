@@ -273,6 +273,33 @@ void parse_artifact(const std::string& text, const std::string& source, Measurem
 
 void read_artifact(const std::string& path, MeasurementSet& m) { parse_artifact(read_text_file(path), path, m); }
 
+MeasurementSet without_rows(const MeasurementSet& m) {
+  MeasurementSet out;
+  out.source = m.source;
+  out.n_targets = m.n_targets;
+  out.orientation = m.orientation;
+  out.config_names = m.config_names;
+  out.setup_names = m.setup_names;
+  out.station_names = m.station_names;
+  out.station_kinds = m.station_kinds;
+  out.artifact = m.artifact;
+  return out;
+}
+
+MeasurementSet subset(const MeasurementSet& m, const std::vector<size_t>& rows) {
+  MeasurementSet out = without_rows(m);
+  out.n_targets = 1;
+  out.orientation = false;
+  out.rows.reserve(rows.size());
+  for (size_t i : rows) {
+    const Measurement& r = m.rows.at(i);
+    out.rows.push_back(r);
+    out.n_targets = std::max(out.n_targets, r.target + 1);
+    out.orientation = out.orientation || r.has_abc;
+  }
+  return out;
+}
+
 std::string format_artifact(const MeasurementSet& m) {
   std::string s = "a,b,distance_mm,angle_deg\n";
   for (const ArtifactTerm& a : m.artifact) {

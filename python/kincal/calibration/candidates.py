@@ -15,7 +15,7 @@ from .._core import Robot
 from .fitting import gravity_fitted
 
 if TYPE_CHECKING:
-    from .._core import Gravity, Measurements
+    from .._core import Gravity, MeasurementSet
 
 #: joint_map candidates: orders 1..MAX_MAP_ORDER, the cross-validation chooses
 MAX_MAP_ORDER = 8
@@ -84,7 +84,7 @@ def _needs_column(kind: _core.EffectKind) -> str:
     return "dir" if kind.needs == "dir" else kind.needs
 
 
-def candidates(robot: Robot, data: Measurements, start: Sequence[Candidate] = (),
+def candidates(robot: Robot, data: MeasurementSet, start: Sequence[Candidate] = (),
                gravity: str = "auto") -> tuple[list[Candidate], list[str]]:
     """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
     compliance as one JointCompliance in the form ``gravity`` gives) the data can support, and notes
@@ -96,16 +96,17 @@ def candidates(robot: Robot, data: Measurements, start: Sequence[Candidate] = ()
         if kind.domain != "serial":
             continue
         col = _needs_column(kind)
-        if col == "dir" and col not in data:
+        have_col = bool(col) and getattr(data, col) is not None  # a column of the set, by the kind's needs
+        if col == "dir" and not have_col:
             notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
             continue
-        if col == "temperature_c" and (col not in data or np.ptp(data["temperature_c"]) <= 0.5):
+        if col == "temperature_c" and (not have_col or np.ptp(np.asarray(data.temperature_c)) <= 0.5):
             notes.append(f"{kind.name} skipped: no temperature_c column, or it does not vary")
             continue
-        if col == "time_s" and (col not in data or np.ptp(data["time_s"]) <= 0):
+        if col == "time_s" and (not have_col or np.ptp(np.asarray(data.time_s)) <= 0):
             notes.append(f"{kind.name} skipped: no time_s column, or it does not vary")
             continue
-        if col and col not in data:
+        if col and not have_col:
             notes.append(f"{kind.name} skipped: the data have no {col} column")
             continue
         joints = applicable_joints(robot, kind) if kind.concerns == "joint" else [0]
@@ -140,7 +141,7 @@ def expand(effects: Sequence[Candidate], robot: Robot) -> tuple[list[_core.Effec
     return out, gravity
 
 
-def check_data(effects: Sequence[Candidate], data: Measurements, robot: Robot) -> None:
+def check_data(effects: Sequence[Candidate], data: MeasurementSet, robot: Robot) -> None:
     """The data columns the effects read (the registry's ``needs``) are present: a clear error names
     the file and the column otherwise."""
     # the core's check (JointCompliance reads no column of its own)

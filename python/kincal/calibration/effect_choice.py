@@ -39,7 +39,7 @@ from .linearisation import evaluate as evaluate, equations, prior_rows as _prior
 from ..stats.robust_scores import loss_threshold, robust_noise, robust_weights
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import BoolArray, FloatArray
 
 #: joint_map's smoothness penalty: order k's sine and cosine amplitudes weigh sqrt(lambda s) k (the
@@ -93,16 +93,16 @@ class Spec:
     def label(self) -> str:
         return " + ".join(["geometry"] + [e.label for e in self.effects])
 
-    def fit(self, data: Measurements, covariance: bool = False) -> _core.IdentifyResult:
+    def fit(self, data: MeasurementSet, covariance: bool = False) -> _core.IdentifyResult:
         eff, gravity = expand(self.effects, self.robot)
         return self.fit_options.fit(self.robot, data, eff, covariance=covariance, penalties=self.penalties,
                                     gravity=gravity)
 
-    def errors(self, res: _core.IdentifyResult, data: Measurements) -> FloatArray:
+    def errors(self, res: _core.IdentifyResult, data: MeasurementSet) -> FloatArray:
         return point_errors(res, data)
 
 
-def fitted_compliance_columns(res: _core.IdentifyResult, data: Measurements, spec: Spec) -> FloatArray:
+def fitted_compliance_columns(res: _core.IdentifyResult, data: MeasurementSet, spec: Spec) -> FloatArray:
     """The columns of JointCompliance("fit") for a model fitted without compliance (``res``, the model
     ``spec``): the model with it is fitted (its torques' mass moments with it), and its compliance
     columns are taken at that fit: each joint's deflection under the torques of the fitted moments.
@@ -125,7 +125,7 @@ class _Linearised:
     residual as the pseudo-residual of the fit's robust loss (robust_weights). ``step(cand)``: the
     linearisation after a step taken without a refit."""
 
-    def __init__(self, res: _core.IdentifyResult, data: Measurements, candidates: Sequence[Candidate], robot: Robot,
+    def __init__(self, res: _core.IdentifyResult, data: MeasurementSet, candidates: Sequence[Candidate], robot: Robot,
                  dims: int, fit: FitOptions, spec: Optional[Spec] = None) -> None:
         self.res, self.data, self.robot, self.dims, self.fit, self.spec = res, data, robot, dims, fit, spec
         have = {(e.name, e.joint) for e in res.layout.effect_list}
@@ -226,7 +226,7 @@ class SerialProblem:
     and the fitting options of every fit; ``fits``: every linearisation's fit, in order. ``dims``:
     residual coordinates per row (3; 6 with measured orientations)."""
 
-    def __init__(self, robot: Robot, data: Measurements, folds: list[BoolArray], fit: FitOptions,
+    def __init__(self, robot: Robot, data: MeasurementSet, folds: list[BoolArray], fit: FitOptions,
                  candidates: Sequence[Candidate] = ()) -> None:
         self.robot, self.data, self.folds, self.fit_options = robot, data, folds, fit
         self.candidates = list(candidates)
@@ -237,7 +237,7 @@ class SerialProblem:
         #: joint -> the refitted range-held-out RMS of each joint_map variant (refine())
         self.refined: dict[int, dict[str, Any]] = {}
         self.fits: list[tuple[list[Candidate], _core.IdentifyResult]] = []
-        self.dims = 6 if "abc" in data else 3
+        self.dims = 6 if data.abc is not None else 3
         self.point_dims = 3
         #: a residual below this (mm per coordinate) is the computation's, not the data's: noise-free data
         self.resolution = 1e-6
@@ -306,7 +306,7 @@ class SerialProblem:
         best = min(ss)
         i = next(j for j, v in enumerate(ss) if v <= best * (1.0 + engine.ORDER_MARGIN))
         e, pen, lam = offered[i]
-        n = len(self.data["pose"])
+        n = len(self.data.pose)
         self.refined[cand.joint] = {"order": e.order, "smoothing": lam, "linear_order": cand.order,
                                     "range_refit_rms_mm": [[o.order, l, float(np.sqrt(v / n))]
                                                            for (o, _, l), v in zip(offered, ss)]}
@@ -317,7 +317,7 @@ class SerialProblem:
         """joint_map's order and smoothing are chosen holding out, in turn, each of VARIANT_BLOCKS
         contiguous ranges of the joint's angle (equal numbers of points):
         a map must predict angles it has not seen, as it will on the next campaign."""
-        q = np.asarray(self.data["q_deg"], dtype=float)[:, cand.joint - 1]
+        q = np.asarray(self.data.q_deg, dtype=float)[:, cand.joint - 1]
         edges = np.quantile(q, np.linspace(0.0, 1.0, VARIANT_BLOCKS + 1))
         block = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, VARIANT_BLOCKS - 1)
         return [block == b for b in range(VARIANT_BLOCKS)]
@@ -330,7 +330,7 @@ class SerialProblem:
             layout = _core.PointModel(self.robot, 1, fit_gravity=effect.gravity == "fit").layout
             if effect.gravity == "masses":
                 if self._loaded is None:
-                    self._loaded = len(loaded_joints(self.robot, self.data["q_deg"], layout.loaded))
+                    self._loaded = len(loaded_joints(self.robot, self.data.q_deg, layout.loaded))
                 return self._loaded
             return sum(p.kind in ("compliance", "gravity_moment") for p in layout.parameters)
         return int(effect.size)
@@ -347,7 +347,7 @@ class SerialProblem:
         free = np.asarray(res.fixed) == 0
         unconstrained = int(np.sum(free & ~np.isfinite(np.asarray(res.prior_sd)))) + int(np.sum(res.held_unseen))
         added = sum(self.size(e) for e in list(effects)[len(start_effects):]) + self.size(cand)
-        return unconstrained + added <= len(self.data["pose"])
+        return unconstrained + added <= len(self.data.pose)
 
     def score_folds(self, cand: Candidate) -> Optional[list[BoolArray]]:
         """The folds on which a candidate must also gain (besides the configurations'): for a periodic
@@ -412,7 +412,7 @@ class Choice:
     problem: Optional[SerialProblem] = field(repr=False, default=None)
 
 
-def choose(robot: Robot, data: Measurements, fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5,
+def choose(robot: Robot, data: MeasurementSet, fit: FitOptions, *, start: Sequence[Candidate] = (), k_folds: int = 5,
            seed: int = 0, max_steps: int = 6, say: Callable[[str], None] = lambda s: None,
            fit_chosen: bool = True) -> Choice:
     """`--effects auto` on one data set: the stepwise search over the candidates from the

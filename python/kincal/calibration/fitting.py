@@ -27,7 +27,7 @@ from . import priors
 from .._core import Robot
 
 if TYPE_CHECKING:
-    from .._core import Gravity, Loss, Measurements
+    from .._core import Gravity, Loss, MeasurementSet
     from ..typing_ import BoolArray, FloatArray
 
 LOSSES = ("none", "huber", "cauchy")
@@ -95,7 +95,7 @@ class FitOptions:
         fit by grouped cross-validation when ``prior_scale`` is None)."""
         return priors.Fitter(robot, self.prior_model, auto_scale=self.auto_prior_scale, seed=seed)
 
-    def fit(self, robot: Robot, data: Measurements, effects: Sequence[_core.Effect] = (), *, covariance: bool = False,
+    def fit(self, robot: Robot, data: MeasurementSet, effects: Sequence[_core.Effect] = (), *, covariance: bool = False,
             penalties: Sequence[tuple[str, float]] = (), gravity: Optional[Gravity] = None, seed: int = 0,
             progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         """One fit of ``data`` with these options."""
@@ -132,7 +132,7 @@ def options(effects: Sequence[_core.Effect] = (), *, loss: Loss = "huber", loss_
     return o
 
 
-def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
+def folds(data: MeasurementSet, k: int, seed: int = 0) -> list[BoolArray]:
     """k masks of held-out rows, whole configurations per fold, as many as the configurations allow
     (at least 2 configurations; none when fewer)."""
     k = min(k, grouping.configurations(data).count)
@@ -145,13 +145,13 @@ def rms(e: FloatArray) -> float:
     return float(np.sqrt(np.mean(np.square(e)))) if len(e) else float("nan")
 
 
-def orientation_errors_deg(robot: Robot, data: Measurements) -> FloatArray:
+def orientation_errors_deg(robot: Robot, data: MeasurementSet) -> FloatArray:
     """Angle (deg) between the measured and the predicted tool orientation of every 6-D row (each
     row seen from its setup's placement, the model's drift at its time)."""
     return np.asarray(_core.orientation_errors(robot, data))
 
 
-def point_errors(res: _core.IdentifyResult, data: Measurements) -> FloatArray:
+def point_errors(res: _core.IdentifyResult, data: MeasurementSet) -> FloatArray:
     """3-D distance (mm) between each measured point and the fitted model's prediction (a probe row's
     error along its constraint, against the fit's station)."""
     return np.asarray(_core.point_errors(res.robot, res.targets, data, res.stations))

@@ -36,7 +36,7 @@ from .simulation import (DEFAULT_HARMONICS as DEFAULT_HARMONICS, DEFAULT_INSTRUM
                          simulate as simulate)
 
 if TYPE_CHECKING:
-    from .._core import Loss, Measurements
+    from .._core import Loss, MeasurementSet
     from ..typing_ import BoolArray, FloatArray
 
 #: order of a joint_map named without one (--effects joint_map:J; joint_map:J:K gives K)
@@ -102,23 +102,23 @@ def parse_effects(text: str, robot: Robot, harmonics: Sequence[int] = DEFAULT_HA
     return out
 
 
-def read_measurements(path: str, robot: Robot, artifact: str | None = None) -> Measurements:
+def read_measurements(path: str, robot: Robot, artifact: str | None = None) -> MeasurementSet:
     """The measurement CSV of the contract (errors name file:line and cause), with the known distances
     and angles between its probe stations from an artifact file."""
     data = _core.read_measurements(str(path), robot.dof, robot)  # the controller's joint numbers converted
     return _core.read_artifact(str(artifact), data, robot.dof) if artifact else data
 
 
-def measurements_csv(data: Measurements, dof: int) -> str:
+def measurements_csv(data: MeasurementSet, dof: int) -> str:
     return _core.format_measurements(data, dof)
 
 
-def split_poses(data: Measurements, holdout: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
+def split_poses(data: MeasurementSet, holdout: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
     """Row masks (fit, held out): a share of the configurations held out whole (grouping.split)."""
     return grouping.split(data, holdout, seed)
 
 
-def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
+def folds(data: MeasurementSet, k: int, seed: int = 0) -> list[BoolArray]:
     """k masks of held-out rows, whole configurations per fold (grouping.folds)."""
     return grouping.folds(data, k, seed)
 
@@ -267,12 +267,12 @@ def check_effects(effects: Union[str, Iterable[Union[str, Candidate]]], robot: R
     return out
 
 
-def _errors(r: _core.IdentifyResult, h: Measurements) -> dict[str, FloatArray]:
+def _errors(r: _core.IdentifyResult, h: MeasurementSet) -> dict[str, FloatArray]:
     """Position (and, with measured orientations, orientation) errors of the rows h: before (the
     nominal geometry, frames fitted) and after (the identified model r)."""
     out = {"ea": _core.point_errors(r.robot, r.targets, h, r.stations),
            "eb": _core.point_errors(r.nominal_fitted, r.nominal_targets, h, r.nominal_stations)}
-    if "abc" in h:  # the 6-D rows only (a mixed file's reflector rows have none)
+    if h.abc is not None:  # the 6-D rows only (a mixed file's reflector rows have none)
         oa = orientation_errors_deg(r.robot, h)
         if len(oa):
             out.update(oa=oa, ob=orientation_errors_deg(r.nominal_fitted, h))
@@ -280,12 +280,12 @@ def _errors(r: _core.IdentifyResult, h: Measurements) -> dict[str, FloatArray]:
 
 
 #: a training set's model: the model fitted on it and its effect choice (None: the effects were given)
-ModelOf = Callable[["Measurements"], "tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]"]
+ModelOf = Callable[["MeasurementSet"], "tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]"]
 #: the errors of a setup held out whole, on the model fitted on the others (_setup_refit)
-SetupRefit = Callable[[Robot, "Measurements"], "dict[str, FloatArray]"]
+SetupRefit = Callable[[Robot, "MeasurementSet"], "dict[str, FloatArray]"]
 
 
-def _fold_errors(model_of: ModelOf, data: Measurements, held_masks: Sequence[BoolArray],
+def _fold_errors(model_of: ModelOf, data: MeasurementSet, held_masks: Sequence[BoolArray],
                  progress: Optional[Callable[[int, int], None]], refit: Optional[SetupRefit] = None
                  ) -> tuple[dict[str, FloatArray], list[Optional[effect_choice.Choice]]]:
     """_errors of every held-out row, each fold predicted by the model fitted without it
@@ -317,7 +317,7 @@ def _fold_errors(model_of: ModelOf, data: Measurements, held_masks: Sequence[Boo
 def _setup_refit(loss: Loss, loss_scale_mm: float) -> SetupRefit:
     """The errors of a setup held out whole: its placement and targets refitted on its rows
     (validate()'s refit) on the model fitted on the other setups."""
-    def refit(robot: Robot, held: Measurements) -> dict[str, FloatArray]:
+    def refit(robot: Robot, held: MeasurementSet) -> dict[str, FloatArray]:
         ea, eb, oa, ob, _ = _refit_placements(robot, held, loss, loss_scale_mm)
         out = {"ea": ea, "eb": eb}
         if oa is not None and ob is not None:  # measured orientations: both, or neither
@@ -336,17 +336,17 @@ def _fit_options(fit: Optional[FitOptions], **kw: Any) -> FitOptions:
     return FitOptions(**kw)
 
 
-def _validation_scheme(data: Measurements, fit: FitOptions, *, hold_out_setups: bool, holdout: Optional[float],
+def _validation_scheme(data: MeasurementSet, fit: FitOptions, *, hold_out_setups: bool, holdout: Optional[float],
                        k_folds: int, seed: int
                        ) -> tuple[BoolArray, list[BoolArray], dict[str, Any], Optional[SetupRefit]]:
     """How identify() validates: the rows its model is fitted on, the held-out masks (each setup
     whole, a split of the configurations, or k folds of them; none), the validation's description
     and, for whole setups, the refit of a held setup's placement and targets."""
-    every_row = np.ones(len(data["pose"]), dtype=bool)
+    every_row = np.ones(len(data.pose), dtype=bool)
     refit: Optional[SetupRefit] = None
     val: dict[str, Any]
     if hold_out_setups:
-        codes = np.asarray(data.get("setup", np.zeros(len(data["pose"]), dtype=np.int64)))
+        codes = np.asarray(data.setup) if data.setup is not None else np.zeros(len(data), dtype=np.int64)
         if len(np.unique(codes)) < 2:
             raise ValueError("holding out whole setups needs a setup column with at least two setups")
         fit_mask, masks = every_row, [codes == c for c in np.unique(codes)]
@@ -362,14 +362,14 @@ def _validation_scheme(data: Measurements, fit: FitOptions, *, hold_out_setups: 
     elif k_folds > 1:
         fit_mask, masks = every_row, folds(data, k_folds, seed)
         val = dict(grouping.describe(data, f"{k_folds}-fold"),
-                   held_rows=int(len(data["pose"])), model_rows="every row (validated by cross-validation)")
+                   held_rows=int(len(data.pose)), model_rows="every row (validated by cross-validation)")
     else:
         fit_mask, masks = every_row, []
         val = {"scheme": "none", "held_rows": 0, "model_rows": "every row (not validated)"}
     return fit_mask, masks, val, refit
 
 
-def identify(robot: Robot, data: Measurements, *, effects: Union[str, Sequence[Union[str, Candidate]]] = "auto",
+def identify(robot: Robot, data: MeasurementSet, *, effects: Union[str, Sequence[Union[str, Candidate]]] = "auto",
              fit: Optional[FitOptions] = None, loss: str = "huber",
              loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM, prior_sd: Optional[dict[str, float]] = None,
              prior_scale: Union[float, str, None] = 1.0,
@@ -419,7 +419,7 @@ def identify(robot: Robot, data: Measurements, *, effects: Union[str, Sequence[U
     holdout = holdout or None  # a share of 0 holds nothing out
     core_effects, gravity_of = effect_choice.expand(effects, robot)
 
-    def model_of(train: Measurements) -> tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]:
+    def model_of(train: MeasurementSet) -> tuple[_core.IdentifyResult, Optional[effect_choice.Choice]]:
         """The model of a training set: its effects chosen on it (auto), then fitted on it."""
         if auto:
             ch = effect_choice.choose(robot, train, fit, k_folds=CHOICE_FOLDS, seed=seed)
@@ -461,7 +461,7 @@ def identify(robot: Robot, data: Measurements, *, effects: Union[str, Sequence[U
     if top is not None:
         info["effect_choice"] = choice_report(top, fold_choices, e, val, CHOICE_FOLDS)
     # the model records the angles its fit saw: where its periodic effects were measured
-    calibrated = r.robot.with_fitted_ranges(_core.joint_ranges(data["q_deg"][fit_mask]))
+    calibrated = r.robot.with_fitted_ranges(_core.joint_ranges(data.q_deg[fit_mask]))
     return Identification(robot=calibrated, targets=np.asarray(r.targets), fit=r, effects=list(core_effects),
                           validation=val, fit_info=info, worst=priors.down_weighted(r, train))
 

@@ -11,7 +11,7 @@ import numpy as np
 from .. import _core
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import BoolArray, FloatArray
 
 
@@ -19,7 +19,7 @@ def _key(p: _core.Parameter) -> tuple[str, int, int, str]:
     return (p.kind, p.joint, p.target, p.name)
 
 
-def evaluate(res: _core.IdentifyResult, data: Measurements, extra: Sequence[_core.Effect]
+def evaluate(res: _core.IdentifyResult, data: MeasurementSet, extra: Sequence[_core.Effect]
              ) -> tuple[FloatArray, FloatArray, FloatArray, list[_core.Parameter], dict[int, int]]:
     """The identification residual r and Jacobian J at a fit ``res`` with the ``extra`` effects'
     parameters appended (at zero): (r, the fit's free columns, J, the parameters, the fit's
@@ -53,11 +53,11 @@ def evaluate(res: _core.IdentifyResult, data: Measurements, extra: Sequence[_cor
     return np.asarray(r), cur, J, new, fit_of
 
 
-def equations(data: Measurements) -> Optional[BoolArray]:
+def equations(data: MeasurementSet) -> Optional[BoolArray]:
     """Per row and position coordinate, whether it carries an equation (a plane's or a ballbar's row
     has one: its first); None when every row has three."""
-    station = np.asarray(data.get("station", np.full(len(data["pose"]), -1)))
-    kinds = data.get("station_kinds", [])
+    station = np.asarray(data.station) if data.station is not None else np.full(len(data), -1)
+    kinds = data.station_kinds or []
     one = np.array([s >= 0 and kinds[s] in ("plane", "distance") for s in station], dtype=bool)
     if not one.any():
         return None
@@ -66,7 +66,7 @@ def equations(data: Measurements) -> Optional[BoolArray]:
     return used
 
 
-def prior_rows(res: _core.IdentifyResult, data: Measurements, fit_of: dict[int, int]
+def prior_rows(res: _core.IdentifyResult, data: MeasurementSet, fit_of: dict[int, int]
                 ) -> Optional[tuple[FloatArray, FloatArray]]:
     """On probe data, the fit's priors as pseudo-rows of the linearisation: for each of its free
     columns with a prior, noise / sd times the parameter's distance from the prior's centre, and
@@ -76,7 +76,7 @@ def prior_rows(res: _core.IdentifyResult, data: Measurements, fit_of: dict[int, 
     2.6e-5 mm), and a candidate the priors leave room for scores nothing. Tracker data keep the plain
     linearisation (their geometry is the data's; with these rows the UR10 series took transmission
     errors their folds do not support). None: no pseudo-rows."""
-    if not np.any(np.asarray(data.get("station", [-1])) >= 0):
+    if data.station is None or not np.any(np.asarray(data.station) >= 0):
         return None
     fixed, sd = np.asarray(res.fixed), np.asarray(res.prior_sd, dtype=float)
     x, x0 = np.asarray(res.x, dtype=float), np.asarray(res.start, dtype=float)

@@ -34,7 +34,7 @@ from ..stats.grouping import subset
 from .fitting import options
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import BoolArray, FloatArray, IntArray
 
 
@@ -144,15 +144,16 @@ def keep_out(robot: Robot, q: FloatArray, targets: FloatArray, rules: KeepOut) -
     return ok, {k: v for k, v in rejected.items() if v}
 
 
-def _campaign(robot: Robot, q: FloatArray, targets: FloatArray) -> Measurements:
+def _campaign(robot: Robot, q: FloatArray, targets: FloatArray) -> MeasurementSet:
     """A noise-free campaign at the nominal model (the instrument at the base), for the Jacobian."""
     n, t = len(q), len(targets)
     frames = _tool_frames(robot, q)
     pts = (frames[:, None, :3, :3] @ targets[None, :, :, None])[..., 0] + frames[:, None, :3, 3]
     rows = n * t
-    return {"pose": np.repeat(np.arange(n, dtype=np.int32), t), "q_deg": np.repeat(q, t, axis=0),
-            "xyz": pts.reshape(rows, 3), "target": np.tile(np.arange(t, dtype=np.int32), n),
-            "payload_kg": np.full(rows, np.nan), "line": np.zeros(rows, dtype=np.int32), "source": "<plan>"}
+    return _core.MeasurementSet({"pose": np.repeat(np.arange(n, dtype=np.int32), t), "q_deg": np.repeat(q, t, axis=0),
+                                 "xyz": pts.reshape(rows, 3), "target": np.tile(np.arange(t, dtype=np.int32), n),
+                                 "payload_kg": np.full(rows, np.nan), "line": np.zeros(rows, dtype=np.int32),
+                                 "source": "<plan>"}, robot.dof)
 
 
 def _jacobian(robot: Robot, q: FloatArray, targets: FloatArray, effects: list[_core.Effect],
@@ -320,13 +321,13 @@ def plan(robot: Robot, k: int, *, targets: FloatArray,
                 min_singular_value=float(s[-1]) if m else 0.0, candidates=int(len(q)), rejected=rejected)
 
 
-def select_observable(robot: Robot, candidates: Measurements, poses: int,
-                      compliance: bool = True) -> Measurements:
+def select_observable(robot: Robot, candidates: MeasurementSet, poses: int,
+                      compliance: bool = True) -> MeasurementSet:
     """Choose ``poses`` of the candidate campaign's poses that maximise observability: greedy
     D-optimal design on the nominal model's identification Jacobian (unit-scaled columns of the
     parameters a generic campaign identifies), each step adding the pose that most increases
     log det of the information matrix. Returns the chosen rows."""
-    n_targets = int(np.max(candidates["target"])) + 1
+    n_targets = int(np.max(candidates.target)) + 1
     res = _core.identify(robot, candidates, _core.IdentifyOptions(compliance=compliance, loss="none", max_iterations=0,
                                                                   covariance=False))
     free = ~np.asarray(res.fixed)
@@ -334,11 +335,11 @@ def select_observable(robot: Robot, candidates: Measurements, poses: int,
     _, J = pm.residuals(list(res.x), candidates, True)
     J = np.asarray(J)[:, free]
     J = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
-    ids = np.unique(candidates["pose"])
+    ids = np.unique(candidates.pose)
     if poses >= len(ids):
         return candidates
-    rows_of = {int(i): np.repeat(np.flatnonzero(candidates["pose"] == i) * 3, 3) + np.tile([0, 1, 2],
-               int(np.sum(candidates["pose"] == i))) for i in ids}
+    rows_of = {int(i): np.repeat(np.flatnonzero(candidates.pose == i) * 3, 3) + np.tile([0, 1, 2],
+               int(np.sum(candidates.pose == i))) for i in ids}
     p = J.shape[1]
     info = 1e-6 * np.eye(p)
     chosen: list[int] = []
@@ -355,4 +356,4 @@ def select_observable(robot: Robot, candidates: Measurements, poses: int,
         chosen.append(best)
         left.remove(best)
         info += J[rows_of[best]].T @ J[rows_of[best]]
-    return subset(candidates, np.isin(candidates["pose"], chosen))
+    return subset(candidates, np.isin(candidates.pose, chosen))

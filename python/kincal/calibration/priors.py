@@ -21,7 +21,7 @@ from ..stats import grouping
 from .._core import Robot
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
 
 #: prior standard deviations by kind (file units): a robot maker's tolerances for the joint geometry,
 #: a tool known to a few mm; none for the compliances (their size per kN m differs 100-fold between
@@ -108,18 +108,18 @@ class Fitter:
         self.auto_scale, self.folds, self.seed = auto_scale, folds, seed
         self.scales: list[float] = []
 
-    def _once(self, data: Measurements, opts: _core.IdentifyOptions,
+    def _once(self, data: MeasurementSet, opts: _core.IdentifyOptions,
               progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         return _core.identify(self.robot, data, opts, progress, self.from_calibrated)
 
-    def __call__(self, data: Measurements, opts: _core.IdentifyOptions,
+    def __call__(self, data: MeasurementSet, opts: _core.IdentifyOptions,
                  progress: Optional[Callable[[int, float], None]] = None) -> _core.IdentifyResult:
         if self.auto_scale and opts.prior_scale > 0:
             opts = _copy(opts, prior_scale=self.choose_scale(data, opts))
             self.scales.append(opts.prior_scale)
         return self._once(data, opts, progress)
 
-    def choose_scale(self, data: Measurements, opts: _core.IdentifyOptions) -> float:
+    def choose_scale(self, data: MeasurementSet, opts: _core.IdentifyOptions) -> float:
         """The overall prior width with the least grouped cross-validated RMS error on data."""
         k = min(self.folds, grouping.configurations(data).count)
         if k < 2:
@@ -152,16 +152,16 @@ def _copy(o: _core.IdentifyOptions, **changes: Any) -> _core.IdentifyOptions:
     return c
 
 
-def down_weighted(fit: _core.IdentifyResult, data: Measurements, n: int = 5) -> list[tuple[int, int, float, float]]:
+def down_weighted(fit: _core.IdentifyResult, data: MeasurementSet, n: int = 5) -> list[tuple[int, int, float, float]]:
     """The rows the robust loss down-weighted most: (pose, target, residual mm, weight), the weight
     the loss gives a row of that residual norm (Huber: scale / residual), smallest first."""
     scale = fit.loss_scale_mm
-    if not scale or not len(data["pose"]):
+    if not scale or not len(data.pose):
         return []
     e = np.asarray(_core.point_errors(fit.robot, fit.targets, data, fit.stations))
     w = np.minimum(1.0, scale / np.maximum(e, 1e-12))
     order = [i for i in np.argsort(w) if w[i] < 1.0][:n]
-    return [(int(data["pose"][i]), int(data["target"][i]), float(e[i]), float(w[i])) for i in order]
+    return [(int(data.pose[i]), int(data.target[i]), float(e[i]), float(w[i])) for i in order]
 
 
 def report(fit: _core.IdentifyResult, loss: str, given_scale: Optional[float], scale_choice: str) -> dict[str, Any]:

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Union, cast
+from typing import TYPE_CHECKING, Any, Callable, Literal, Optional, Sequence, Union
 
 import numpy as np
 
@@ -44,7 +44,7 @@ from .fitting import options
 from .plan import KeepOut, _tool_frames, keep_out, path_order
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import FloatArray, IntArray
 
 Kind = Literal["sphere", "plane", "distance"]
@@ -59,7 +59,7 @@ class ProbePlan:
     """The chosen touches (a measurement set without measurements: q_deg, kind, station, radius,
     length and the artifact of the stations as placed) and what they promise."""
     kind: str
-    data: Measurements
+    data: MeasurementSet
     tcp_uncertainty_mm: float         #: predicted RMS of the ball centre over the configurations, rigid part removed (median)
     tcp_uncertainty_p90_mm: float     #: its 90th percentile over repeated campaigns
     priors_tcp_mm: float              #: the same (median) for a robot one prior sd off the priors' centre, noise aside
@@ -72,9 +72,9 @@ class ProbePlan:
     left_out: list[tuple[str, str]]   #: (name, reason) of the parameters held on the whole pool
 
     def summary(self, noise_mm: float) -> str:
-        names = self.data["station_names"]
-        counts = np.bincount(np.asarray(self.data["station"]), minlength=len(names))
-        lines = [f"{len(self.data['pose'])} {self.kind} touches at {len(names)} stations ("
+        names = self.data.station_names or []
+        counts = np.bincount(np.asarray(self.data.station), minlength=len(names))
+        lines = [f"{len(self.data)} {self.kind} touches at {len(names)} stations ("
                  + ", ".join(f"{n}: {c}" for n, c in zip(names, counts)) + f"), chosen from {self.candidates} "
                  "candidates each (D-optimal, with identify's priors)",
                  f"predicted TCP uncertainty (the ball centre, RMS over {self.configurations} configurations after "
@@ -106,28 +106,22 @@ def rigid_rms(a: FloatArray, b: FloatArray) -> float:
     return float(np.sqrt(np.mean(np.sum((a @ m[:3, :3].T + m[:3, 3] - b) ** 2, axis=1))))
 
 
-def _subset(data: Measurements, rows: IntArray) -> Measurements:
+def _subset(data: MeasurementSet, rows: IntArray) -> MeasurementSet:
     """The rows ``rows`` of a measurement set, numbered again from 0 (its other entries as they are)."""
-    n = len(data["pose"])
-    # the same keys, the per-row arrays' rows picked: still a measurement set
-    out = cast("Measurements", {k: (v[rows] if isinstance(v, np.ndarray) and len(v) == n else v)
-                                for k, v in data.items()})
-    out["pose"] = np.arange(len(rows), dtype=np.int32)
-    return out
+    return data.subset(rows).with_columns(pose=np.arange(len(rows), dtype=np.int32))
 
 
-def _whitened_rows(J: FloatArray, data: Measurements, sigma: float) -> tuple[FloatArray, IntArray]:
+def _whitened_rows(J: FloatArray, data: MeasurementSet, sigma: float) -> tuple[FloatArray, IntArray]:
     """The Jacobian's rows of each touch (residual_size rows per row in J, the constraint's
     equations first) divided by the noise, as (touches, equations, columns), and each touch's
     station."""
-    n = len(data["pose"])
-    kinds = data["station_kinds"]
-    eq = {EQUATIONS[k] for k in kinds}
+    n = len(data.pose)
+    eq = {EQUATIONS[k] for k in data.station_kinds or []}
     if len(eq) != 1:
         raise ValueError("plan: one kind of station per plan")
     e = eq.pop()
     size = J.shape[0] // n
-    return J.reshape(n, size, -1)[:, :e, :] / sigma, np.asarray(data["station"], dtype=int)
+    return J.reshape(n, size, -1)[:, :e, :] / sigma, np.asarray(data.station, dtype=int)
 
 
 def _ball_jacobian(robot: Robot, q: FloatArray, probe: FloatArray, effects: list[_core.Effect],
@@ -137,9 +131,10 @@ def _ball_jacobian(robot: Robot, q: FloatArray, probe: FloatArray, effects: list
     frames = _tool_frames(robot, q)
     pts = frames[:, :3, :3] @ probe + frames[:, :3, 3]
     n = len(q)
-    data: Measurements = {"pose": np.arange(n, dtype=np.int32), "q_deg": q, "xyz": pts,
-                          "target": np.zeros(n, dtype=np.int32), "payload_kg": np.full(n, np.nan),
-                          "line": np.zeros(n, dtype=np.int32), "source": "<plan>", "dir": np.ones((n, robot.dof))}
+    data = _core.MeasurementSet({"pose": np.arange(n, dtype=np.int32), "q_deg": q, "xyz": pts,
+                                 "target": np.zeros(n, dtype=np.int32), "payload_kg": np.full(n, np.nan),
+                                 "line": np.zeros(n, dtype=np.int32), "source": "<plan>",
+                                 "dir": np.ones((n, robot.dof))}, robot.dof)
     pm = _core.PointModel(robot, 1, effects)
     x = np.asarray(pm.start(data), dtype=float)
     for p in pm.layout.parameters:
@@ -260,7 +255,7 @@ def plan_probe(robot: Robot, kind: Kind, *, stations: int = 3, touches: int = 25
     if np.max(np.abs(r)) > 1e-6 * max(1.0, float(np.max(np.abs(probe_v)))):
         raise AssertionError(f"plan: the candidates are {np.max(np.abs(r)):.3g} mm off their stations at the start")
     J = np.asarray(J)
-    n_rows = len(J) - len(pool.get("artifact", []))
+    n_rows = len(J) - len(pool.artifact or [])
     Jw, station = _whitened_rows(J[:n_rows], pool, noise_mm)
     # columns scaled: by the prior's sd where there is one, else to unit RMS over the pool's rows
     sd = np.asarray(res.prior_sd, dtype=float)[free]
@@ -297,7 +292,7 @@ def _nominal(robot: Robot) -> Robot:
     return robot.nominal_only() if robot.identified else robot
 
 
-def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> Measurements:
+def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> MeasurementSet:
     """The candidate touches: `kincal simulate --kind`'s campaign on the robot's nominal model, noise-free,
     without the candidates near a singularity (a touch there cannot be made again to the plan's
     orientation). Stations placed where the cone cannot be reached, or with fewer than ``needed``
@@ -311,9 +306,9 @@ def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> Mea
             if "block has 5 faces" in why:
                 raise
             continue
-        ok, _ = keep_out(robot, np.asarray(pool["q_deg"]), np.asarray(kw["probe"])[None, :],
+        ok, _ = keep_out(robot, np.asarray(pool.q_deg), np.asarray(kw["probe"])[None, :],
                          KeepOut(min_sigma=MIN_SIGMA))
-        counts = np.bincount(np.asarray(pool["station"])[ok], minlength=len(pool["station_names"]))
+        counts = np.bincount(np.asarray(pool.station)[ok], minlength=len(pool.station_names or []))
         if np.all(counts >= needed):
             return _subset(pool, np.flatnonzero(ok))
         why = f"a station with {int(counts.min())} of {kw['touches']} candidates away from singularities"
@@ -321,20 +316,20 @@ def _pool(robot: Robot, kind: Kind, needed: int, *, seed: int, **kw: Any) -> Mea
                      "--touches or a smaller --cone")
 
 
-def _path_within_stations(pool: Measurements, chosen: list[int]) -> IntArray:
+def _path_within_stations(pool: MeasurementSet, chosen: list[int]) -> IntArray:
     """The chosen touches station by station, each station's in a short path order (nearest
     neighbour in joint space)."""
-    st = np.asarray(pool["station"])[chosen]
+    st = np.asarray(pool.station)[chosen]
     ch = np.asarray(chosen)
     out = []
     for s in np.unique(st):
         mine = ch[st == s]
-        out.append(mine[path_order(np.asarray(pool["q_deg"])[mine])])
+        out.append(mine[path_order(np.asarray(pool.q_deg)[mine])])
     return np.concatenate(out)
 
 
-def measure(truth: Robot, plan: Measurements, probe: Sequence[float] = (0.0, 0.0, 150.0), noise_mm: float = 0.005,
-            seed: int = 1) -> Measurements:
+def measure(truth: Robot, plan: MeasurementSet, probe: Sequence[float] = (0.0, 0.0, 150.0), noise_mm: float = 0.005,
+            seed: int = 1) -> MeasurementSet:
     """The planned touches made on a true robot: each row's ball centre is where the plan put it on
     the nominal model (a sphere's centre, a point of a face, the ballbar's far end) with the same tool
     orientation, reached on the truth's calibrated model (Newton on its forward kinematics, from the
@@ -342,12 +337,12 @@ def measure(truth: Robot, plan: Measurements, probe: Sequence[float] = (0.0, 0.0
     plane's normal, the ballbar's measured length). The returned set holds the truth's angles."""
     rng = np.random.default_rng(seed)
     probe_v = np.asarray(probe, dtype=float)
-    q = np.asarray(plan["q_deg"], dtype=float).copy()
+    q = np.asarray(plan.q_deg, dtype=float).copy()
     nominal = _tool_frames(truth, q)
-    out = cast("Measurements", dict(plan))  # a copy: the same keys
-    kinds = [plan["station_kinds"][s] for s in plan["station"]]
-    dirs = np.asarray(plan["dir"], dtype=float) if "dir" in plan else None  # the last motion's, when recorded
-    length = np.asarray(plan["length_mm"], dtype=float).copy()
+    station_kinds = plan.station_kinds or []
+    kinds = [station_kinds[s] for s in np.asarray(plan.station)]
+    dirs = np.asarray(plan.dir, dtype=float) if plan.dir is not None else None  # the last motion's, when recorded
+    length = np.asarray(plan.length_mm, dtype=float).copy()
     for i in range(len(q)):
         target = nominal[i].copy()
         if kinds[i] == "sphere":
@@ -357,15 +352,14 @@ def measure(truth: Robot, plan: Measurements, probe: Sequence[float] = (0.0, 0.0
         else:
             length[i] += rng.normal(0.0, noise_mm)
         q[i] = _reach(truth, q[i], target, probe_v, None if dirs is None else dirs[i])
-    out["q_deg"] = q
-    out["length_mm"] = length
-    return out
+    return plan.with_columns(q_deg=q, length_mm=length)
 
 
-def _plane_normal(frames: FloatArray, plan: Measurements, i: int) -> FloatArray:
+def _plane_normal(frames: FloatArray, plan: MeasurementSet, i: int) -> FloatArray:
     """The unit normal of row i's plane, from the station's touches' tool axes (the probe points into
     the face, so their mean is along the inward normal)."""
-    rows = np.flatnonzero(np.asarray(plan["station"]) == plan["station"][i])
+    station = np.asarray(plan.station)
+    rows = np.flatnonzero(station == station[i])
     z = frames[rows, :3, 2].mean(axis=0)
     out: FloatArray = -z / np.linalg.norm(z)
     return out

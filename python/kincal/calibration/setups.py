@@ -5,7 +5,7 @@ The joint identification of every placement and the validation itself are in ide
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, Iterable, Mapping, Optional, Sequence, Union, cast
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
@@ -15,15 +15,12 @@ from .fitting import orientation_errors_deg, rms
 from .simulation import simulate
 
 if TYPE_CHECKING:
-    from .._core import Loss, Measurements
+    from .._core import Loss, MeasurementSet
     from ..typing_ import BoolArray, FloatArray
-
-    #: a measurement set's entry, whatever its key (Measurements: arrays, the source, names, artifact tuples)
-    Column = Union[np.ndarray, str, list[str], list[tuple[str, str, float, float, str]]]
 
 
 def simulate_setups(truth: Robot, placements: Mapping[str, Sequence[float]], poses: int = 150, *, seed: int = 1,
-                    **options: Any) -> Measurements:
+                    **options: Any) -> MeasurementSet:
     """A campaign measured from several instrument placements: ``placements`` maps each setup's
     name to the robot base frame seen from the instrument there, (x, y, z mm, a, b, c deg). Each
     setup measures ``poses`` random configurations (its own seed, ``seed`` + its index) with the
@@ -40,19 +37,18 @@ def simulate_setups(truth: Robot, placements: Mapping[str, Sequence[float]], pos
         if len(f) != 6:
             raise ValueError(f"simulate_setups: placement {name}: x, y, z, a, b, c")
         d = simulate(truth.with_placements([(str(name), f[:3], f[3:])]), poses, seed=seed + k, **options)
-        d["pose"] = d["pose"] + k * poses
-        d["setup"] = np.full(len(d["pose"]), k, dtype=np.int64)
-        if "time_s" in d:  # one setup after the other
-            d["time_s"] = d["time_s"] + t0
-            t0 = float(d["time_s"][-1]) + 60.0
-        parts.append(d)
-    # the parts' entries by name (the same keys in each): the arrays' rows concatenated, the rest the
-    # first part's; the result has the parts' keys, so it is a measurement set
-    cols = cast("list[Mapping[str, Column]]", parts)
-    out = cast("Measurements", {key: (np.concatenate([p[key] for p in cols]) if isinstance(cols[0][key], np.ndarray)
-                                      else cols[0][key]) for key in cols[0]})
+        c = d.columns()
+        c["pose"] = d.pose + k * poses
+        c["setup"] = np.full(len(d), k, dtype=np.int64)
+        if d.time_s is not None:  # one setup after the other
+            c["time_s"] = d.time_s + t0
+            t0 = float(d.time_s[-1]) + t0 + 60.0
+        parts.append(c)
+    # the parts' columns (the same in each): the arrays' rows concatenated, the rest the first part's
+    out = {key: (np.concatenate([p[key] for p in parts]) if isinstance(parts[0][key], np.ndarray)
+                 else parts[0][key]) for key in parts[0]}
     out["setup_names"] = [str(n) for n in placements]
-    return out
+    return _core.MeasurementSet(out, truth.dof)
 
 
 def with_setups(truth: Robot, placements: Mapping[str, Sequence[float]]) -> Robot:
@@ -124,7 +120,7 @@ def drift_report(fit: _core.IdentifyResult) -> Optional[dict[str, Any]]:
 
 
 def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[FloatArray],
-                       o_before: Optional[FloatArray], data: Measurements) -> dict[str, Any]:
+                       o_before: Optional[FloatArray], data: MeasurementSet) -> dict[str, Any]:
     """The figures of `kincal validate` from the position errors (mm) after (the calibrated model)
     and before (the nominal one) and, with measured orientations, the orientation errors (deg):
     ``points``, ``rms_mm``, ``mean_mm``, ``max_mm``, ``before_rms_mm`` (``before_mean_mm``,
@@ -133,7 +129,7 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
     ``rows``, ``after_rms_mm``, ``after_max_mm`` (the names of earlier versions)."""
     ea, eb = np.asarray(after), np.asarray(before)
     # the orientation errors are those of the 6-D rows (reflector rows among them have NaN a, b, c)
-    six_d = (~np.isnan(np.asarray(data["abc"], dtype=float)[:, 0]) if "abc" in data
+    six_d = (~np.isnan(np.asarray(data.abc, dtype=float)[:, 0]) if data.abc is not None
              else np.ones(len(ea), dtype=bool))
 
     def figures(mask: BoolArray) -> dict[str, Any]:
@@ -148,13 +144,13 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
 
     v = figures(np.ones(len(ea), dtype=bool))
     v.update(rows=v["points"], after_rms_mm=v["rms_mm"], after_max_mm=v["max_mm"])
-    if "setup" in data and len(data.get("setup_names", [])) > 1:
-        codes = np.asarray(data["setup"])
-        v["setups"] = {name: figures(codes == k) for k, name in enumerate(data["setup_names"]) if np.any(codes == k)}
+    if data.setup is not None and data.setup_names is not None and len(data.setup_names) > 1:
+        codes = np.asarray(data.setup)
+        v["setups"] = {name: figures(codes == k) for k, name in enumerate(data.setup_names) if np.any(codes == k)}
     return v
 
 
-def _refit_placements(robot: Robot, data: Measurements, loss: Loss = "huber", loss_scale_mm: float = 0.1,
+def _refit_placements(robot: Robot, data: MeasurementSet, loss: Loss = "huber", loss_scale_mm: float = 0.1,
                       target_start: Optional[Sequence[Sequence[float]]] = None) -> tuple[
         FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
@@ -163,7 +159,7 @@ def _refit_placements(robot: Robot, data: Measurements, loss: Loss = "huber", lo
 
     def frames_only(calibrated: bool) -> _core.IdentifyResult:
         # the calibrated geometry may load a joint the nominal one does not: each its own names
-        layout = _core.PointModel(robot, int(np.max(data["target"])) + 1, [], 20.0, calibrated, []).layout
+        layout = _core.PointModel(robot, int(np.max(data.target)) + 1, [], 20.0, calibrated, []).layout
         held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
         opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
                                      covariance=False)
@@ -175,7 +171,7 @@ def _refit_placements(robot: Robot, data: Measurements, loss: Loss = "huber", lo
     ea = np.asarray(_core.point_errors(cal.robot, cal.targets, data, cal.stations))
     eb = np.asarray(_core.point_errors(nom.robot, nom.targets, data, nom.stations))
     oa = ob = None
-    if "abc" in data:
+    if data.abc is not None:
         oa, ob = orientation_errors_deg(cal.robot, data), orientation_errors_deg(nom.robot, data)
     return ea, eb, oa, ob, cal
 
@@ -189,13 +185,13 @@ def extrapolated(robot: Robot, q_deg: FloatArray) -> list[dict[str, Any]]:
             for e in _core.extrapolated(robot, np.asarray(q_deg, dtype=float))]
 
 
-def inside_and_outside(robot: Robot, data: Measurements, loss: Loss = "huber",
+def inside_and_outside(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
                        loss_scale_mm: float = 0.1) -> dict[str, dict[str, Any]]:
     """validate()'s RMS (after, before) split between the rows that take none of the robot's periodic
     effects outside their fitted ranges and the rows that take one: ``{"inside": {"rows",
     "rms_mm", "before_rms_mm"}, "outside": {...}}`` (the placements refitted on every row)."""
     ea, eb, _, _, _ = _refit_placements(robot, data, loss, loss_scale_mm)
-    q = np.asarray(data["q_deg"], dtype=float)
+    q = np.asarray(data.q_deg, dtype=float)
     out = np.zeros(len(q), dtype=bool)
     for e in _core.extrapolated(robot, q):
         out |= np.asarray(_core.outside_range(q[:, e.joint - 1], e.fitted_deg))
@@ -206,7 +202,7 @@ def inside_and_outside(robot: Robot, data: Measurements, loss: Loss = "huber",
     return {"inside": part(~out), "outside": part(out)}
 
 
-def validate(robot: Robot, data: Measurements, loss: Loss = "huber", loss_scale_mm: float = 0.1,
+def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber", loss_scale_mm: float = 0.1,
              target_start: Optional[Sequence[Sequence[float]]] = None) -> dict[str, Any]:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
@@ -223,10 +219,10 @@ def validate(robot: Robot, data: Measurements, loss: Loss = "huber", loss_scale_
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
     ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm, target_start)
     v = validation_figures(ea, eb, oa, ob, data)
-    v.update(source=str(data.get("source", "<data>")), targets_mm=np.asarray(cal.targets).tolist(),
+    v.update(source=str(data.source), targets_mm=np.asarray(cal.targets).tolist(),
              refitted="the instrument placement of every setup and the target offsets"
-                      + (", the probe stations" if data.get("station_names") else "")
+                      + (", the probe stations" if data.station_names else "")
                       + "; the model's geometry and effects held (its drift left out)",
              placements=setup_frames(cal.setups),
-             extrapolated=extrapolated(robot, data["q_deg"]))
+             extrapolated=extrapolated(robot, data.q_deg))
     return v

@@ -12,7 +12,7 @@ from .. import _core
 from .._core import Robot
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
 
 #: reflector offsets (mm, tool frame) used by `kincal simulate --targets N`
 DEFAULT_TARGETS = np.array([[0.0, 0.0, 0.0], [120.0, 0.0, 30.0], [0.0, 150.0, -20.0], [-100.0, -80.0, 40.0]])
@@ -35,7 +35,7 @@ def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg:
 def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float = 0.02, targets: int = 1,
              outlier_fraction: float = 0.0, outlier_mm: float = 5.0, effects: Sequence[HiddenEffect] = (),
              t_ref: float = 20.0, orientation_noise_deg: Optional[float] = None,
-             duration_h: Optional[float] = None) -> Measurements:
+             duration_h: Optional[float] = None) -> MeasurementSet:
     """Measure ``poses`` random configurations (inside the joint limits) of the truth's calibrated
     model with ``targets`` reflectors, Gaussian noise per coordinate and optional gross outliers.
     ``effects`` hides more effects in the truth: (Effect, values) or (name, joint from 1 or 0, values),
@@ -57,16 +57,21 @@ def simulate(truth: Robot, poses: int = 150, *, seed: int = 1, noise_mm: float =
         raise ValueError(f"the outlier fraction must be in 0..1, not {outlier_fraction}")
     if duration_h is not None and not (duration_h > 0 and math.isfinite(duration_h)):
         raise ValueError(f"the campaign's duration must be a positive number of hours, not {duration_h}")
-    return _core.simulate(truth, poses, seed, noise_mm, outlier_fraction, outlier_mm, DEFAULT_TARGETS[:targets], 0.9,
-                          [_effect_value(e) for e in effects], t_ref,
-                          -1.0 if orientation_noise_deg is None else float(orientation_noise_deg),
-                          0.0 if duration_h is None else 3600.0 * float(duration_h))
+    o = _core.SimulationOptions()
+    o.poses, o.seed, o.noise_mm = poses, seed, noise_mm
+    o.outlier_fraction, o.outlier_mm = outlier_fraction, outlier_mm
+    o.targets = DEFAULT_TARGETS[:targets]
+    o.effects = [_effect_value(e) for e in effects]
+    o.t_ref = t_ref
+    o.orientation_noise_deg = -1.0 if orientation_noise_deg is None else float(orientation_noise_deg)
+    o.duration_s = 0.0 if duration_h is None else 3600.0 * float(duration_h)
+    return _core.simulate(truth, o)
 
 
 def simulate_probe(truth: Robot, kind: Literal["sphere", "plane", "distance"], *, stations: int = 3, touches: int = 25, cone_deg: float = 35.0,
                    probe: Sequence[float] = (0.0, 0.0, 150.0), radius_mm: float = 3.0, length_mm: float = 150.0,
                    block_mm: float = 400.0, noise_mm: float = 0.005, seed: int = 1,
-                   artifact: bool = True) -> Measurements:
+                   artifact: bool = True) -> MeasurementSet:
     """A probe campaign (no tracker) on the truth's calibrated model: ``kind`` 'sphere' (the ball in
     ``stations`` fixed nests placed in reach), 'plane' (the faces of one block of ``block_mm``: top,
     the face towards the robot, the sideways ones, the surface plate it stands on) or 'distance' (a ballbar of

@@ -9,7 +9,6 @@ import json
 import sys
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -24,8 +23,6 @@ from .options import (artifact_opt, artifact_out, effect_opts, effects_arg, fit_
                       loss_opts, probe_offset, probe_opts, probe_start, progress, robot_of, robot_opts, say, step_progress,
                       tool_targets)
 
-if TYPE_CHECKING:
-    from .._core import Measurements
 
 
 def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.Robot) -> None:
@@ -34,17 +31,16 @@ def _simulate_probe(args: argparse.Namespace, robot: _core.Robot, truth: _core.R
     data = sim.simulate_probe(truth, args.kind, stations=args.stations, touches=args.touches, cone_deg=args.cone,
                               probe=probe, radius_mm=args.radius, length_mm=args.length, block_mm=args.block,
                               noise_mm=0.005 if args.noise is None else args.noise, seed=args.seed)
-    # the controller's numbers (the same keys: still a measurement set)
-    data = cast("Measurements", dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"])))
+    data = data.with_columns(q_deg=_core.joints_to_controller(robot, data.q_deg))  # the controller's numbers
     art = artifact_out(args)
     text = ident.measurements_csv(data, robot.dof)
-    artifact = _core.format_artifact(data, robot.dof) if "artifact" in data else None
+    artifact = _core.format_artifact(data, robot.dof) if data.artifact is not None else None
     _core.write_file_atomic(args.out, text)
     if artifact:
         _core.write_file_atomic(art, artifact)
     if args.truth_out and not args.truth:  # the truth drawn, once the campaign on it was made
         _core.write_file_atomic(args.truth_out, truth.to_json())
-    print(f"wrote {len(data['pose'])} {args.kind} rows at {len(data['station_names'])} stations to {args.out}"
+    print(f"wrote {len(data)} {args.kind} rows at {len(data.station_names or [])} stations to {args.out}"
           + (f", their known distances and angles to {art}" if artifact else ""), file=sys.stderr)
 
 
@@ -75,10 +71,9 @@ def cmd_simulate(args: argparse.Namespace) -> None:
     if args.select == "observability":
         from ..calibration import plan
         data = plan.select_observable(robot, data, args.poses)
-    # the controller's numbers (the same keys: still a measurement set)
-    data = cast("Measurements", dict(data, q_deg=_core.joints_to_controller(robot, data["q_deg"])))
+    data = data.with_columns(q_deg=_core.joints_to_controller(robot, data.q_deg))  # the controller's numbers
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
-    print(f"wrote {len(data['pose'])} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
+    print(f"wrote {len(data)} measured points of {args.poses} poses to {args.out}", file=sys.stderr)
 
 
 def cmd_identify(args: argparse.Namespace) -> None:
@@ -117,7 +112,7 @@ def cmd_validate(args: argparse.Namespace) -> None:
     # not see, a reflector's along the axis every orientation shares, is then held there, not at the flange)
     start = probe_start(args)
     carried = carried_targets(args.model)
-    n_targets = int(np.max(data["target"])) + 1 if len(data["target"]) else 0
+    n_targets = int(np.max(data.target)) + 1 if len(data.target) else 0
     from_model = start is None and carried is not None and len(carried) == n_targets
     v = ident.validate(robot, data, loss=args.loss, loss_scale_mm=args.loss_scale,
                        target_start=carried.tolist() if from_model and carried is not None else start)

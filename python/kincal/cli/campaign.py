@@ -7,15 +7,12 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from typing import TYPE_CHECKING, cast
 
 from .. import _core
 from ..calibration import identify as ident
 from ..io.csv_text import format_rows
 from .options import artifact_out, effect_opts, probe_offset, probe_opts, robot_of, robot_opts, step_progress
 
-if TYPE_CHECKING:
-    from .._core import Measurements
 
 
 def _numbers(text: str, n: int, option: str) -> list[float]:
@@ -45,13 +42,12 @@ def _plan_probe(args: argparse.Namespace, robot: _core.Robot) -> None:
                                 seed=args.seed, progress=step_progress("plan"))
     if sys.stderr.isatty():
         print(file=sys.stderr)
-    # the controller's numbers (the same keys: still a measurement set)
-    data = cast("Measurements", dict(res.data, q_deg=_core.joints_to_controller(robot, res.data["q_deg"])))
+    data = res.data.with_columns(q_deg=_core.joints_to_controller(robot, res.data.q_deg))  # the controller's numbers
     art = artifact_out(args)
     _core.write_file_atomic(args.out, ident.measurements_csv(data, robot.dof))
     _core.write_file_atomic(art, _core.format_artifact(data, robot.dof))
     print(res.summary(noise))
-    print(f"wrote {len(data['pose'])} touches (the commanded angles on the nominal model: replace each row's angles "
+    print(f"wrote {len(data)} touches (the commanded angles on the nominal model: replace each row's angles "
           f"with the controller's reading at the touch) to {args.out}, the stations' distances and angles as "
           f"placed to {art}")
 

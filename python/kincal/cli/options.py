@@ -7,7 +7,7 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Optional, Union, cast
+from typing import TYPE_CHECKING, Callable, Optional, Union
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from ..calibration.effect_choice import check_data
 from ..calibration.fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, masses
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import FloatArray
 
 
@@ -134,22 +134,22 @@ def fit_options(args: argparse.Namespace, robot: _core.Robot) -> FitOptions:
                       artifact_sd_mm=args.artifact_sd)
 
 
-def effects_arg(args: argparse.Namespace, robot: _core.Robot, data: Measurements) -> Union[str, list[_core.Effect]]:
+def effects_arg(args: argparse.Namespace, robot: _core.Robot, data: MeasurementSet) -> Union[str, list[_core.Effect]]:
     """--effects: "auto" (identify's default) or a list (checked against the data's columns)."""
     if args.effects.strip() == "auto":
         return "auto"
     effects = ident.parse_effects(args.effects, robot, args.harmonics)
-    check_data(effects, cast("Measurements", dict(data, source=args.data)), robot)  # named by its file
+    check_data(effects, data.with_columns(source=args.data), robot)  # named by its file
     return effects
 
 
-def tool_targets(path: Optional[str], data: Measurements, data_path: str) -> Optional[FloatArray]:
+def tool_targets(path: Optional[str], data: MeasurementSet, data_path: str) -> Optional[FloatArray]:
     """--tool-targets: x,y,z of each target of the measurements in the tool frame, one row each
     (checked before any fit: an error names the file and both counts)."""
     if not path:
         return None
     known = _core.read_csv_columns(path, ["x", "y", "z"])
-    n = int(np.max(data["target"])) + 1
+    n = int(np.max(data.target)) + 1
     if len(known) != n:
         raise ValueError(f"{path}: {len(known)} rows, but {data_path} measures {n} target(s) (one row of x,y,z per "
                          "target in the tool frame, in target order)")

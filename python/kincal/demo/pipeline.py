@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Optional, cast
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
 
@@ -40,7 +40,7 @@ from ..io import strict_json
 from ..io.csv_text import format_rows
 
 if TYPE_CHECKING:
-    from .._core import CompensationResult, Measurements, Robot
+    from .._core import CompensationResult, Robot
     from ..typing_ import FloatArray
 
 SEED = 7
@@ -148,13 +148,13 @@ def _spheres(out: Path, robot: Robot, truth: Robot, tracker_model: Robot, diagno
                                  configurations=q, seed=SEED)
     touches = probe_plan.measure(truth, plan.data, PROBE, 0.005, seed=SEED)  # the truth's backlash acting
     _core.write_file_atomic(str(out / "spheres.csv"), ident.measurements_csv(  # the controller's numbers
-        cast("Measurements", dict(touches, q_deg=_core.joints_to_controller(robot, touches["q_deg"]))), robot.dof))
+        touches.with_columns(q_deg=_core.joints_to_controller(robot, touches.q_deg)), robot.dof))
     _core.write_file_atomic(str(out / "spheres-artifact.csv"), _core.format_artifact(touches, robot.dof))
     res = ident.identify(robot, touches, fit=FitOptions(target_start=[PROBE]))
     _core.write_file_atomic(str(out / "spheres_model.json"), res.model_json())
     ball = np.asarray(PROBE)
     t = probe_plan.ball_centres(truth, q, ball)
-    return {"touches": int(len(touches["pose"])), "stations": 6, "predicted_mm": plan.tcp_uncertainty_mm,
+    return {"touches": int(len(touches.pose)), "stations": 6, "predicted_mm": plan.tcp_uncertainty_mm,
             "effects": res.effect_labels(), "nominal_mm": probe_plan.rigid_rms(probe_plan.ball_centres(robot, q, ball), t),
             "spheres_mm": probe_plan.rigid_rms(probe_plan.ball_centres(res.robot, q, np.asarray(res.targets)[0]), t),
             "tracker_mm": probe_plan.rigid_rms(probe_plan.ball_centres(tracker_model, q, ball), t),

@@ -20,7 +20,7 @@ offsets as temperature_c, a compliance that is not linear as a gravity torque.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Literal, Sequence, Union
+from typing import TYPE_CHECKING, Any, Sequence, Union
 
 import numpy as np
 
@@ -28,7 +28,7 @@ from .. import _core
 from .._core import Robot
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import BoolArray, FloatArray
 
 #: knots of the piecewise-linear functions of a continuous variable (at its quantiles)
@@ -40,10 +40,10 @@ RIDGE = 1e-2
 CARRIES = 0.05
 
 
-def variables(robot: Robot, data: Measurements) -> list[dict[str, Any]]:
+def variables(robot: Robot, data: MeasurementSet) -> list[dict[str, Any]]:
     """The candidate variables of a measurement set: dicts with ``variable`` (its name), ``label``
     (in words, with unit), ``values`` (one per row) and ``discrete``."""
-    q = np.asarray(data["q_deg"], dtype=float)
+    q = np.asarray(data.q_deg, dtype=float)
     n, dof = q.shape
     out = [{"variable": f"q{j + 1}", "label": f"joint {j + 1} angle (deg)", "values": q[:, j], "discrete": False}
            for j in range(dof)]
@@ -52,15 +52,15 @@ def variables(robot: Robot, data: Measurements) -> list[dict[str, Any]]:
         tau = gravity_torques(robot, q)
         out += [{"variable": f"tau{j}", "label": f"gravity torque on joint {j} (kN m)",
                  "values": tau[:, j - 1] / 1000.0, "discrete": False} for j in loaded]
-    key: Literal["temperature_c", "time_s"]  # the measurement set's optional columns of these names
-    for key, label in (("temperature_c", "temperature (deg C)"), ("time_s", "measurement time (s)")):
-        if key in data and np.ptp(np.asarray(data[key], dtype=float)) > 0:
-            out.append({"variable": key, "label": label, "values": np.asarray(data[key], dtype=float),
+    for key, label, col in (("temperature_c", "temperature (deg C)", data.temperature_c),
+                            ("time_s", "measurement time (s)", data.time_s)):
+        if col is not None and np.ptp(np.asarray(col, dtype=np.float64)) > 0:
+            out.append({"variable": key, "label": label, "values": np.asarray(col, dtype=np.float64),
                         "discrete": False})
     out.append({"variable": "order", "label": "measurement order (row of the file)",
                 "values": np.arange(n, dtype=float), "discrete": False})
-    if "dir" in data:
-        d = np.asarray(data["dir"], dtype=float)
+    if data.dir is not None:
+        d = np.asarray(data.dir, dtype=float)
         out += [{"variable": f"dir{j + 1}", "label": f"joint {j + 1} motion direction (sign)", "values": d[:, j],
                  "discrete": True} for j in range(dof) if len(np.unique(d[:, j])) > 1]
     return out
@@ -71,7 +71,7 @@ def gravity_torques(robot: Robot, q_deg: FloatArray) -> FloatArray:
     return np.array([_core.gravity_torque(robot, qq)[0] for qq in np.asarray(q_deg, dtype=float)])
 
 
-def carriers(res: _core.IdentifyResult, data: Measurements) -> tuple[FloatArray, FloatArray]:
+def carriers(res: _core.IdentifyResult, data: MeasurementSet) -> tuple[FloatArray, FloatArray]:
     """The residual r (dims per row) of a fit and the carriers C (one column per way the model moves
     a point: the instrument's 6 placement parameters, then each joint's angle, in mm per rad) at
     that fit."""
@@ -81,9 +81,9 @@ def carriers(res: _core.IdentifyResult, data: Measurements) -> tuple[FloatArray,
     extra = [_core.Effect("joint_map", j, order=1) for j in range(1, dof + 1)]
     r, _, J, new, fit_of = evaluate(res, data, extra)
     base = [p.index for p in new if p.kind == "base"]
-    n = len(data["pose"])
+    n = len(data.pose)
     dims = len(r) // n
-    q = np.radians(np.asarray(data["q_deg"], dtype=float))
+    q = np.radians(np.asarray(data.q_deg, dtype=float))
     s, c = np.repeat(np.sin(q), dims, axis=0), np.repeat(np.cos(q), dims, axis=0)
     # the appended maps' (sine, cosine) columns, joint by joint (not the fit's own, nor a probe
     # campaign's stations after them)

@@ -23,12 +23,12 @@ from ..calibration.fitting import FitOptions
 from . import residual_vars
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import FloatArray
 
 __all__ = ["JointCompliance", "SerialProblem", "Spec", "candidates", "diagnose", "final_identification", "step_effect"]
 
-def diagnose(robot: Robot, data: Measurements, *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
+def diagnose(robot: Robot, data: MeasurementSet, *, folds: int = 5, alpha: float = ALPHA, min_gain: float = MIN_GAIN,
              max_steps: int = 6, seed: int = 0, noise_mm: Optional[float] = None,
              progress: Optional[Callable[[str], None]] = None,
              effects: Union[str, Sequence[Union[str, Candidate]]] = (),
@@ -88,7 +88,7 @@ def step_effect(step: dict[str, Any]) -> Candidate:
     return _core.Effect(step["effect"], step["joint"] or 0)
 
 
-def final_identification(robot: Robot, data: Measurements, diag: dict[str, Any],
+def final_identification(robot: Robot, data: MeasurementSet, diag: dict[str, Any],
                          tool_targets: Optional[FloatArray] = None) -> ident.Identification:
     """The diagnosed model (every named effect and those it started from), identified on all the data
     with Ceres as `kincal identify` does (covariance included), ready for model.json; with
@@ -98,7 +98,7 @@ def final_identification(robot: Robot, data: Measurements, diag: dict[str, Any],
     res = ident.identify(robot, data, effects=spec.effects, k_folds=0, penalties=spec.penalties, fit=spec.fit_options)
     res.validation = {"scheme": f"fitted on every row; cross-validated in the diagnosis ({diag['validation']['scheme']}, "
                                 f"{diag['validation']['configurations']} configurations)",
-                      "held_rows": 0, "fit_rows": int(len(data["pose"])),
+                      "held_rows": 0, "fit_rows": int(len(data.pose)),
                       "diagnosis_cv_rms_mm": diag["final_rms_mm"]}
     if tool_targets is not None:
         res = ident.tool_from_targets(res, tool_targets)

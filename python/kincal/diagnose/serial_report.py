@@ -17,7 +17,7 @@ from ..stats.stepwise import noise_phrase
 from .serial import Spec, step_effect
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..calibration.effect_choice import Candidate
     from ..typing_ import BoolArray, FloatArray
 
@@ -27,23 +27,23 @@ def _label(step: dict[str, Any]) -> str:
     return e.label + (f", order {e.order}" if e.kind.ordered else "")
 
 
-def _variable(robot: Robot, data: Measurements, effect: str, joint: Optional[int]) -> tuple[FloatArray, str]:
+def _variable(robot: Robot, data: MeasurementSet, effect: str, joint: Optional[int]) -> tuple[FloatArray, str]:
     """The natural variable of an effect for plots: (values per point, axis label)."""
     j = joint or 1
     kind = _core.effect_kind(effect)
     if kind.harmonic:
-        return data["q_deg"][:, j - 1], f"q{joint} (deg)"
+        return data.q_deg[:, j - 1], f"q{joint} (deg)"
     if kind.needs == "dir":
-        return data["dir"][:, j - 1] + np.random.default_rng(0).uniform(-0.15, 0.15, len(data["pose"])), \
+        return np.asarray(data.dir)[:, j - 1] + np.random.default_rng(0).uniform(-0.15, 0.15, len(data)), \
             f"dir{joint} (sign of the last motion, jittered)"
     if kind.needs == "temperature_c":
-        return data["temperature_c"], "temperature (C)"
+        return np.asarray(data.temperature_c, dtype=np.float64), "temperature (C)"
     if kind.needs == "time_s":
-        return np.asarray(data["time_s"]) / 3600.0, "time of the measurement (h)"
+        return np.asarray(data.time_s) / 3600.0, "time of the measurement (h)"
     if joint is None:  # compliance of every loaded joint: the shoulder's gravity torque, when the masses are known
-        tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, 1] / 1000.0
-        return (tau, "gravity torque on joint 2 (kN m)") if np.ptp(tau) > 0 else (data["q_deg"][:, 1], "q2 (deg)")
-    tau = residual_vars.gravity_torques(robot, data["q_deg"])[:, j - 1] / 1000.0
+        tau = residual_vars.gravity_torques(robot, data.q_deg)[:, 1] / 1000.0
+        return (tau, "gravity torque on joint 2 (kN m)") if np.ptp(tau) > 0 else (data.q_deg[:, 1], "q2 (deg)")
+    tau = residual_vars.gravity_torques(robot, data.q_deg)[:, j - 1] / 1000.0
     return tau, f"gravity torque on joint {joint} (kN m)"
 
 
@@ -52,12 +52,12 @@ def _variable(robot: Robot, data: Measurements, effect: str, joint: Optional[int
 LEVER = 0.25
 
 
-def _joint_error(res: _core.IdentifyResult, data: Measurements, joint: int) -> tuple[FloatArray, BoolArray]:
+def _joint_error(res: _core.IdentifyResult, data: MeasurementSet, joint: int) -> tuple[FloatArray, BoolArray]:
     """The angle error of ``joint`` (deg) each row's residual implies: the least-squares joint-angle
     change that would close it (-J_j . r / J_j . J_j, J_j the joint's column at the fit); and which
     rows the joint moves enough (|J_j| at least LEVER times the median row's) to read it."""
     r, C = residual_vars.carriers(res, data)
-    n = len(data["pose"])
+    n = len(data.pose)
     Jj = C[:, 6 + joint - 1].reshape(n, -1)
     rr = r.reshape(n, -1)
     lever = np.sqrt(np.sum(Jj * Jj, axis=1))
@@ -65,7 +65,7 @@ def _joint_error(res: _core.IdentifyResult, data: Measurements, joint: int) -> t
     return err, lever >= LEVER * np.median(lever)
 
 
-def _effect_curve(res: _core.IdentifyResult, data: Measurements, effect: Candidate,
+def _effect_curve(res: _core.IdentifyResult, data: MeasurementSet, effect: Candidate,
                   var: FloatArray) -> Optional[tuple[FloatArray, FloatArray]]:
     """The identified effect as a joint-angle change (deg) along its variable, sorted, less its mean
     over the points (a constant change is the joint's offset, which the geometry carries, so the
@@ -90,7 +90,7 @@ def _effect_curve(res: _core.IdentifyResult, data: Measurements, effect: Candida
     return xs, dq(xs) - float(np.mean(dq(np.asarray(var, dtype=float))))
 
 
-def _step_figure(plt: ModuleType, robot: Robot, data: Measurements, k: int, st: dict[str, Any],
+def _step_figure(plt: ModuleType, robot: Robot, data: MeasurementSet, k: int, st: dict[str, Any],
                  before_fit: _core.IdentifyResult, after_fit: _core.IdentifyResult, path: Path) -> None:
     """The residual against the variable that carries a step's effect, before and after it was
     added: as the joint's implied angle error for a joint-angle effect (with the identified effect's
@@ -147,7 +147,7 @@ def _share(share: float) -> str:
     return f"{share:.1%}" if share > 0 else f"none ({share:.1%})"
 
 
-def _point_errors(res: _core.IdentifyResult, data: Measurements) -> FloatArray:
+def _point_errors(res: _core.IdentifyResult, data: MeasurementSet) -> FloatArray:
     return _core.point_errors(res.robot, res.targets, data)
 
 
@@ -174,14 +174,14 @@ def _variables_figure(plt: ModuleType, scores: list[dict[str, Any]], path: Path)
     plt.close(fig)
 
 
-def _residual_figure(plt: ModuleType, data: Measurements, e0: FloatArray, e1: FloatArray, path: Path) -> None:
+def _residual_figure(plt: ModuleType, data: MeasurementSet, e0: FloatArray, e1: FloatArray, path: Path) -> None:
     """The rows' errors with the starting model (e0) and the final one (e1): a map of the measured
     points in the instrument frame; for a campaign with probe rows each row's error along its
     constraint against the configurations, one colour per station (tracker points as one more)."""
-    station = np.asarray(data.get("station", np.full(len(data["pose"]), -1)))
+    station = np.asarray(data.station) if data.station is not None else np.full(len(data), -1)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
     if np.any(station >= 0):
-        names = list(data["station_names"])
+        names = list(data.station_names or [])
         groups = [(k, names[k]) for k in range(len(names))] + ([(-1, "tracker points")] if np.any(station < 0) else [])
         row = np.arange(len(station))
         for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
@@ -196,7 +196,7 @@ def _residual_figure(plt: ModuleType, data: Measurements, e0: FloatArray, e1: Fl
     else:
         norm = report.error_norm(np.concatenate([e0, e1]) * 1000)
         for ax, e, lab in ((axes[0], e0, "starting model"), (axes[1], e1, "final model")):
-            sc = ax.scatter(data["xyz"][:, 0], data["xyz"][:, 1], c=e * 1000, s=8, cmap="viridis", norm=norm)
+            sc = ax.scatter(data.xyz[:, 0], data.xyz[:, 1], c=e * 1000, s=8, cmap="viridis", norm=norm)
             ax.set_title(f"{lab}: RMS {np.sqrt(np.mean(e ** 2)) * 1000:.1f} um (fitted points)", fontsize=10)
             ax.set_xlabel("x (mm, instrument)")
             ax.set_aspect("equal")
@@ -206,7 +206,7 @@ def _residual_figure(plt: ModuleType, data: Measurements, e0: FloatArray, e1: Fl
     plt.close(fig)
 
 
-def write_report(robot: Robot, data: Measurements, diag: dict[str, Any], out_dir: Union[str, Path],
+def write_report(robot: Robot, data: MeasurementSet, diag: dict[str, Any], out_dir: Union[str, Path],
                  title: str = "kincal diagnose", model_file: Optional[str] = None) -> list[str]:
     """Figures and report.html of a diagnosis in out_dir; returns the files written. ``model_file``:
     the name of the final model's JSON written beside it (said in the report)."""
@@ -269,7 +269,7 @@ def write_report(robot: Robot, data: Measurements, diag: dict[str, Any], out_dir
         f"the data, ready for <code>kincal compensate --model {report.esc(model_file)}</code>.</p>")
     steps_img = "".join(report.figure(f, f) for f in files if f.startswith("step"))
     body = f"""<h1>{report.esc(title)}</h1>
-<p>{len(data['pose'])} measured points. Each step scores every candidate effect of the library against the
+<p>{len(data)} measured points. Each step scores every candidate effect of the library against the
 residual of the current model (projected off what the model can already absorb), adds the best significant one,
 refits everything and checks that the cross-validated RMS falls ({diag['folds']} folds of whole configurations:
 the repeats of one of the {diag['validation']['configurations']} configurations never sit on both sides).</p>

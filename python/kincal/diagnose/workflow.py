@@ -17,11 +17,11 @@ from .serial import diagnose, final_identification
 from .serial_report import write_report
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import FloatArray
 
 
-def run(robot: Robot, data: Measurements, out: Union[str, Path], *, title: str,
+def run(robot: Robot, data: MeasurementSet, out: Union[str, Path], *, title: str,
         tool_targets: Optional[FloatArray] = None, progress: Optional[Callable[[str], None]] = None,
         **options: Any) -> tuple[dict[str, Any], ident.Identification]:
     """`kincal diagnose`: the diagnosis (``options``: those of diagnose()), the final model identified

@@ -9,7 +9,6 @@ and the nonlinear fit run in the C++ core; the minimax fit is a sequence of line
 from __future__ import annotations
 
 import math
-import re
 from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
@@ -162,12 +161,11 @@ def check_commanded_by(model: FiveBar, pts: FiveBarPoints, fit_file: str, grid_f
     """``pts`` when its angles are the commands ``model`` gives for its desired points: an error
     matrix corrects the model that commanded the grid, and only that one. Otherwise a ValueError
     naming the grid's line, the angles and the model's."""
-    try:
-        q = command(model, pts["desired"])
-    except ValueError as e:  # "row K: ..." (K from 1): said at the grid file's line of that point
-        m = re.match(r"row (\d+): (.*)", str(e))
-        where = f"{grid_file}:{int(pts['line'][int(m.group(1)) - 1])}" if m else grid_file
-        raise ValueError(f"{where}: {m.group(2) if m else e} for {fit_file}") from None
+    try:  # the core names the grid file's line of a point it cannot command
+        q = _core.fivebar_command(model, None, np.asarray(pts["desired"], dtype=float).reshape(-1, 2), grid_file,
+                                  [int(v) for v in pts["line"]])
+    except ValueError as e:
+        raise ValueError(f"{e} for {fit_file}") from None
     d = q - np.c_[pts["theta1_deg"], pts["theta2_deg"]]
     diff = np.max(np.abs((d + 180.0) % 360.0 - 180.0), axis=1)  # angles modulo a turn (368.7 is 8.7)
     k = int(np.argmax(diff))

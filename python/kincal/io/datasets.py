@@ -7,17 +7,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._core import abc_to_rotation, rotation_to_abc
+from .._core import MeasurementSet, abc_to_rotation, rotation_to_abc
 
 if TYPE_CHECKING:
-    from .._core import Measurements
     from ..typing_ import FloatArray
 
 UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
              "wrist_3_joint"]
 
 
-def read_ipa(path: str | Path, orientation: bool = False) -> Measurements:
+def read_ipa(path: str | Path, orientation: bool = False) -> MeasurementSet:
     """A series of the UR10 laser-tracker data of Landgraf et al. (CASE 2021; ../shared/data/
     ipa-robot-accuracy): ';' separated, ',' decimal mark, joints in rad, the T-Mac probe's position
     in the tracker frame in mm. Returns a measurement set (one target: the probe) with the
@@ -51,7 +50,7 @@ def read_ipa(path: str | Path, orientation: bool = False) -> Measurements:
         bad = int(np.argwhere(~np.isfinite(a))[0, 0])
         raise ValueError(f"{path}: row {bad + 2}: not a finite number")
     n = len(a)
-    out: Measurements = {
+    out: dict[str, object] = {
         "pose": np.arange(n, dtype=np.int32),
         "q_deg": np.degrees(a[:, :6]),
         "xyz": a[:, 6:9].copy(),
@@ -63,7 +62,7 @@ def read_ipa(path: str | Path, orientation: bool = False) -> Measurements:
     }
     if orientation:
         out["abc"] = np.array([_abc_of_xyz_intrinsic(*np.radians(r)) for r in a[:, 10:13]])
-    return out
+    return MeasurementSet(out, 6)
 
 
 def _abc_of_xyz_intrinsic(rx: float, ry: float, rz: float) -> FloatArray:

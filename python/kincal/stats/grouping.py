@@ -13,22 +13,21 @@ configuration, whatever the other rule says.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from .._core import Measurements
+    from .._core import MeasurementSet
     from ..typing_ import BoolArray, FloatArray, IntArray
 
 #: joint angles that agree within this (deg) on every joint are one configuration
 JOINT_TOLERANCE_DEG = 1e-3
 
 
-def subset(data: Measurements, mask: BoolArray) -> Measurements:
+def subset(data: MeasurementSet, mask: BoolArray) -> MeasurementSet:
     """The rows ``mask`` of a measurement set (its other entries as they are)."""
-    # the same keys, the arrays' rows picked: still a measurement set
-    return cast("Measurements", {k: (v[mask] if isinstance(v, np.ndarray) else v) for k, v in data.items()})
+    return data.subset(mask)
 
 
 @dataclass(frozen=True)
@@ -87,23 +86,23 @@ def _equal_joints(q: FloatArray, tol: float) -> tuple[IntArray, IntArray]:
     return np.concatenate(a_out), np.concatenate(b_out)
 
 
-def configurations(data: Measurements, tol_deg: float = JOINT_TOLERANCE_DEG) -> Configurations:
+def configurations(data: MeasurementSet, tol_deg: float = JOINT_TOLERANCE_DEG) -> Configurations:
     """The configuration of every row of a measurement set (see the module's text)."""
-    pose = np.asarray(data["pose"])
+    pose = np.asarray(data.pose)
     n = len(pose)
     if n == 0:
         return Configurations(np.zeros(0, dtype=np.int64), 0, "no rows")
     # rows of one pose id are one configuration: join each row to the first row of its pose
     _, first_of_pose, pose_code = np.unique(pose, return_index=True, return_inverse=True)
     a, b = [np.arange(n)], [first_of_pose[pose_code]]
-    if "config" in data:
-        cfg = np.asarray(data["config"])
+    if data.config is not None:
+        cfg = np.asarray(data.config)
         _, first_of_cfg, cfg_code = np.unique(cfg, return_index=True, return_inverse=True)
         a.append(np.arange(n))
         b.append(first_of_cfg[cfg_code])
         rule = "rows sharing a config value"
     else:
-        ea, eb = _equal_joints(np.asarray(data["q_deg"], dtype=float), tol_deg)
+        ea, eb = _equal_joints(np.asarray(data.q_deg, dtype=float), tol_deg)
         a.append(ea)
         b.append(eb)
         rule = f"rows with equal joint angles (within {tol_deg:g} deg)"
@@ -111,11 +110,11 @@ def configurations(data: Measurements, tol_deg: float = JOINT_TOLERANCE_DEG) -> 
     return Configurations(codes, int(codes.max()) + 1, rule)
 
 
-def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
+def folds(data: MeasurementSet, k: int, seed: int = 0) -> list[BoolArray]:
     """k boolean masks of held-out rows: whole configurations dealt at random into k folds."""
     cfg = configurations(data)
     if k > cfg.count:
-        raise ValueError(f"{data.get('source', '<data>')}: {k} folds need at least {k} configurations; the data "
+        raise ValueError(f"{data.source}: {k} folds need at least {k} configurations; the data "
                          f"have {cfg.count} ({cfg.rule})")
     perm = np.random.default_rng(seed).permutation(cfg.count)
     fold_of = np.empty(cfg.count, dtype=np.int64)
@@ -123,7 +122,7 @@ def folds(data: Measurements, k: int, seed: int = 0) -> list[BoolArray]:
     return [fold_of[cfg.codes] == i for i in range(k)]
 
 
-def split(data: Measurements, share: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
+def split(data: MeasurementSet, share: float, seed: int = 0) -> tuple[BoolArray, BoolArray]:
     """Boolean row masks (fitted, held out): a random share of the configurations is held out whole."""
     cfg = configurations(data)
     n_out = int(round(share * cfg.count))
@@ -132,7 +131,7 @@ def split(data: Measurements, share: float, seed: int = 0) -> tuple[BoolArray, B
     return ~held, held
 
 
-def describe(data: Measurements, scheme: str) -> dict[str, Any]:
+def describe(data: MeasurementSet, scheme: str) -> dict[str, Any]:
     """The validation scheme for a summary and a JSON: ``scheme`` (e.g. "5-fold"), the grouping rule
     and the number of configurations."""
     cfg = configurations(data)

@@ -94,7 +94,6 @@ struct IdentifyResult {
   std::vector<StationValue> stations;     ///< the probe stations (the campaign's, not the robot's)
   std::vector<EffectValue> effects;       ///< identified values of the extra effects
   double t_ref = 20.0;                    ///< reference temperature of thermal_expansion
-  double t_mean_s = 0;                    ///< reference time of the drift (the data's mean time)
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
   double rms_mm = 0, max_mm = 0;          ///< on the fitted rows

@@ -25,6 +25,8 @@ enum class TargetKind {
   Filtered  ///< Cartesian targets the controller's nominal model turns into the compensated joints
 };
 
+/// "joints" or "filtered" (InputError otherwise: "--targets WORD: joints or filtered").
+TargetKind target_kind_named(const std::string& name);
 /// "krl", "rapid", "fanuc-ls", "urscript", "gcode", "csv" (InputError otherwise).
 ControllerFormat controller_format_named(const std::string& name);
 /// By the output's extension: .src/.dat KRL, .mod/.modx RAPID, .ls FANUC LS, .script URScript, .csv

@@ -88,6 +88,13 @@ void read_artifact(const std::string& path, MeasurementSet& m);
 void parse_artifact(const std::string& text, const std::string& source, MeasurementSet& m);
 std::string format_artifact(const MeasurementSet& m);
 
+/// A set's source, names, stations and artifact without its rows: what a subset of it, or a made-up
+/// campaign of its kind, starts from.
+MeasurementSet without_rows(const MeasurementSet& m);
+/// The rows `rows` of a set (indices, in that order) with its names, stations and artifact; its
+/// targets (one at least) and orientation those of the rows kept.
+MeasurementSet subset(const MeasurementSet& m, const std::vector<size_t>& rows);
+
 struct ModelSpec;
 /// The rows' joint angles, read as the controller numbers them, turned into the model's (its joint
 /// convention: kincal/model/joint_convention.hpp); nothing for a model with its own convention.

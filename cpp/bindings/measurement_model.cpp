@@ -3,6 +3,8 @@
 // simulation (measurements without a tracker).
 #include "common.hpp"
 
+#include "kincal/identify/design.hpp"
+
 #include <numeric>
 #include <optional>
 
@@ -164,4 +166,24 @@ void define_point_model(py::module_& m) {
 void define_measurement_model(py::module_& m) {
   define_probe_stations(m);
   define_point_model(m);
+  m.def(
+      "d_optimal_gains",
+      [](const py::array_t<float, py::array::c_style>& J,
+         const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& idx,
+         const py::array_t<float, py::array::c_style>& L) {
+        if (J.ndim() != 3 || L.ndim() != 2 || L.shape(0) != J.shape(2) || L.shape(1) != J.shape(2) ||
+            idx.ndim() != 1)
+          throw InputError("d_optimal_gains: J is (candidates, rows, columns), L (columns, columns), idx indices");
+        py::array_t<float> out(idx.shape(0));
+        {
+          py::gil_scoped_release free;
+          d_optimal_gains(J.data(), static_cast<std::size_t>(J.shape(0)), static_cast<int>(J.shape(1)),
+                          static_cast<int>(J.shape(2)), idx.data(), static_cast<std::size_t>(idx.shape(0)), L.data(),
+                          out.mutable_data());
+        }
+        return out;
+      },
+      py::arg("J"), py::arg("idx"), py::arg("L"),
+      "log det(I + A A^T), A = J[i] L, of each candidate i of idx (float32 J and L, L lower triangular): the\n"
+      "D-optimal gain of adding candidate i's rows to an information matrix M with M^-1 = L L^T");
 }

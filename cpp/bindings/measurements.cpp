@@ -185,8 +185,9 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
     throw InputError(m.source + ": " + std::to_string(q.cols()) + " joint angles per row but the robot has " +
                      std::to_string(dof));
   int nt = 1;
+  m.rows.resize(n);  // filled in place: a plan's campaign has hundreds of thousands of rows
   for (size_t i = 0; i < n; ++i) {
-    Measurement r;
+    Measurement& r = m.rows[i];
     r.pose = pose[i];
     r.q_deg = q.row(i).transpose();
     r.xyz = xyz.row(i).transpose();
@@ -195,7 +196,6 @@ MeasurementSet measurements_from_dict(const py::dict& d, int dof) {
     r.payload_kg = pay[i];
     r.line = line[i];
     nt = std::max(nt, r.target + 1);
-    m.rows.push_back(r);
   }
   if (d.contains("temperature_c")) {
     const auto t = d["temperature_c"].cast<Eigen::VectorXd>();

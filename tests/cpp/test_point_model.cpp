@@ -1,5 +1,6 @@
 // The identification's measurement model: the analytic Jacobian of PointModel (rigid, compliant,
 // with effects) and of the 6-D row residuals against central differences.
+#include "kincal/identify/design.hpp"
 #include "kincal/identify/point_model.hpp"
 #include "kincal/identify/simulate.hpp"
 #include "identify_test_util.hpp"
@@ -274,4 +275,44 @@ TEST(PointModel, FittedGravityOrientationJacobianAndWrittenModel) {
   ASSERT_EQ(e.size(), d.rows.size());
   for (size_t i = 0; i < d.rows.size(); ++i)
     EXPECT_NEAR(e[i], (at_x.predict(d.rows[i], nullptr) - d.rows[i].xyz).norm(), 1e-9);
+}
+
+// The D-optimal gain of kincal plan: log det(I + J_i M^-1 J_i^T) for each candidate, against the
+// determinant of that matrix in double precision. Truth: 40 candidates of 9 rows x 12 standard normal
+// columns, M = 0.5 I + B^T B of 30 more such rows (seeded); the gains are single precision products,
+// so they agree to 1e-4 relative.
+TEST(Design, GainsAreTheLogDeterminantsOfTheCandidatesBlocks) {
+  std::mt19937_64 rng(test::test_seed(21));
+  std::normal_distribution<double> nd;
+  const int n = 40, rows = 9, cols = 12;
+  Eigen::MatrixXd Jd(n * rows, cols), B(30, cols);
+  for (Eigen::Index i = 0; i < Jd.size(); ++i) Jd.data()[i] = nd(rng);
+  for (Eigen::Index i = 0; i < B.size(); ++i) B.data()[i] = nd(rng);
+  const Eigen::MatrixXd M = 0.5 * Eigen::MatrixXd::Identity(cols, cols) + B.transpose() * B;
+  const Eigen::MatrixXd Minv = M.inverse();
+  const Eigen::MatrixXd Ld = Eigen::LLT<Eigen::MatrixXd>(0.5 * (Minv + Minv.transpose())).matrixL();
+  // row-major float copies, as numpy hands them over
+  std::vector<float> J(static_cast<size_t>(n * rows * cols)), L(static_cast<size_t>(cols * cols));
+  for (int r = 0; r < n * rows; ++r)
+    for (int c = 0; c < cols; ++c) J[static_cast<size_t>(r * cols + c)] = static_cast<float>(Jd(r, c));
+  for (int r = 0; r < cols; ++r)
+    for (int c = 0; c < cols; ++c) L[static_cast<size_t>(r * cols + c)] = static_cast<float>(c <= r ? Ld(r, c) : 99.0);
+  const std::vector<std::int64_t> idx = {39, 0, 17, 17, 5};  // any order, repeats allowed
+  std::vector<float> gain(idx.size());
+  d_optimal_gains(J.data(), n, rows, cols, idx.data(), idx.size(), L.data(), gain.data());
+  for (size_t k = 0; k < idx.size(); ++k) {
+    const Eigen::MatrixXd Ji = Jd.middleRows(idx[k] * rows, rows);
+    const double want =
+        std::log((Eigen::MatrixXd::Identity(rows, rows) + Ji * Minv * Ji.transpose()).determinant());
+    EXPECT_NEAR(gain[k], want, 1e-4 * std::abs(want)) << "candidate " << idx[k];
+  }
+  const std::vector<std::int64_t> out_of_range = {40};
+  EXPECT_EQ(test::error_of([&] {
+              d_optimal_gains(J.data(), n, rows, cols, out_of_range.data(), 1, L.data(), gain.data());
+            }),
+            "d_optimal_gains: candidate 40 of 40");
+  J[0] = std::nanf("");
+  const std::string nan_error =
+      test::error_of([&] { d_optimal_gains(J.data(), n, rows, cols, idx.data(), idx.size(), L.data(), gain.data()); });
+  EXPECT_NE(nan_error.find("candidate 0: its block is not positive definite"), std::string::npos) << nan_error;
 }

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -112,6 +112,8 @@ def keep_out(robot: Robot, q: FloatArray, targets: FloatArray, rules: KeepOut) -
     lim = np.asarray(robot.limits_deg, dtype=float)
     ok = np.all((q >= lim[:, 0]) & (q <= lim[:, 1]), axis=1)
     rejected = {"outside the joint limits": int(np.sum(~ok))}
+    if rules.min_sigma <= 0 and rules.box is None and rules.instrument is None:
+        return ok, {k: v for k, v in rejected.items() if v}  # no rule needs the tool frames
     frames = _tool_frames(robot, q)
     if rules.min_sigma > 0:
         reach = float(np.max(np.linalg.norm(frames[:, :3, 3], axis=1)))
@@ -196,21 +198,6 @@ def _free_columns(robot: Robot, q: FloatArray, targets: FloatArray, effects: lis
     return np.asarray(free, dtype=int), left
 
 
-def _logdet_spd(G: "np.ndarray[Any, np.dtype[np.floating[Any]]]") -> "np.ndarray[Any, np.dtype[np.floating[Any]]]":
-    """log det of each symmetric positive definite matrix of G (m, r, r): a Cholesky factorisation
-    written out over the batch (a vector operation per entry; numpy's batched cholesky pays a call
-    per small matrix, four times the time for 9 x 9 blocks)."""
-    r = G.shape[1]
-    Gt = np.ascontiguousarray(np.transpose(G, (1, 2, 0)))  # (r, r, m)
-    out = np.zeros(G.shape[0], dtype=G.dtype)
-    for k in range(r):
-        d = Gt[k, k]
-        out += np.log(d)
-        if k + 1 < r:
-            Gt[k + 1:, k + 1:] -= (Gt[k + 1:, k] / d)[:, None, :] * Gt[k, k + 1:][None, :, :]
-    return out
-
-
 def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, epsilon: float = 0.01,
                      seed: int = 0, progress: Optional[Callable[[int, int], None]] = None,
                      col_scale: Optional[FloatArray] = None) -> list[int]:
@@ -222,7 +209,8 @@ def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, 
     least 2,000 (all of them when fewer): the "stochastic greedy" of Mirzasoleiman et al. (AAAI 2015),
     within 1 - 1/e - epsilon of the optimum in expectation for this submodular criterion, and the
     plain greedy when the sample is every candidate. M^-1 follows each choice by the Woodbury
-    identity; a gain is log det of a small matrix from the rows times the Cholesky factor of M^-1."""
+    identity; a gain is log det of a small matrix from the rows times the Cholesky factor of M^-1,
+    computed by the core (d_optimal_gains) on its threads in single precision."""
     n, p = J.shape[0] // rows_per, J.shape[1]
     Jb = J.reshape(n, rows_per, p)
     cs = np.ones(p) if col_scale is None else np.asarray(col_scale, dtype=float)
@@ -230,7 +218,6 @@ def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, 
     Jb32 = Jb.astype(np.float32)
     Jb32 *= (1.0 / cs).astype(np.float32)
     eye = np.eye(rows_per)
-    eye32 = eye.astype(np.float32)
     rng = np.random.default_rng(seed)
     sample = min(n, max(2000, int(math.ceil(n / k * math.log(1.0 / epsilon)))))
     Minv = np.eye(p) / ridge
@@ -242,8 +229,7 @@ def greedy_d_optimal(J: FloatArray, rows_per: int, k: int, ridge: float = 1e-3, 
         pool = np.flatnonzero(left)
         idx = pool if len(pool) <= sample else np.sort(rng.choice(pool, size=sample, replace=False))
         L = np.linalg.cholesky(Minv).astype(np.float32)
-        A = (Jb32[idx].reshape(-1, p) @ L).reshape(len(idx), rows_per, p)
-        gain = _logdet_spd(A @ np.transpose(A, (0, 2, 1)) + eye32)
+        gain = _core.d_optimal_gains(Jb32, idx, L)  # log det(I + A A^T), A = J_i L, on the core's threads
         best = int(idx[int(np.argmax(gain))])
         chosen.append(best)
         left[best] = False

@@ -4,7 +4,7 @@ product, a batched product and a Cholesky written out over the batch), in the sa
 inputs (BENCHMARKS.md, "Planning 100,000 candidates in under a second").
 
 Inputs: the plan's own scaled float32 Jacobian of 100,000 random kr500 candidates (3 reflectors,
-geometry + compliance: 9 rows and 31 columns each), a sample of 7,676 of them (the stochastic greedy's
+geometry + compliance: 9 rows each, a column per parameter the plan keeps), a sample of 7,676 of them (the stochastic greedy's
 sample at K = 60), L of M = 0.1 I + B^T B (B: 200 standard normal rows, seed 0).
 
     .venv/bin/python benchmarks/plan_gains.py [--repeats 50]

@@ -37,7 +37,7 @@ def balls(robot: kincal.Robot, q: np.ndarray) -> np.ndarray:
     return pp.ball_centres(robot, q, PROBE)
 
 
-def accuracy(robot: kincal.Robot, truth: kincal.Robot, data: dict, q: np.ndarray) -> float:
+def accuracy(robot: kincal.Robot, truth: kincal.Robot, data: kincal.MeasurementSet, q: np.ndarray) -> float:
     fit = ident.identify(robot, data, effects=["joint_compliance"], k_folds=0, fit=FitOptions(target_start=[PROBE]))
     mine = pp.ball_centres(fit.robot, q, np.asarray(fit.targets)[0])
     return pp.rigid_rms(mine, balls(truth, q))

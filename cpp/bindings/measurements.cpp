@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 
 #include "kincal/io/measurements.hpp"
 #include "kincal/model/model.hpp"
@@ -84,9 +85,13 @@ void probe_from_dict(const py::dict& d, size_t n, MeasurementSet& m) {
   if (!d.contains("artifact")) return;
   std::string text = "a,b,distance_mm,angle_deg\n";  // through the reader: its checks, its messages
   auto num = [](double v) { return std::isnan(v) ? std::string() : py::str(py::float_(v)).cast<std::string>(); };
-  for (const auto& t : d["artifact"].cast<std::vector<std::tuple<std::string, std::string, double, double, std::string>>>())
+  using Term = std::tuple<std::string, std::string, double, double, std::string>;
+  const auto terms = d["artifact"].cast<std::vector<Term>>();
+  for (const auto& t : terms)
     text += std::get<0>(t) + "," + std::get<1>(t) + "," + num(std::get<2>(t)) + "," + num(std::get<3>(t)) + "\n";
   parse_artifact(text, m.source + " (artifact)", m);
+  for (size_t k = 0; k < terms.size() && k < m.artifact.size(); ++k)  // a term keeps the file:line it came with
+    if (!std::get<4>(terms[k]).empty()) m.artifact[k].where = std::get<4>(terms[k]);
 }
 
 }  // namespace
@@ -259,11 +264,10 @@ PyMeasurementSet from_columns(const py::dict& d, int dof);
 }  // namespace
 
 PyMeasurementSet set_arg(const py::handle& data) {
-  if (py::isinstance<py::dict>(data)) return from_columns(data.cast<py::dict>(), -1);
-  if (!py::isinstance<PyMeasurementSet>(data))
-    throw py::type_error("a MeasurementSet (or a dict of its columns) is needed, not " +
-                         py::str(py::type::of(data)).cast<std::string>());
-  return data.cast<PyMeasurementSet>();
+  if (py::isinstance<PyMeasurementSet>(data)) return data.cast<PyMeasurementSet>();
+  if (py::hasattr(data, "keys")) return from_columns(py::dict(py::reinterpret_borrow<py::object>(data)), -1);
+  throw py::type_error("a MeasurementSet (or a mapping of its columns) is needed, not " +
+                       py::str(py::type::of(data)).cast<std::string>());
 }
 
 namespace {
@@ -290,9 +294,10 @@ py::object column(const PyMeasurementSet& s, const std::string& key) {
 /// A set from columns: dof -1 takes the joint count from q_deg.
 PyMeasurementSet from_columns(const py::dict& d, int dof) {
   if (dof < 0) {
-    if (!d.contains("q_deg")) throw InputError("a measurement set needs q_deg (n x dof joint angles)");
+    const std::string source = d.contains("source") ? py::str(d["source"]).cast<std::string>() : "<data>";
+    if (!d.contains("q_deg")) throw InputError(source + ": a measurement set needs q_deg (n x dof joint angles)");
     py::array q = py::array::ensure(d["q_deg"]);
-    if (!q || q.ndim() != 2) throw InputError("a measurement set's q_deg is n x dof joint angles");
+    if (!q || q.ndim() != 2) throw InputError(source + ": a measurement set's q_deg is n x dof joint angles");
     dof = static_cast<int>(q.shape(1));
   }
   return measurement_set(measurements_from_dict(d, dof), dof);
@@ -328,6 +333,8 @@ void define_measurement_set(py::module_& m) {
               for (size_t i = 0; i < n; ++i)
                 if (mask.data()[i]) pick.push_back(i);
             } else {
+              if (rows.size() > 0 && rows.dtype().kind() != 'i' && rows.dtype().kind() != 'u')
+                throw InputError(a.source + ": rows are a boolean mask or integer indices");
               const auto idx = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(rows);
               if (!idx || idx.ndim() != 1) throw InputError(a.source + ": rows are a mask or indices");
               for (py::ssize_t k = 0; k < idx.size(); ++k) {
@@ -348,7 +355,12 @@ void define_measurement_set(py::module_& m) {
           "with_columns",
           [](const PyMeasurementSet& s, const py::kwargs& kw) {
             py::dict d = measurements_to_dict(*s.set, s.dof);
-            for (auto item : kw) d[item.first] = item.second;
+            for (auto item : kw) {
+              const auto key = item.first.cast<std::string>();
+              if (std::find(std::begin(kColumns), std::end(kColumns), key) == std::end(kColumns))
+                throw InputError(s.set->source + ": with_columns: '" + key + "' is not a column of a measurement set");
+              d[item.first] = item.second;
+            }
             return from_columns(d, kw.contains("q_deg") ? -1 : s.dof);
           },
           "A new set: these columns given, the others as they are (e.g. with_columns(q_deg=q))")

@@ -11,8 +11,8 @@ JointConvention = Literal["", "fanuc"]
 ControllerFormat = Literal["krl", "rapid", "fanuc-ls", "ls", "urscript", "gcode", "csv"]
 TargetKind = Literal["joints", "filtered"]
 
-# Records the core hands over as dicts of numpy arrays (so Python can slice them by rows). They exist
-# for type checkers only: at run time each is a plain dict with these keys.
+# The measurement set is a class of the core. The records after it are handed over as dicts of numpy
+# arrays: TypedDicts for type checkers only (at run time each is a plain dict with these keys).
 
 class MeasurementSet:
     """A measurement set, immutable: one entry per row of each column (read-only numpy arrays): the
@@ -399,9 +399,10 @@ def parse_joint_program(text: str, source: str = ..., gcode: bool = ..., dof: in
 def time_optimal_feed(s: np.ndarray, d1: np.ndarray, d2: np.ndarray, v: np.ndarray, a: np.ndarray,
                       cap: np.ndarray) -> tuple[np.ndarray, float]: ...
 
-# identification (a measurement set is a dict: pose, q_deg, xyz, target, payload_kg, line, source,
-# and optionally temperature_c, dir and abc; with probe rows kind, station, station_names,
-# station_kinds, radius_mm, length_mm and artifact: (a, b, distance_mm, angle_deg, where) tuples)
+# identification (a MeasurementSet, or a dict of its columns where the core takes one: pose, q_deg,
+# xyz, target, payload_kg, line, source, and optionally temperature_c, dir and abc; with probe rows
+# kind, station, station_names, station_kinds, radius_mm, length_mm and artifact: (a, b,
+# distance_mm, angle_deg, where) tuples)
 def read_measurements(path: str, dof: int, robot: Optional[Robot] = ...) -> MeasurementSet: ...
 def parse_measurements(text: str, source: str = ..., dof: int = ...) -> MeasurementSet: ...
 def format_measurements(data: MeasurementSet, dof: int) -> str: ...

@@ -58,8 +58,12 @@ def test_subset_and_with_columns_make_new_sets(data):
         data.subset(np.array([True, False, True]))
     with pytest.raises(ValueError, match="row 24 of 24"):
         data.subset(np.array([0, 24]))
+    with pytest.raises(ValueError, match="a boolean mask or integer indices"):
+        data.subset(np.array([1.7]))
     with pytest.raises(ValueError, match="xyz of a different length|different lengths"):
         data.with_columns(xyz=np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="with_columns: 'xzy' is not a column of a measurement set"):
+        data.with_columns(xzy=data.xyz)
 
 
 def test_a_set_from_columns_and_the_dict_of_earlier_versions(kr500, data):
@@ -90,7 +94,8 @@ def test_a_probe_set_keeps_its_stations_and_artifact(kr500):
     first = d.subset(np.asarray(d.station) == 0)
     assert len(first) == 8 and first.station_names == d.station_names
     assert first.artifact is not None and [t[:3] for t in first.artifact] == [t[:3] for t in d.artifact]
-    longer = d.with_columns(artifact=[(a, b, dist + 0.05, ang, w) for a, b, dist, ang, w in d.artifact])
+    longer = d.with_columns(artifact=[(a, b, dist + 0.05, ang, "bar.csv:7") for a, b, dist, ang, w in d.artifact])
+    assert [t[4] for t in longer.artifact] == ["bar.csv:7"] * len(d.artifact)  # where each term came from, kept
     assert [t[2] for t in longer.artifact] == pytest.approx([t[2] + 0.05 for t in d.artifact], abs=1e-12)
     with pytest.raises(ValueError, match="station"):
         d.with_columns(artifact=[("nowhere", d.station_names[0], 50.0, float("nan"), "")])

@@ -1,8 +1,10 @@
 """Measurement campaigns and parameter identification (the Samak paper's calibration step 3).
 
-A measurement set is a dict of numpy arrays, the rows of the contract's measurement CSV (``pose``,
-``q_deg``, ``xyz``, ``target``, ``payload_kg``, ``line``, ``source``; optional ``temperature_c``, ``dir``,
-``abc``, ``time_s``, ``config``/``setup`` int64 codes with ``config_names``/``setup_names``). The
+A measurement set is a ``kincal.MeasurementSet``: the rows of the contract's measurement CSV as read-only
+columns (``pose``, ``q_deg``, ``xyz``, ``target``, ``payload_kg``, ``line``, ``source``; optional
+``temperature_c``, ``dir``, ``abc``, ``time_s``, ``config``/``setup`` int64 codes with
+``config_names``/``setup_names``, None when absent); the package's functions take one
+(``kincal.MeasurementSet(columns)`` makes one from a dict). The
 heavy work (residuals, analytic Jacobian, Ceres) runs in the C++ core.
 """
 

@@ -43,6 +43,17 @@ void define_effects(py::module_& m) {
       },
       py::arg("effect"), py::arg("q_rad"), py::arg("dir") = py::none(),
       "The basis of a joint-angle effect at each angle (n x size): dq = sum_k p_k b_k(q, dir), the core's own");
+  m.def(
+      "link_basis",
+      [](const Effect& e, const Eigen::VectorXd& t1_rad, const Eigen::VectorXd& t2_rad) {
+        if (t1_rad.size() != t2_rad.size()) throw InputError("link_basis: one t2 per t1");
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> b(t1_rad.size(), e.size());
+        for (Eigen::Index i = 0; i < t1_rad.size(); ++i) link_basis(e, t1_rad[i], t2_rad[i], b.row(i).data());
+        return b;
+      },
+      py::arg("effect"), py::arg("t1_rad"), py::arg("t2_rad"),
+      "The basis of a five-bar link-length effect at each pair of actuated angles (n x size): the link's\n"
+      "length moves by sum_k p_k b_k(t1, t2) (mm), the core's own");
 
   py::class_<Effect>(m, "Effect", "An effect on one joint (or link), or on the whole robot")
       .def(py::init([](const std::string& name, int joint, std::vector<int> harmonics, int order) {

@@ -96,6 +96,15 @@ TEST(Effects, RegistryNamesEveryEffectOnce) {
     EXPECT_NEAR(db[2 * i], k[i] * std::cos(k[i] * 0.7), 1e-13);
     EXPECT_NEAR(db[2 * i + 1], -k[i] * std::sin(k[i] * 0.7), 1e-13);
   }
+  // a five-bar link's length basis lives in its effect's file: cos t1, sin t1, cos t2, sin t2
+  double lb[4];
+  link_basis(Effect{"link_deflection", 2, {}}, 0.3, -1.1, lb);
+  EXPECT_DOUBLE_EQ(lb[0], std::cos(0.3));
+  EXPECT_DOUBLE_EQ(lb[1], std::sin(0.3));
+  EXPECT_DOUBLE_EQ(lb[2], std::cos(-1.1));
+  EXPECT_DOUBLE_EQ(lb[3], std::sin(-1.1));
+  EXPECT_EQ(test::error_of([&] { link_basis(te, 0.3, -1.1, lb); }),
+            "transmission_error is no link-length effect (it has no link basis)");
 }
 
 TEST(Effects, ModelJsonVersion3RoundTripAndVersion1Reads) {

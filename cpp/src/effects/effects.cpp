@@ -90,4 +90,10 @@ void joint_basis(const Effect& e, double q, double dir, double* b, double* db) {
   k.basis(e, q, dir, b, db);
 }
 
+void link_basis(const Effect& e, double t1, double t2, double* b) {
+  const EffectKind& k = e.kind();
+  if (!k.link_basis) throw InputError(e.name + " is no link-length effect (it has no link basis)");
+  k.link_basis(e, t1, t2, b);
+}
+
 }  // namespace kincal

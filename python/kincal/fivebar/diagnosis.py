@@ -43,12 +43,13 @@ def _acts_on(effect: _core.Effect) -> str:
 
 
 def _basis(effect: _core.Effect, t1: FloatArray, t2: FloatArray) -> FloatArray:
-    """Per-point basis functions (n x effect.size) of an effect: a link's length varies with the pose
-    as p1 cos t1 + p2 sin t1 + p3 cos t2 + p4 sin t2 (mm); a joint-angle effect of actuator j is the
-    sum over its harmonic orders k of s_k sin(k tj) + c_k cos(k tj) (rad)."""
+    """Per-point basis functions (n x effect.size) of an effect, the core's own (its effect's file): a
+    link-length effect's at both actuated angles (link_deflection: p1 cos t1 + p2 sin t1 + p3 cos t2 +
+    p4 sin t2, mm); a joint-angle effect of actuator j, the sum over its harmonic orders k of
+    s_k sin(k tj) + c_k cos(k tj) (rad)."""
     b: FloatArray
     if _acts_on(effect) == "link_length":
-        b = np.c_[np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)]
+        b = _core.link_basis(effect, np.asarray(t1, dtype=float), np.asarray(t2, dtype=float))
     else:
         b = _core.joint_basis(effect, np.asarray(t1 if effect.joint == 1 else t2, dtype=float))  # the core's basis
     if b.shape[1] != effect.size:

@@ -46,6 +46,9 @@ struct EffectKind {
   void (*basis)(const Effect&, double q_rad, double dir, double* b, double* db);
   /// a harmonic effect that carries every order 1..K, named by its order K (joint_map)
   bool ordered = false;
+  /// a five-bar link-length effect's basis, dl = sum_k p_k b_k(t1, t2) (the actuated angles, rad);
+  /// nullptr for the others
+  void (*link_basis)(const Effect&, double t1_rad, double t2_rad, double* b) = nullptr;
   bool reads_dir() const { return needs == "dir"; }               ///< the direction of motion (dir1..dirN)
   bool scales_lengths() const { return acts_on == "length_scale"; }  ///< scales the robot's lengths
   bool of_instrument() const { return acts_on == "instrument"; }    ///< the measurement's, never the robot's
@@ -102,5 +105,8 @@ void check_effect(const Effect& e, int dof, const std::string& who);
 /// The basis of a joint-angle effect (transmission_error, joint_map, backlash): dq = sum_k p_k b_k(q, dir).
 /// Writes size() values to b and, when db is not null, their derivatives with respect to q.
 void joint_basis(const Effect& e, double q_rad, double dir, double* b, double* db = nullptr);
+/// The basis of a five-bar link-length effect at the actuated angles t1, t2 (rad): its link's length
+/// moves by sum_k p_k b[k] (mm). InputError for an effect that has none.
+void link_basis(const Effect& e, double t1_rad, double t2_rad, double* b);
 
 }  // namespace kincal

@@ -232,7 +232,9 @@ TEST(Ik, OrthoParallelFormEqualsTheVectorForm) {
       if (test::near_singular(one, 1.0)) continue;  // each form's rounding is magnified there
       ++n;
       const Vec6 random_ref = test::random_q(m, rng);
-      for (const Vec6& ref : {q, random_ref}) {
+      // a reference beyond the limits: the solves' general path to degrees (IkSolver::to_degrees)
+      const Vec6 far_ref = random_ref + Vec6::Constant(400.0);
+      for (const Vec6& ref : {q, random_ref, far_ref}) {
         for (Branches b : {Branches::All, Branches::NearestReference}) {
           const IkSolutions a = fast.solve(t, IkOptions(ref, b)), v = vec.solve(t, IkOptions(ref, b));
           ASSERT_EQ(a.status, v.status);

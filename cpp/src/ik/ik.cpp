@@ -137,29 +137,21 @@ IkSolutions IkSolver::solve(const Eigen::Isometry3d& target, const IkOptions& op
   const Mat3 gr = target.linear() * tool_.linear().transpose();
   const Vec3 gt = target.translation() - gr * tool_.translation();
   const Vec3 p = gr * st_.wrist_center + gt;
-  IkSolutions out = st_.ortho_parallel ? solve_ortho(gr, p, opt) : solve_vector(gr, p, opt);
-  to_degrees(out, opt.reference_deg);
+  const bool deliver_now = delivers(opt);
+  IkSolutions out = st_.ortho_parallel ? solve_ortho(gr, p, opt, deliver_now) : solve_vector(gr, p, opt, deliver_now);
+  if (!deliver_now) to_degrees(out, opt.reference_deg);
   out.status = out.count > 0 ? IkStatus::Ok : IkStatus::OutOfReach;
   return out;
 }
 
-// One solution (radians) into out, its wrist polished near the singularity (wrist: the sine of the
-// angle between axes 4 and 6), flagged; to_degrees converts all of them at the end.
-void IkSolver::record(IkSolutions& out, double* q, double wrist, const Mat3& gr, bool shoulder, bool clamped) const {
+// The wrist angles of one solution (radians) polished near the singularity (IkSolver::record).
+void IkSolver::polish(double* q, const Mat3& gr) const {
   const Vec3 &w1 = w_[0], &w2 = w_[1], &w3 = w_[2];
-  IkSolution& s = out.sol[out.count];
-  if (wrist < 1e-3) {  // within 0.06 deg of the singularity q5 has lost digits
-    const Mat3 r456 = (axis_rotation(w1, q[0]) * axis_rotation(w2, q[1]) * axis_rotation(w3, q[2])).transpose() * gr;
-    polish_wrist(w_[3], w_[4], w_[5], r456, q + 3);
-  }
-  for (int j = 0; j < 6; ++j) s.q_deg[j] = q[j];
-  s.wrist_singular = wrist < 1e-7;
-  s.shoulder_singular = shoulder;
-  s.approximate = clamped;
-  ++out.count;
+  const Mat3 r456 = (axis_rotation(w1, q[0]) * axis_rotation(w2, q[1]) * axis_rotation(w3, q[2])).transpose() * gr;
+  polish_wrist(w_[3], w_[4], w_[5], r456, q + 3);
 }
 
-IkSolutions IkSolver::solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt) const {
+IkSolutions IkSolver::solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const {
   const double* ref_deg = opt.reference_deg;
   const Branch br{ref_deg, opt.branches == Branches::NearestReference && ref_deg != nullptr};
   IkSolutions out;
@@ -241,7 +233,7 @@ IkSolutions IkSolver::solve_vector(const Mat3& gr, const Vec3& p, const IkOption
         double q[6] = {a1.q, a2.q, a3.q, a4.q, a5.q, a6.q};
         // sin of the angle between axes 4 and 6 (|sin q5| for a wrist with the flip)
         const double wrist = flip ? std::abs(a5.s) : w4.cross(rotv(w5, a5.c, a5.s, w6)).norm();
-        record(out, q, wrist, gr, shoulder, tg.clamped);
+        record(out, q, wrist, gr, shoulder, tg.clamped, opt, deliver_now);
       }
     }
   }

@@ -8,6 +8,105 @@ namespace kincal {
 
 using namespace ik_detail;
 
+namespace {
+
+// A shoulder branch (q1) of the ortho form: its elbow's cosine, sine and angle offset (sub3_elbow)
+struct Shoulder {
+  int n3;
+  double ca, sa, a;
+  bool clamped;
+  Vec3 y, w6, v6;  // e^{-xi1 q1} p - p2, and C G w6, C G w5 turned back by -q1
+};
+
+// An arm branch (q1, q3) of the ortho form, in the order of solve_vector's loops
+struct Arm {
+  Angle a3, a2;
+  Vec3 v6;  // C G w5 turned back by -q1 and -(q2 + sigma q3)
+  bool clamped;
+  int i1;  // its shoulder branch
+};
+
+#if defined(__SSE2__)
+// The ortho form's solutions in degrees within the limits (IkSolver::delivers: all branches, a plain
+// reference), each angle converted once where solutions share it (q1 by up to four, q2 and q3 by
+// two), two at a time: q1 of the two shoulder branches, (q2, q3) of an arm, q4, q5, q6 of its two
+// wrists (to_limits2 lane by lane: the values IkSolver::deliver gives). polish(q) polishes a wrist
+// near its singularity first.
+template <class Polish>
+void deliver_arms(IkSolutions& out, const Angle* q1s, int n1, const Arm* arm, int na, const Angle (*t4)[2],
+                  const Angle (*t5)[2], const Angle* a6, const int* n45, const double* ref_deg,
+                  const std::array<double, 6>& lo, const std::array<double, 6>& hi, Polish&& polish) {
+  // each joint's reference and limits in both lanes
+  __m128d r[6], l[6], h[6];
+  for (int j = 0; j < 6; j += j == 0 ? 3 : 1) {
+    r[j] = _mm_set1_pd(ref_deg ? ref_deg[j] : 0.0);
+    l[j] = _mm_set1_pd(lo[j]);
+    h[j] = _mm_set1_pd(hi[j]);
+  }
+  int in1;
+  alignas(16) double d1[2];
+  _mm_store_pd(d1, to_limits2(_mm_set_pd(q1s[n1 - 1].q, q1s[0].q), r[0], l[0], h[0], in1));  // (a lane repeated for one)
+  const __m128d r23 = ref_deg ? _mm_loadu_pd(ref_deg + 1) : _mm_setzero_pd();
+  const __m128d l23 = _mm_loadu_pd(lo.data() + 1), h23 = _mm_loadu_pd(hi.data() + 1);
+  int count = 0;
+  for (int k = 0; k < na; ++k) {
+    const int n = n45[k];
+    if (n == 0) continue;
+    const Arm& a = arm[k];
+    int in23;
+    alignas(16) double d23[2], d4[2], d5[2], d6[2];
+    _mm_store_pd(d23, to_limits2(_mm_set_pd(a.a3.q, a.a2.q), r23, l23, h23, in23));
+    // the wrists (q4, q5, q6) and (q4 + pi, -q5, q6 + pi) (a lane repeated for one), radians, polished
+    // near the singularity
+    __m128d q4 = _mm_set_pd(t4[k][0].q + (n - 1) * kPi, t4[k][0].q);
+    __m128d q5 = _mm_set_pd(n == 2 ? -t5[k][0].q : t5[k][0].q, t5[k][0].q);
+    __m128d q6 = _mm_set_pd(a6[k].q + (n - 1) * kPi, a6[k].q);
+    const double wrist = std::abs(t5[k][0].s);
+    if (wrist < 1e-3) {
+      alignas(16) double w[2][6], p4[2], p5[2], p6[2];
+      _mm_store_pd(p4, q4);
+      _mm_store_pd(p5, q5);
+      _mm_store_pd(p6, q6);
+      for (int i = 0; i < n; ++i) {
+        w[i][0] = q1s[a.i1].q;
+        w[i][1] = a.a2.q;
+        w[i][2] = a.a3.q;
+        w[i][3] = p4[i];
+        w[i][4] = p5[i];
+        w[i][5] = p6[i];
+        polish(w[i]);
+      }
+      const int last = n - 1;
+      q4 = _mm_set_pd(w[last][3], w[0][3]);
+      q5 = _mm_set_pd(w[last][4], w[0][4]);
+      q6 = _mm_set_pd(w[last][5], w[0][5]);
+    }
+    int in4, in5, in6;
+    _mm_store_pd(d4, to_limits2(q4, r[3], l[3], h[3], in4));
+    _mm_store_pd(d5, to_limits2(q5, r[4], l[4], h[4], in5));
+    _mm_store_pd(d6, to_limits2(q6, r[5], l[5], h[5], in6));
+    const int wrists_in = ((in1 >> a.i1) & 1) && in23 == 3 ? in4 & in5 & in6 : 0;
+    for (int i = 0; i < n; ++i) {
+      IkSolution& s = out.sol[count++];
+      double* qd = s.q_deg.data();
+      qd[0] = d1[a.i1];
+      qd[1] = d23[0];
+      qd[2] = d23[1];
+      qd[3] = d4[i];
+      qd[4] = d5[i];
+      qd[5] = d6[i];
+      s.within_limits = (wrists_in >> i) & 1;
+      s.wrist_singular = wrist < 1e-7;
+      s.shoulder_singular = false;
+      s.approximate = a.clamped;
+    }
+  }
+  out.count = count;
+}
+#endif
+
+}  // namespace
+
 void IkSolver::fill_ortho(IkForm form, const Vec3& c) {
   const Vec3 &w1 = w_[0], &w2 = w_[1], &w3 = w_[2];
   const double sigma = w3.dot(w2) > 0 ? 1.0 : -1.0;
@@ -38,7 +137,7 @@ void IkSolver::fill_ortho(IkForm form, const Vec3& c) {
 // frame (w4, w5, w4 x w5), with v6 = w5: each rotation is a plane rotation of two numbers. The arm
 // branches (q1, q3) go through each stage together, so that their independent arctangents overlap.
 // Same branches in the same order; a wrist centre on axis 1 (or out of reach) goes to solve_vector.
-IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt) const {
+IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const {
   const double* ref_deg = opt.reference_deg;
   const Branch br{ref_deg, opt.branches == Branches::NearestReference && ref_deg != nullptr};
   Tangency tg;
@@ -50,36 +149,64 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
   // q1 (sub4 with h = w2, k = w1: A = w2 . u, B = w2 . (w1 x u), C = d)
   Angle t1[2];
   const int n1 = sub4_abc(u[1], -u[2], o.d, t1, tg);
-  if (n1 == 0) return solve_vector(gr, p, opt);
+  IkSolutions out;
+  if (n1 == 0) {
+    out = solve_vector(gr, p, opt, deliver_now);
+    return out;
+  }
   const bool clamped1 = tg.clamped;
-  // the arm branches (q1, q3), in the order of solve_vector's loops
-  struct Arm {
-    Angle a1, a3, a2;
-    Vec3 y, w6, v6;  // e^{-xi1 q1} p - p2, and C G w6, C G w5 turned back by -q1
-    bool clamped;
-  };
   Arm arm[4];
   int na = 0;
   Angle q1s[2];
   for (int i = 0; i < n1; ++i) q1s[i] = negated(t1[i]);
   const int b1 = br.pick(q1s, n1, 0);
-  for (int i1 = br.begin(b1); i1 < br.end(b1, n1); ++i1) {
+  // q3 of each shoulder branch (the elbow's cosine, then the two branches' arctangents as a pair)
+  Shoulder sh[2];
+  const int i1_begin = br.begin(b1), i1_end = br.end(b1, n1);
+  for (int i1 = i1_begin; i1 < i1_end; ++i1) {
     const Angle& a1 = q1s[i1];
+    Shoulder& h = sh[i1];
     // rotation about axis 1 by -q1 on components 2, 3
     auto r1 = [&](const Vec3& v) { return Vec3(v[0], v[1] * a1.c + v[2] * a1.s, -v[1] * a1.s + v[2] * a1.c); };
-    const Vec3 y = r1(u) - o.p21;
-    Angle t3[2];
+    h.y = r1(u) - o.p21;
+    h.w6 = r1(gw);
+    h.v6 = r1(gv);
     tg.clamped = clamped1;
-    const int n3 = sub3_elbow(kc, y.norm(), t3, tg);
-    const int b3 = br.pick(t3, n3, 2);
-    for (int i3 = br.begin(b3); i3 < br.end(b3, n3); ++i3) arm[na++] = Arm{a1, t3[i3], Angle{}, y, r1(gw), r1(gv), tg.clamped};
+    h.n3 = sub3_elbow_cos(kc, h.y.norm(), h.ca, tg);
+    h.clamped = tg.clamped;
+    h.sa = h.n3 > 0 ? sine_of(h.ca) : 0.0;
   }
-  // q2 (sub1 about w2 from x - p2 = rot(w2, sigma q3)(pw - p3) + p3 - p2 to y, components 1 and 3)
+  if (i1_end - i1_begin == 2 && sh[0].n3 > 0 && sh[1].n3 > 0) {
+    fastmath::atan2x2(sh[0].sa, sh[0].ca, sh[1].sa, sh[1].ca, sh[0].a, sh[1].a);
+  } else {
+    for (int i1 = i1_begin; i1 < i1_end; ++i1)
+      if (sh[i1].n3 > 0) sh[i1].a = fastmath::atan2(sh[i1].sa, sh[i1].ca);
+  }
+  for (int i1 = i1_begin; i1 < i1_end; ++i1) {
+    const Shoulder& h = sh[i1];
+    if (h.n3 == 0) continue;
+    Angle t3[2];
+    sub3_elbow_angles(kc, h.a, h.ca, h.sa, t3);
+    const int b3 = br.pick(t3, h.n3, 2);
+    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, Vec3(), h.clamped, i1};
+  }
+  // q2 (sub1 about w2 from x - p2 = rot(w2, sigma q3)(pw - p3) + p3 - p2 to y, components 1 and 3),
+  // two arm branches at a time
+  double x2[4], y2[4];
   for (int k = 0; k < na; ++k) {
-    Arm& a = arm[k];
+    const Arm& a = arm[k];
     const double c3 = a.a3.c, s3 = o.sigma * a.a3.s;
     const double x1 = o.pw3_1 * c3 + o.pw3_3 * s3 + o.p32_1, x3 = -o.pw3_1 * s3 + o.pw3_3 * c3 + o.p32_3;
-    a.a2 = from_xy(x1 * a.y[0] + x3 * a.y[2], x3 * a.y[0] - x1 * a.y[2]);
+    const Vec3& y = sh[a.i1].y;
+    x2[k] = x1 * y[0] + x3 * y[2];
+    y2[k] = x3 * y[0] - x1 * y[2];
+  }
+  for (int k = 0; k < na; k += 2) {
+    if (k + 1 < na) {
+      from_xy2(x2[k], y2[k], x2[k + 1], y2[k + 1], arm[k].a2, arm[k + 1].a2);
+    } else {
+      arm[k].a2 = from_xy(x2[k], y2[k]);
+    }
   }
   // q4, q5 (sub2 of the wrist) and q6 of the first wrist solution of each arm branch
   Angle t4[4][2], t5[4][2], a6[4];
@@ -88,23 +215,39 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
     Arm& a = arm[k];
     // rotation about axis 2 by -(q2 + sigma q3) on components 1, 3
     const double c = a.a2.c * a.a3.c - o.sigma * a.a2.s * a.a3.s, s = a.a2.s * a.a3.c + o.sigma * a.a2.c * a.a3.s;
-    const Vec3 w6(a.w6[0] * c - a.w6[2] * s, a.w6[1], a.w6[0] * s + a.w6[2] * c);
-    a.v6 = Vec3(a.v6[0] * c - a.v6[2] * s, a.v6[1], a.v6[0] * s + a.v6[2] * c);
+    const Vec3 &w1 = sh[a.i1].w6, &v1 = sh[a.i1].v6;
+    const Vec3 w6(w1[0] * c - w1[2] * s, w1[1], w1[0] * s + w1[2] * c);
+    a.v6 = Vec3(v1[0] * c - v1[2] * s, v1[1], v1[0] * s + v1[2] * c);
     tg.clamped = a.clamped;
     n45[k] = sub2_dots(kc, o.w4.dot(w6), o.w5.dot(w6), o.n.dot(w6), o.m.dot(w6), t4[k], t5[k], true, tg);
     a.clamped = tg.clamped;
   }
+  // q6 takes w5 to rot(w5, -q5) rot(w4, -q4) R456 w5; in the frame (w4, w5, n) a turn about w4
+  // moves components 2, 3 and one about w5 components 1, 3; sub1 about tau w4 from (0, 1, 0);
+  // the arctangents two arm branches at a time
+  double x6[4] = {1, 1, 1, 1}, y6[4] = {0, 0, 0, 0};
   for (int k = 0; k < na; ++k) {
     if (n45[k] == 0) continue;
-    // q6 takes w5 to rot(w5, -q5) rot(w4, -q4) R456 w5; in the frame (w4, w5, n) a turn about w4
-    // moves components 2, 3 and one about w5 components 1, 3; sub1 about tau w4 from (0, 1, 0)
     const Vec3& v = arm[k].v6;
     const double e1 = o.w4.dot(v), e2 = o.w5.dot(v), e3 = o.n.dot(v);
     const Angle &a4 = t4[k][0], &a5 = t5[k][0];
     const double f2 = e2 * a4.c + e3 * a4.s, f3 = -e2 * a4.s + e3 * a4.c;
-    a6[k].q = fastmath::atan2(o.tau * (e1 * a5.s + f3 * a5.c), f2);
+    x6[k] = f2;
+    y6[k] = o.tau * (e1 * a5.s + f3 * a5.c);
   }
-  IkSolutions out;
+  for (int k = 0; k < na; k += 2) {
+    if (k + 1 < na) {
+      fastmath::atan2x2(y6[k], x6[k], y6[k + 1], x6[k + 1], a6[k].q, a6[k + 1].q);
+    } else {
+      a6[k].q = fastmath::atan2(y6[k], x6[k]);
+    }
+  }
+#if defined(__SSE2__)
+  if (deliver_now) {
+    deliver_arms(out, q1s, n1, arm, na, t4, t5, a6, n45, ref_deg, lo_, hi_, [&](double* q) { polish(q, gr); });
+    return out;
+  }
+#endif
   for (int k = 0; k < na; ++k) {
     if (n45[k] == 2) {  // the other wrist: (q4 + pi, -q5, q6 + pi)
       t4[k][1].q = t4[k][0].q + kPi;
@@ -112,8 +255,8 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
     }
     const int b45 = br.pick_wrist(t4[k], t5[k], n45[k]);
     for (int i45 = br.begin(b45); i45 < br.end(b45, n45[k]); ++i45) {
-      double q[6] = {arm[k].a1.q, arm[k].a2.q, arm[k].a3.q, t4[k][i45].q, t5[k][i45].q, a6[k].q + i45 * kPi};
-      record(out, q, std::abs(t5[k][i45].s), gr, false, arm[k].clamped);
+      double q[6] = {q1s[arm[k].i1].q, arm[k].a2.q, arm[k].a3.q, t4[k][i45].q, t5[k][i45].q, a6[k].q + i45 * kPi};
+      record(out, q, std::abs(t5[k][i45].s), gr, false, arm[k].clamped, opt, deliver_now);
     }
   }
   return out;

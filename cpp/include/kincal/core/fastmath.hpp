@@ -134,13 +134,52 @@ inline double atan2(double y, double x) {
   const double ck = k * (1.0 / 16);
   const double u = (t - ck) / (1 + t * ck);  // atan t = atan ck + atan u, |u| <= 1/32
   const double u2 = u * u;
-  const double au = u + u * u2 * (-1.0 / 3 + u2 * (1.0 / 5 + u2 * (-1.0 / 7 + u2 * (1.0 / 9 + u2 * (-1.0 / 11)))));
+  const double u4 = u2 * u2, u3 = u * u2;  // the series by Estrin's scheme: half Horner's latency
+  const double au = u + u3 * ((-1.0 / 3 + u2 * (1.0 / 5)) + u4 * ((-1.0 / 7 + u2 * (1.0 / 9)) + u4 * (-1.0 / 11)));
   const double atk = kAtanSixteenths[k];
   double a = atk + au;
   constexpr double pio2_lo = kPiLo / 2;
   if (ay > ax) a = (kPiHi / 2 - atk) + (pio2_lo - au);  // atan(y/x) = pi/2 - atan(x/y)
   if (x < 0) a = (kPiHi - a) + kPiLo;
   return std::signbit(y) ? -a : a;
+}
+
+/// atan2 of two arguments at once in the two lanes of an SSE2 register (GCC/Clang vector
+/// extensions): lane by lane the operations of atan2, so the results are bit-identical to two atan2
+/// calls (test_fastmath.cpp), at about half the instructions and one division per pair where two
+/// calls take two. A lane with a zero, infinity or NaN sends both to atan2.
+inline void atan2x2(double y0, double x0, double y1, double x1, double& a0, double& a1) {
+  using namespace detail;
+  typedef double v2d __attribute__((vector_size(16)));
+  typedef long long v2l __attribute__((vector_size(16)));
+  const v2d y = {y0, y1}, x = {x0, x1};
+  const v2l abs_mask = {0x7fffffffffffffffLL, 0x7fffffffffffffffLL};
+  const v2d ax = (v2d)((v2l)x & abs_mask), ay = (v2d)((v2l)y & abs_mask);
+  const v2l x_bigger = ax > ay, y_bigger = ay > ax;
+  const v2d big = x_bigger ? ax : ay, small = x_bigger ? ay : ax;
+  const v2l ok = (big > 0) & (big < HUGE_VAL) & (small < big * 1e300);
+  if (!(ok[0] && ok[1])) {
+    a0 = fastmath::atan2(y0, x0);
+    a1 = fastmath::atan2(y1, x1);
+    return;
+  }
+  const v2d t = small / big;  // in [0, 1]
+  const v2d t16 = t * 16 + 0.5;
+  const int k0 = static_cast<int>(t16[0]), k1 = static_cast<int>(t16[1]);
+  const v2d ck = v2d{static_cast<double>(k0), static_cast<double>(k1)} * (1.0 / 16);
+  const v2d u = (t - ck) / (1 + t * ck);  // atan t = atan ck + atan u, |u| <= 1/32
+  const v2d u2 = u * u;
+  const v2d u4 = u2 * u2, u3 = u * u2;  // as atan2
+  const v2d au = u + u3 * ((-1.0 / 3 + u2 * (1.0 / 5)) + u4 * ((-1.0 / 7 + u2 * (1.0 / 9)) + u4 * (-1.0 / 11)));
+  const v2d atk = {kAtanSixteenths[k0], kAtanSixteenths[k1]};
+  constexpr double pio2_lo = kPiLo / 2;
+  v2d a = atk + au;
+  a = y_bigger ? (kPiHi / 2 - atk) + (pio2_lo - au) : a;  // atan(y/x) = pi/2 - atan(x/y)
+  a = x < 0 ? (kPiHi - a) + kPiLo : a;
+  const v2l sign = {static_cast<long long>(0x8000000000000000ULL), static_cast<long long>(0x8000000000000000ULL)};
+  a = (v2d)((v2l)a ^ ((v2l)y & sign));
+  a0 = a[0];
+  a1 = a[1];
 }
 
 /// acos(x) for x in [-1, 1], as atan2(sqrt((1 - x)(1 + x)), x).

@@ -131,12 +131,16 @@ class IkSolver {
     double tau = 1;           ///< w6 = tau w4
     Vec3 w4 = Vec3::Zero(), w5 = Vec3::Zero(), n = Vec3::Zero(), m = Vec3::Zero();  ///< C w4, C w5, C n, C m
   };
-  IkSolutions solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt) const;
-  IkSolutions solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt) const;
+  IkSolutions solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const;
+  IkSolutions solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const;
   bool into_limits(Vec6& q_deg, const double* ref_deg) const;
   void to_degrees(IkSolutions& out, const double* ref_deg) const;
+  bool delivers(const IkOptions& opt) const;
+  bool deliver(const double* q, const double* ref_deg, double* q_deg) const;
   void fill_ortho(IkForm form, const Vec3& wrist_center);
-  void record(IkSolutions& out, double* q, double wrist, const Mat3& gr, bool shoulder, bool clamped) const;
+  void record(IkSolutions& out, double* q, double wrist, const Mat3& gr, bool shoulder, bool clamped,
+              const IkOptions& opt, bool deliver_now) const;
+  void polish(double* q, const Mat3& gr) const;
 
   IkStructure st_;
   Constants k_;

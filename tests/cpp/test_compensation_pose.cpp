@@ -99,7 +99,13 @@ TEST(Compensation, BlockSolveMatchesPivotedLu) {
 // kr500 with 1 mm / 0.05 deg geometric errors, with compliance (0.003 deg/kN m), and with compliance,
 // transmission error (harmonics 1, 2) and backlash on joints 1-3 (seed 7; poses: the nominal FK at
 // random configurations more than 1 deg from every singularity, started at that configuration).
-// Both stop at |F| < 1e-9, so the solutions agree to the joint-space image of that: 1e-8 deg.
+// Both stop at |F| < 1e-9, so the solutions agree to the joint-space image of that: 1e-8 deg, where
+// the solution is more than 0.5 deg from a singularity (nearer, the image of |F| grows: 1e-8..3e-8
+// deg at 0.2 deg). A pose where Newton's iteration wandered (a joint over 30 deg from the start, to
+// 942 deg once) is no solution a program wants and is not compared. Over seeds 0-20 Newton converges
+// near the start at 95.1-99.7% of the poses (1 deg from the nominal singularities is not 1 deg from
+// the calibrated robot's). Until the chord step was kept to |F| < 1e-3, the default iteration reached
+// another branch 5.8-10 deg away at one pose in 2000 at seeds 4, 5, 8 and 9.
 TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
   KINCAL_SEED_TRACE(7, 17);
   const Model nom(kr500_spec());
@@ -128,6 +134,7 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
       const Pose6 target = iso_to_pose(fk(nom, VecQ(q * kDeg)));
       const CompensationResult a = compensate(cal, target, q, reuse, ctx), b = compensate(cal, target, q, newton, ctx);
       // near the singularities either may fail where the other converges: count both
+      if (b.status == CompStatus::Converged && (b.q_deg - q).cwiseAbs().maxCoeff() > 30) continue;  // wandered
       converged_newton += b.status == CompStatus::Converged;
       if (a.status != CompStatus::Converged) continue;
       ++converged;
@@ -135,14 +142,14 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
       ++both;
       it_reuse += a.iterations;
       it_newton += b.iterations;
-      worst = std::max(worst, (a.q_deg - b.q_deg).cwiseAbs().maxCoeff());
+      if (test::singularity_distance_deg(nom, b.q_deg) > 0.5) worst = std::max(worst, (a.q_deg - b.q_deg).cwiseAbs().maxCoeff());
     }
     std::printf("converged: %d reused, %d Newton of %d; mean iterations where both did %.2f reused, %.2f Newton; "
                 "worst difference %.1e deg\n",
                 converged, converged_newton, poses, static_cast<double>(it_reuse) / both,
                 static_cast<double>(it_newton) / both, worst);
     EXPECT_EQ(both, converged_newton);  // converged wherever Newton did
-    EXPECT_GE(both, 1950);              // (from this start, 1 deg from singularities, 98.6-99.3% converge)
+    EXPECT_GE(both, 1880);              // (see above: 95.1-99.7% over seeds 0-20)
     EXPECT_LT(worst, 1e-8);
   }
 }

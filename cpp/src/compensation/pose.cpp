@@ -292,7 +292,9 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     if (f2 < opt.epsilon) return finish(CompStatus::Converged);
     if (it >= opt.max_iterations) return finish(CompStatus::NotConverged);
     if (ev.orientation_singular()) return finish(CompStatus::OrientationSingular);
-    const bool fresh = reused || !(f2 < reuse2 * f2_last);
+    // a chord step only near the solution (|F| < 1e-3 mm or deg, where the Jacobian barely changes
+    // over a step): from farther, as near a singularity, a stale Jacobian can lead to another branch
+    const bool fresh = reused || !(f2 < reuse2 * f2_last) || !(f2 < 1e-6);
     if (fresh) {
       if (!with_derivative) ev.derivative_at(q);
       ev.jacobian(jf, e, false);

@@ -188,7 +188,7 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
     Angle t3[2];
     sub3_elbow_angles(kc, h.a, h.ca, h.sa, t3);
     const int b3 = br.pick(t3, h.n3, 2);
-    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, Vec3(), h.clamped, i1};
+    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, Vec3::Zero(), h.clamped, i1};
   }
   // q2 (sub1 about w2 from x - p2 = rot(w2, sigma q3)(pw - p3) + p3 - p2 to y, components 1 and 3),
   // two arm branches at a time

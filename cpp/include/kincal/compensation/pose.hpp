@@ -36,7 +36,8 @@ struct CompensationOptions {
   double epsilon = 1e-15;          ///< stop when |F|^2 < epsilon (mm^2 + deg^2)
   int max_iterations = 20;
   /// The analytic Jacobian is reused (a chord step) while each step shrinks |F| by at least this
-  /// factor, and taken anew otherwise; 0 takes it at every step (Newton's iteration as eq. 8 reads).
+  /// factor and |F| < 1e-3 (mm, deg), and taken anew otherwise; 0 takes it at every step (Newton's
+  /// iteration as eq. 8 reads).
   double reuse_contraction = 0.1;
   /// The analytic iteration's first step corrected by its second-order term (the tool's acceleration
   /// along the step, solved with the same Jacobian): F falls to 1e-5..1e-3 of its start instead of

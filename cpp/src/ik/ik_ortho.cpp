@@ -26,6 +26,44 @@ struct Arm {
   int i1;  // its shoulder branch
 };
 
+// q3 of each shoulder branch the solve visits (the elbow's cosine, then the two branches'
+// arctangents as a pair), with u (the wrist centre), gw and gv (C G w6, C G w5) turned back by -q1;
+// the arm branches (q1, q3) into arm in solve_vector's order. Returns their count.
+int elbow_arms(const IkSolver::Constants& kc, const Branch& br, const Angle* q1s, int n1, const Vec3& u, const Vec3& gw,
+               const Vec3& gv, const Vec3& p21, bool clamped1, Tangency& tg, Shoulder* sh, Arm* arm) {
+  int na = 0;
+  const int b1 = br.pick(q1s, n1, 0);
+  const int i1_begin = br.begin(b1), i1_end = br.end(b1, n1);
+  for (int i1 = i1_begin; i1 < i1_end; ++i1) {
+    const Angle& a1 = q1s[i1];
+    Shoulder& h = sh[i1];
+    // rotation about axis 1 by -q1 on components 2, 3
+    auto r1 = [&](const Vec3& v) { return Vec3(v[0], v[1] * a1.c + v[2] * a1.s, -v[1] * a1.s + v[2] * a1.c); };
+    h.y = r1(u) - p21;
+    h.w6 = r1(gw);
+    h.v6 = r1(gv);
+    tg.clamped = clamped1;
+    h.n3 = sub3_elbow_cos(kc, h.y.norm(), h.ca, tg);
+    h.clamped = tg.clamped;
+    h.sa = h.n3 > 0 ? sine_of(h.ca) : 0.0;
+  }
+  if (i1_end - i1_begin == 2 && sh[0].n3 > 0 && sh[1].n3 > 0) {
+    fastmath::atan2x2(sh[0].sa, sh[0].ca, sh[1].sa, sh[1].ca, sh[0].a, sh[1].a);
+  } else {
+    for (int i1 = i1_begin; i1 < i1_end; ++i1)
+      if (sh[i1].n3 > 0) sh[i1].a = fastmath::atan2(sh[i1].sa, sh[i1].ca);
+  }
+  for (int i1 = i1_begin; i1 < i1_end; ++i1) {
+    const Shoulder& h = sh[i1];
+    if (h.n3 == 0) continue;
+    Angle t3[2];
+    sub3_elbow_angles(kc, h.a, h.ca, h.sa, t3);
+    const int b3 = br.pick(t3, h.n3, 2);
+    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, Vec3::Zero(), h.clamped, i1};
+  }
+  return na;
+}
+
 #if defined(__SSE2__)
 // The ortho form's solutions in degrees within the limits (IkSolver::delivers: all branches, a plain
 // reference), each angle converted once where solutions share it (q1 by up to four, q2 and q3 by
@@ -156,40 +194,10 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
   }
   const bool clamped1 = tg.clamped;
   Arm arm[4];
-  int na = 0;
   Angle q1s[2];
   for (int i = 0; i < n1; ++i) q1s[i] = negated(t1[i]);
-  const int b1 = br.pick(q1s, n1, 0);
-  // q3 of each shoulder branch (the elbow's cosine, then the two branches' arctangents as a pair)
   Shoulder sh[2];
-  const int i1_begin = br.begin(b1), i1_end = br.end(b1, n1);
-  for (int i1 = i1_begin; i1 < i1_end; ++i1) {
-    const Angle& a1 = q1s[i1];
-    Shoulder& h = sh[i1];
-    // rotation about axis 1 by -q1 on components 2, 3
-    auto r1 = [&](const Vec3& v) { return Vec3(v[0], v[1] * a1.c + v[2] * a1.s, -v[1] * a1.s + v[2] * a1.c); };
-    h.y = r1(u) - o.p21;
-    h.w6 = r1(gw);
-    h.v6 = r1(gv);
-    tg.clamped = clamped1;
-    h.n3 = sub3_elbow_cos(kc, h.y.norm(), h.ca, tg);
-    h.clamped = tg.clamped;
-    h.sa = h.n3 > 0 ? sine_of(h.ca) : 0.0;
-  }
-  if (i1_end - i1_begin == 2 && sh[0].n3 > 0 && sh[1].n3 > 0) {
-    fastmath::atan2x2(sh[0].sa, sh[0].ca, sh[1].sa, sh[1].ca, sh[0].a, sh[1].a);
-  } else {
-    for (int i1 = i1_begin; i1 < i1_end; ++i1)
-      if (sh[i1].n3 > 0) sh[i1].a = fastmath::atan2(sh[i1].sa, sh[i1].ca);
-  }
-  for (int i1 = i1_begin; i1 < i1_end; ++i1) {
-    const Shoulder& h = sh[i1];
-    if (h.n3 == 0) continue;
-    Angle t3[2];
-    sub3_elbow_angles(kc, h.a, h.ca, h.sa, t3);
-    const int b3 = br.pick(t3, h.n3, 2);
-    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, Vec3::Zero(), h.clamped, i1};
-  }
+  const int na = elbow_arms(kc, br, q1s, n1, u, gw, gv, o.p21, clamped1, tg, sh, arm);
   // q2 (sub1 about w2 from x - p2 = rot(w2, sigma q3)(pw - p3) + p3 - p2 to y, components 1 and 3),
   // two arm branches at a time
   double x2[4], y2[4];

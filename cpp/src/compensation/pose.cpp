@@ -276,8 +276,10 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
   double f2_last = 0;
   bool reused = true;  // the last step's Jacobian was a reused one (none yet)
   const double reuse2 = opt.reuse_contraction * opt.reuse_contraction;
+  // the joint effects' derivative d(actual)/dq once, at the start, in the fast iteration: it is I +
+  // O(1e-3) and moves by O(1e-5) over the steps, so the Jacobian's error is far below the chord's
   for (int it = 0;; ++it) {
-    const bool with_derivative = reused || reuse2 == 0;  // a fresh Jacobian is certain
+    const bool with_derivative = reuse2 == 0 || (it == 0 && reused);  // a fresh Jacobian is certain
     const Vec6 f = ev.deviation_at(q, with_derivative);
     const double f2 = f.squaredNorm();
     auto finish = [&](CompStatus status) {
@@ -296,7 +298,7 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     // over a step): from farther, as near a singularity, a stale Jacobian can lead to another branch
     const bool fresh = reused || !(f2 < reuse2 * f2_last) || !(f2 < 1e-6);
     if (fresh) {
-      if (!with_derivative) ev.derivative_at(q);
+      if (reuse2 == 0 && !with_derivative) ev.derivative_at(q);
       ev.jacobian(jf, e, false);
       const double det = fac.factor(ev, jf, e);
       if (!(det > 1e-18) || !std::isfinite(det)) return finish(CompStatus::SingularJacobian);

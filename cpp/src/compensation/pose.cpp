@@ -152,7 +152,12 @@ struct DeviationEvaluator {
   // F at q_deg; with derivative, d(actual joint angles)/dq as well (the Jacobian needs it)
   Vec6 deviation_at(const Vec6& q_deg, bool derivative = true) {
     const VecQ qr = q_deg * kDeg;
-    fk_frames(cal, effects ? joint_angles(cal, qr, ctx, derivative ? &dqd : nullptr) : qr, frames);
+    if (!effects)
+      fk_frames(cal, qr, frames);
+    else if (derivative)
+      fk_frames(cal, joint_angles(cal, qr, ctx, &dqd), frames);
+    else
+      fk_frames_actual(cal, qr, ctx, frames);
     const Vec3 pos = scale * frames.tool.translation();
     if (abc) {
       tr = abc_trig(frames.tool.linear());

@@ -66,6 +66,11 @@ void check_context(const Model& m, const EffectContext& ctx, const std::string& 
 /// backlash * dir; with dqd their derivative with respect to q. The context must suffice.
 VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ* dqd = nullptr);
 
+/// fk_frames at joint_angles(m, q, ctx), the sines and cosines of q shared by the gravity torque and
+/// the walk (theta's from q's by the small angle theta - q): one evaluation of the model's F in
+/// Newton compensation. The same frames as fk_frames(m, joint_angles(m, q, ctx)) to rounding.
+void fk_frames_actual(const Model& m, const VecQ& q, const EffectContext& ctx, ChainFrames& f);
+
 /// The factor every length of the robot scales by (thermal expansion; 1 without it).
 inline double length_scale(const Model& m, const EffectContext& ctx) {
   return m.thermal_alpha() == 0 ? 1.0 : 1.0 + m.thermal_alpha() * (ctx.temperature_c - m.spec().t_ref_c);

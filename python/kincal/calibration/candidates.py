@@ -79,11 +79,6 @@ def loaded_joints(robot: Robot, q_deg: Any, loaded: Sequence[int]) -> list[int]:
     return [j for j in loaded if top > 0 and tmax[j - 1] >= share * top]
 
 
-def _needs_column(kind: _core.EffectKind) -> str:
-    """The measurement-set key of the column an effect kind reads ('' when none)."""
-    return "dir" if kind.needs == "dir" else kind.needs
-
-
 def candidates(robot: Robot, data: MeasurementSet, start: Sequence[Candidate] = (),
                gravity: str = "auto") -> tuple[list[Candidate], list[str]]:
     """Every candidate effect (a _core.Effect per joint where it applies, from the registry; joint
@@ -95,8 +90,8 @@ def candidates(robot: Robot, data: MeasurementSet, start: Sequence[Candidate] = 
     for kind in _core.effect_kinds():
         if kind.domain != "serial":
             continue
-        col = _needs_column(kind)
-        have_col = bool(col) and getattr(data, col) is not None  # a column of the set, by the kind's needs
+        col = kind.needs  # the measurement set's attribute of the column the kind reads ('' when none)
+        have_col = bool(col) and getattr(data, col) is not None
         if col == "dir" and not have_col:
             notes.append(f"{kind.name} skipped: the data have no dir1..dir{robot.dof} columns")
             continue

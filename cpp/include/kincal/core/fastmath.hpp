@@ -146,8 +146,9 @@ inline double atan2(double y, double x) {
 
 /// atan2 of two arguments at once in the two lanes of an SSE2 register (GCC/Clang vector
 /// extensions): lane by lane the operations of atan2, so the results are bit-identical to two atan2
-/// calls (test_fastmath.cpp), at about half the instructions and one division per pair where two
-/// calls take two. A lane with a zero, infinity or NaN sends both to atan2.
+/// calls (test_fastmath.cpp), at about half the instructions: two vector divisions where two calls
+/// take four scalar ones. A lane with a zero, infinity or NaN sends both to atan2. (The scalar and
+/// the pair are written out separately: atan2's branches are the pair's lane selects.)
 inline void atan2x2(double y0, double x0, double y1, double x1, double& a0, double& a1) {
   using namespace detail;
   typedef double v2d __attribute__((vector_size(16)));

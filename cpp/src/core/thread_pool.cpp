@@ -53,6 +53,10 @@ class Pool {
     wake_.notify_all();
     pieces(0);
     std::unique_lock<std::mutex> lock(m_);
+    // every piece is handed out: a worker that has not joined yet would find nothing, so it is not
+    // waited for (on a short loop the caller would otherwise wait out a sleeping thread's wake-up)
+    active_ -= wanted_ - joined_;
+    wanted_ = joined_;
     done_.wait(lock, [this] { return active_ == 0; });
     f_ = nullptr;
     if (error_) std::rethrow_exception(error_);

@@ -18,41 +18,6 @@
 
 namespace kincal {
 
-namespace detail {
-
-/// J^T J with only its lower triangle filled (half the work of the product; what a self-adjoint
-/// solver reads).
-Eigen::MatrixXd normal_matrix_lower(const Eigen::MatrixXd& j) {
-  Eigen::MatrixXd n = Eigen::MatrixXd::Zero(j.cols(), j.cols());
-  n.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose());
-  return n;
-}
-
-/// The Jacobian of every parameter and the residuals of data at x.
-Linearization linearize(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x, double weight) {
-  const PointState at_x = pm.at(x);
-  const int P = pm.layout().size;
-  const size_t n = residual_size(residual_kind(data)) * data.rows.size();
-  std::vector<int> every(P);
-  std::iota(every.begin(), every.end(), 0);
-  RowMatrix J(n, P);
-  Linearization lin;
-  lin.residuals.assign(n, 0.0);
-  all_residuals(at_x, data, weight, every, lin.residuals.data(), J.data());
-  lin.jacobian = J;
-  // the artifact's known lengths and angles follow the rows, one residual each
-  const Eigen::Index rows = static_cast<Eigen::Index>(n);
-  lin.jacobian.conservativeResize(rows + static_cast<Eigen::Index>(data.artifact.size()), P);
-  std::vector<double> grad(static_cast<size_t>(P));
-  for (size_t k = 0; k < data.artifact.size(); ++k) {
-    lin.residuals.push_back(at_x.artifact_residual(data.artifact[k], grad.data()));
-    for (int c = 0; c < P; ++c) lin.jacobian(rows + static_cast<Eigen::Index>(k), c) = grad[static_cast<size_t>(c)];
-  }
-  return lin;
-}
-
-}  // namespace detail
-
 using detail::linearize;
 using detail::normal_matrix_lower;
 

@@ -2,6 +2,7 @@
 // of the two translation units that include Ceres (builds stay quick).
 #include "kincal/identify/identify.hpp"
 
+#include "ceres_rows.hpp"
 #include "fit_setup.hpp"
 
 #include "kincal/identify/identifiability.hpp"
@@ -17,139 +18,10 @@
 
 namespace kincal {
 
-using namespace fit_setup;  // the checks and starts before Ceres runs
+using namespace fit_setup;   // the checks and starts before Ceres runs
+using namespace ceres_rows;  // the rows as Ceres reads them
 
 namespace {
-
-/// Fills residuals and Jacobians of every row once per evaluation point (the cost functions read).
-class AllRows : public ceres::EvaluationCallback {
- public:
-  /// x: the full parameter vector (held values stay, free ones are written back by finish());
-  /// Ceres sees only the free parameters (z), so no manifold is needed.
-  /// base: the measurement model at some parameters (its mode: full, or the frames alone).
-  AllRows(PointState base, const MeasurementSet& d, std::vector<double>& x, std::vector<int> free_idx, double weight)
-      : state_(std::move(base)), d_(d), x_(x), free_(std::move(free_idx)), F_(static_cast<int>(free_.size())),
-        RS_(residual_size(residual_kind(d))), w_(weight), r_(RS_ * d.rows.size()), j_(RS_ * d.rows.size() * F_),
-        ar_(d.artifact.size()), aj_(d.artifact.size() * F_) {
-    for (int i : free_) z_.push_back(x_[i]);
-  }
-  void PrepareForEvaluation(bool jacobians, bool /*new_point*/) override {
-    // rows already evaluated at this very point (Ceres's repeated calls, or the seed) are kept
-    if (valid_ && z_ == at_ && (!jacobians || have_j_)) return;
-    for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
-    state_ = state_.with_params(x_);
-    all_residuals(state_, d_, w_, free_, r_.data(), jacobians ? j_.data() : nullptr);
-    std::vector<double> grad(jacobians ? x_.size() : 0);
-    for (size_t k = 0; k < d_.artifact.size(); ++k) {
-      ar_[k] = state_.artifact_residual(d_.artifact[k], jacobians ? grad.data() : nullptr);
-      if (jacobians)
-        for (int c = 0; c < F_; ++c) aj_[k * F_ + c] = grad[free_[c]];
-    }
-    valid_ = true;
-    have_j_ = jacobians;
-    at_ = z_;
-  }
-  /// Rows already evaluated at the start point (the residuals and the Jacobian of every parameter,
-  /// at the same x): the first evaluation reuses them.
-  void seed(const Linearization& start) {
-    const size_t n = RS_ * d_.rows.size();
-    for (size_t i = 0; i < n; ++i) {
-      r_[i] = start.residuals[i];
-      for (int k = 0; k < F_; ++k) j_[i * F_ + k] = start.jacobian(static_cast<Eigen::Index>(i), free_[k]);
-    }
-    for (size_t a = 0; a < ar_.size(); ++a) {  // the artifact's terms follow the rows
-      ar_[a] = start.residuals[n + a];
-      for (int k = 0; k < F_; ++k) aj_[a * F_ + k] = start.jacobian(static_cast<Eigen::Index>(n + a), free_[k]);
-    }
-    valid_ = have_j_ = true;
-    at_ = z_;
-  }
-  void finish() {
-    for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
-  }
-  /// The residuals at the current point (Ceres's last evaluation may have been a rejected step).
-  void refresh() { PrepareForEvaluation(false, true); }
-  double* z() { return z_.data(); }
-  const double* residual(size_t i) const { return &r_[RS_ * i]; }
-  const double* jacobian(size_t i) const { return &j_[RS_ * i * F_]; }
-  double artifact_residual(size_t k) const { return ar_[k]; }
-  const double* artifact_jacobian(size_t k) const { return &aj_[k * F_]; }
-  size_t artifact_terms() const { return ar_.size(); }
-  int row_size() const { return RS_; }
-  int size() const { return F_; }
-  size_t rows() const { return d_.rows.size(); }
-
- private:
-  PointState state_;  ///< the model at the last evaluation's point
-  const MeasurementSet& d_;
-  std::vector<double>& x_;
-  std::vector<int> free_;
-  int F_, RS_;
-  double w_;
-  std::vector<double> z_, r_, j_, at_;  // at_: the point r_ (and j_ if have_j_) were evaluated at
-  std::vector<double> ar_, aj_;         // the artifact's terms and their Jacobian rows
-  bool valid_ = false, have_j_ = false;
-};
-
-class RowCost : public ceres::CostFunction {
- public:
-  RowCost(const AllRows& all, size_t i) : all_(all), i_(i) {
-    set_num_residuals(all.row_size());
-    mutable_parameter_block_sizes()->push_back(all.size());
-  }
-  bool Evaluate(double const* const*, double* residuals, double** jacobians) const override {
-    std::copy_n(all_.residual(i_), all_.row_size(), residuals);
-    if (jacobians && jacobians[0]) std::copy_n(all_.jacobian(i_), all_.row_size() * all_.size(), jacobians[0]);
-    return true;
-  }
-
- private:
-  const AllRows& all_;
-  size_t i_;
-};
-
-/// A known length or angle of the artifact (the --artifact file): one residual, no robust loss.
-class ArtifactCost : public ceres::CostFunction {
- public:
-  ArtifactCost(const AllRows& all, size_t k, double weight) : all_(all), k_(k), w_(weight) {
-    set_num_residuals(1);
-    mutable_parameter_block_sizes()->push_back(all.size());
-  }
-  bool Evaluate(double const* const*, double* residuals, double** jacobians) const override {
-    residuals[0] = w_ * all_.artifact_residual(k_);
-    if (jacobians && jacobians[0]) {
-      const double* g = all_.artifact_jacobian(k_);
-      for (int i = 0; i < all_.size(); ++i) jacobians[0][i] = w_ * g[i];
-    }
-    return true;
-  }
-
- private:
-  const AllRows& all_;
-  size_t k_;
-  double w_;
-};
-
-/// Ridge penalties and Gaussian priors: residual w_k (z_k - m_k) for the free parameters that carry one.
-class PenaltyCost : public ceres::CostFunction {
- public:
-  PenaltyCost(std::vector<PenaltyTerm> terms, int size) : terms_(std::move(terms)), size_(size) {
-    set_num_residuals(static_cast<int>(terms_.size()));
-    mutable_parameter_block_sizes()->push_back(size);
-  }
-  bool Evaluate(double const* const* z, double* residuals, double** jacobians) const override {
-    for (size_t i = 0; i < terms_.size(); ++i) residuals[i] = terms_[i].weight * (z[0][terms_[i].index] - terms_[i].mean);
-    if (jacobians && jacobians[0]) {
-      std::fill_n(jacobians[0], terms_.size() * size_, 0.0);
-      for (size_t i = 0; i < terms_.size(); ++i) jacobians[0][i * size_ + terms_[i].index] = terms_[i].weight;
-    }
-    return true;
-  }
-
- private:
-  std::vector<PenaltyTerm> terms_;
-  int size_;
-};
 
 /// The penalty terms of the free parameters (towards zero); InputError for a name the layout does
 /// not have or a weight that is negative or not finite.
@@ -206,14 +78,17 @@ enum class Report { silent, progress };
 void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, const IdentifyOptions& opt,
            ceres::Solver::Summary& summary, Report report, const std::vector<PenaltyTerm>& penalties = {},
            double artifact_weight = 1.0) {
-  for (size_t i = 0; i < all.rows(); ++i) problem.AddResidualBlock(new RowCost(all, i), loss, all.z());
+  // without a loss the rows' blocks are sized for the cache (a block's Jacobian about 32 KB)
+  const size_t per_block = loss ? 1 : std::max<size_t>(1, 4096 / static_cast<size_t>(all.row_size() * all.size()));
+  for (size_t i = 0; i < all.rows(); i += per_block)
+    problem.AddResidualBlock(new RowCost(all, i, std::min(per_block, all.rows() - i)), loss, all.z());
   for (size_t k = 0; k < all.artifact_terms(); ++k)
     problem.AddResidualBlock(new ArtifactCost(all, k, artifact_weight), nullptr, all.z());
   if (!penalties.empty()) problem.AddResidualBlock(new PenaltyCost(penalties, all.size()), nullptr, all.z());
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = opt.max_iterations;
-  so.function_tolerance = 1e-15;
+  so.function_tolerance = 1e-10;
   so.gradient_tolerance = 1e-14;
   so.parameter_tolerance = 1e-14;
   so.num_threads = 1;
@@ -231,8 +106,9 @@ Vec3 target_of(const ParamLayout& L, const std::vector<double>& x, int t) {
 /// Stage 1: the base frame of every setup, the targets and the drift fitted on the nominal geometry
 /// (the "before" of the summary, and a start where the targets are where they are, so that the
 /// identifiability analysis sees the real geometry). x: from the start to the fitted frames.
-void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet& data, const IdentifyOptions& opt,
-                std::vector<double>& x, IdentifyResult& res) {
+/// start: the frames-only evaluation at x (PointModel::at_frames_only).
+void fit_frames(const PointModel& pm, const PointState& start, const Model& nominal, const MeasurementSet& data,
+                const IdentifyOptions& opt, std::vector<double>& x, IdentifyResult& res) {
   const ParamLayout& L = res.layout;
   std::vector<int> frames = frame_columns(L, data, res);
   for (int i = L.stations; i < L.size; ++i)  // the probe stations are the campaign's frames too
@@ -242,7 +118,7 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
       if (!res.fixed[i]) frames.push_back(i);
   ceres::Solver::Summary summary;
   // only the base and target columns are needed here: every row's flange frame computed once
-  AllRows all(pm.at_frames_only(x, data), data, x, frames, opt.orientation_weight);
+  AllRows all(start, data, x, frames, opt.orientation_weight);
   ceres::Problem problem(problem_options(all));
   std::unique_ptr<ceres::LossFunction> loss = make_loss(opt, opt.loss_scale_mm);  // a scale from the data: none yet
   solve(problem, all, loss.get(), opt, summary, Report::silent);
@@ -258,8 +134,19 @@ void fit_frames(const PointModel& pm, const Model& nominal, const MeasurementSet
   }
   for (int t = 0; t < data.n_targets; ++t) res.nominal_targets.push_back(target_of(L, x, t));
   res.nominal_stations = fitted.stations();
+  // every row's error at the fitted frames (row_errors' figure): the frames-only rows at that point,
+  // whose flange frames are those of the fitted model unless the fit moved the tool (6-D rows: the
+  // payload's centre of mass moves with it, and with it the gravity torque)
+  std::vector<double> errors;
+  if (data.orientation) {
+    errors = row_errors(fitted, data);
+  } else {
+    all.refresh();
+    for (size_t i = 0; i < data.rows.size(); ++i)
+      errors.push_back(Eigen::Map<const Eigen::VectorXd>(all.residual(i), position_equations(data.rows[i])).norm());
+  }
   double ss = 0;
-  for (double e : row_errors(fitted, data)) {
+  for (double e : errors) {
     ss += e * e;
     res.nominal_max_mm = std::max(res.nominal_max_mm, e);
   }
@@ -345,7 +232,7 @@ class Stage2 {
   void solve(const std::vector<int>& free_idx, const Linearization* start, double scale_mm,
              std::vector<PenaltyTerm> priors, double artifact_weight = 1.0) {
     problem_.reset();  // before the rows and the loss it refers to
-    all_ = std::make_unique<AllRows>(pm_.at(x_), data_, x_, free_idx, opt_.orientation_weight);
+    all_ = std::make_unique<AllRows>(pm_.at(x_), data_, x_, free_idx, opt_.orientation_weight, AllRows::Columns::every);
     if (start) all_->seed(*start);
     loss_ = make_loss(opt_, scale_mm);
     scale_ = loss_ ? scale_mm : 0.0;
@@ -440,8 +327,9 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   std::vector<double> x = res.start;
   // stage 1: the frames on the nominal geometry; then what the data cannot determine is held (or,
   // with priors, left to them)
-  hold_unseen_frames(pm, data, x, opt, res);
-  fit_frames(pm, nominal, data, opt, x, res);
+  const PointState frames_only = pm.at_frames_only(x, data);  // every row's flange frame once
+  hold_unseen_frames(frames_only, data, opt, res);
+  fit_frames(pm, frames_only, nominal, data, opt, x, res);
   res.prior_sd = prior_sds(res.layout, opt);
   const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd);
   const std::vector<int> free_idx = free_parameters(data, res, res.prior_sd);
@@ -485,7 +373,8 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   store_solution(pm, nominal, data, x, res);
   // the joint ranges the starting campaign recorded stay with the refitted one (its caller records new ones)
   res.campaign.fitted_deg = res.nominal_campaign.fitted_deg = reference.fitted_deg;
-  observability(pm, data, opt, res);
+  // the observability figures at the solution: the stage-2 rows' Jacobian there when it is at hand
+  observability(pm, data, opt, res, s2.free() == free_idx ? s2.rows().jacobian_here() : nullptr);
   if (s2.free() == free_idx) covariance(s2.problem(), s2.rows(), s2.summary, free_idx, opt, res);
   else res.stddev.assign(res.layout.size, std::nan(""));
   return res;

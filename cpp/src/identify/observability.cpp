@@ -56,20 +56,19 @@ Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>&
   return v;
 }
 
-}  // namespace
-
-bool scale_seen(const PointModel& pm, const Eigen::MatrixXd& J, const std::vector<double>& x) {
+template <class Matrix>
+bool scale_seen_by(const PointModel& pm, const Matrix& J, const std::vector<double>& x) {
   const Eigen::VectorXd v = scale_direction(pm, x);
   double parts = 0;
   for (Eigen::Index i = 0; i < v.size(); ++i) parts += J.col(i).squaredNorm() * v[i] * v[i];
   return (J * v).norm() > 1e-3 * std::sqrt(parts);
 }
 
-void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res) {
-  const Eigen::MatrixXd J = linearize(pm, data, res.x, opt.orientation_weight).jacobian;
+template <class Matrix>
+void observability_of(const PointModel& pm, const Matrix& J, const MeasurementSet& data, IdentifyResult& res) {
   // the overall scale: what the rows see of a uniform scaling of every length, against what a point
   // measured at the robot's reach would see (a probe campaign without a known length sees nothing)
-  res.scale_determined = scale_seen(pm, J, res.x);
+  res.scale_determined = scale_seen_by(pm, J, res.x);
   std::vector<int> free_idx;
   for (int i = 0; i < res.layout.size; ++i)  // what the data determine (not the priors)
     if (!res.fixed[i] && !(i < static_cast<int>(res.at_prior.size()) && res.at_prior[i])) free_idx.push_back(i);
@@ -85,6 +84,22 @@ void observability(const PointModel& pm, const MeasurementSet& data, const Ident
   double logsum = 0;
   for (int k = 0; k < s.size(); ++k) logsum += std::log(s(k));
   res.observability_index = std::exp(logsum / s.size()) / std::sqrt(static_cast<double>(data.rows.size()));
+}
+
+}  // namespace
+
+bool scale_seen(const PointModel& pm, const Eigen::MatrixXd& J, const std::vector<double>& x) {
+  return scale_seen_by(pm, J, x);
+}
+
+void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res,
+                   const double* jacobian) {
+  if (jacobian && data.artifact.empty()) {
+    const Eigen::Index rows = static_cast<Eigen::Index>(residual_size(residual_kind(data)) * data.rows.size());
+    observability_of(pm, Eigen::Map<const RowMatrix>(jacobian, rows, pm.layout().size), data, res);
+  } else {
+    observability_of(pm, linearize(pm, data, res.x, opt.orientation_weight).jacobian, data, res);
+  }
 }
 
 }  // namespace kincal

@@ -4,6 +4,8 @@
 // row and of a whole measurement set.
 #include "point_eval.hpp"
 
+#include "../core/thread_pool.hpp"
+
 #include "kincal/identify/so3.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
@@ -242,16 +244,19 @@ std::shared_ptr<const FlangeCache> PointEval::compute_flanges(const MeasurementS
   const int n = layout_.dof;
   out->rows.resize(data.rows.size());
   out->first = data.rows.data();
-  for (size_t i = 0; i < data.rows.size(); ++i) {
-    const Measurement& m = data.rows[i];
-    FlangeCache::Flange& f = out->rows[i];
-    GravityState gs;
-    std::array<Mat3, kMaxJoints + 1> gr;
-    std::array<Vec3, kMaxJoints + 1> gt;
-    row_frames(model_for(m.payload_kg), m, gs, gr, gt, f.scale);
-    f.r = gr[n];
-    f.t = gt[n];
-  }
+  const size_t rows = data.rows.size(), threads = std::min(pool_threads(), rows / 256 + 1);
+  parallel_pieces(rows, (rows + threads - 1) / threads, threads, [&](size_t begin, size_t end, size_t) {
+    for (size_t i = begin; i < end; ++i) {
+      const Measurement& m = data.rows[i];
+      FlangeCache::Flange& f = out->rows[i];
+      GravityState gs;
+      std::array<Mat3, kMaxJoints + 1> gr;
+      std::array<Vec3, kMaxJoints + 1> gt;
+      row_frames(model_for(m.payload_kg), m, gs, gr, gt, f.scale);
+      f.r = gr[n];
+      f.t = gt[n];
+    }
+  });
   return out;
 }
 

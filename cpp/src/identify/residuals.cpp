@@ -47,7 +47,7 @@ int row_residuals(const PointState& pm, const Measurement& m, ResidualKind kind,
 }
 
 void all_residuals(const PointState& pm, const MeasurementSet& data, double orientation_weight,
-                   const std::vector<int>& columns, double* r, double* J) {
+                   const std::vector<int>& columns, double* r, double* J, size_t column_stride) {
   const ResidualKind kind = residual_kind(data);
   const size_t RS = residual_size(kind), P = pm.layout().size, F = columns.size(), n = data.rows.size();
   // at least 256 rows per thread (fewer do not pay for the hand-over), one contiguous piece each
@@ -59,9 +59,12 @@ void all_residuals(const PointState& pm, const MeasurementSet& data, double orie
     double row_r[6];
     for (size_t i = begin; i < end; ++i) {
       row_residuals(pm, data.rows[i], kind, orientation_weight, r ? r + RS * i : row_r, full, full ? full + 6 * P : nullptr);
-      if (J)
+      if (J && column_stride == 0)
         for (size_t k = 0; k < RS; ++k)
           for (size_t c = 0; c < F; ++c) J[(RS * i + k) * F + c] = full[k * P + columns[c]];
+      else if (J)
+        for (size_t c = 0; c < F; ++c)
+          for (size_t k = 0; k < RS; ++k) J[c * column_stride + RS * i + k] = full[k * P + columns[c]];
     }
   });
 }

@@ -4,14 +4,12 @@
 
 #include "linearization.hpp"
 
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
 namespace kincal {
-
-using detail::linearize;
 
 std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data, const IdentifyResult& res) {
   const auto unseen = [&](int i) { return held_unseen(res, i); };
@@ -28,29 +26,38 @@ std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data,
   return frames;
 }
 
-void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
-                        const IdentifyOptions& opt, IdentifyResult& res) {
+void hold_unseen_frames(const PointState& frames_only, const MeasurementSet& data, const IdentifyOptions& opt,
+                        IdentifyResult& res) {
   if (data.has_probe() || data.rows.empty()) return;
   const ParamLayout& L = res.layout;
   const auto on_tool = [&](int i) {  // a target's offset, or the tool frame a 6-D row measures
     return (i >= L.targets && i < L.effects) || (data.orientation && i >= L.tool && i < L.tool + 6);
   };
-  const Eigen::MatrixXd J = linearize(pm, data, x, opt.orientation_weight).jacobian;
+  // the frames' columns alone, from the frames-only evaluation (every row's flange frame once; the
+  // same columns as the full linearization's at x, without the robot's own)
+  const std::vector<int> frames = frame_columns(L, data, res);
+  const Eigen::Index F = static_cast<Eigen::Index>(frames.size());
+  Eigen::MatrixXd J(static_cast<Eigen::Index>(residual_size(residual_kind(data)) * data.rows.size()), F);
+  all_residuals(frames_only, data, opt.orientation_weight, frames, nullptr, J.data(), static_cast<size_t>(J.rows()));
+  std::vector<Eigen::Index> at(static_cast<size_t>(L.size), -1);  // a parameter's column in J
   std::vector<int> cols;  // what the frames' fit moves (frame_columns), where the rows see it at all
-  for (int i : frame_columns(L, data, res))
-    if (J.col(i).norm() > 0) cols.push_back(i);
+  for (Eigen::Index c = 0; c < F; ++c) {
+    at[static_cast<size_t>(frames[static_cast<size_t>(c)])] = c;
+    if (J.col(c).norm() > 0) cols.push_back(frames[static_cast<size_t>(c)]);
+  }
   // the smallest singular value of the unit-scaled columns: below the weak tolerance its direction is
   // held by one parameter, the largest part of it on the tool when the tool takes a fair share (the
   // depth of a reflector along the axis every orientation shares), else the largest; again until none
   while (!cols.empty()) {
     Eigen::MatrixXd A(J.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (size_t c = 0; c < cols.size(); ++c) A.col(static_cast<Eigen::Index>(c)) = J.col(cols[c]).normalized();
-    // the full V: with fewer residuals than columns its last columns span the null space
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
-    const Eigen::Index last = A.cols() - 1;
-    const double sigma = last < static_cast<Eigen::Index>(svd.singularValues().size()) ? svd.singularValues()[last] : 0.0;
+    for (size_t c = 0; c < cols.size(); ++c) A.col(static_cast<Eigen::Index>(c)) = J.col(at[static_cast<size_t>(cols[c])]).normalized();
+    // the smallest singular value and its right vector from the (few columns') normal matrix: its
+    // eigenvalues are the squares, exact to about 1e-15 beside the weak tolerance's square 4e-6 (with
+    // fewer residuals than columns the smallest is 0, its vector in the null space)
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(detail::normal_matrix_lower(A));
+    const double sigma = std::sqrt(std::max(0.0, eig.eigenvalues()[0]));
     if (sigma >= opt.weak_tolerance) break;
-    const Eigen::VectorXd v = svd.matrixV().col(last);
+    const Eigen::VectorXd v = eig.eigenvectors().col(0);
     Eigen::Index pick = 0, pick_tool = -1;
     for (Eigen::Index c = 0; c < v.size(); ++c) {
       if (std::abs(v[c]) > std::abs(v[pick])) pick = c;
@@ -58,7 +65,7 @@ void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const 
     }
     if (pick_tool >= 0 && std::abs(v[pick_tool]) >= 0.5 * std::abs(v[pick])) pick = pick_tool;
     std::string with;  // the direction in the parameters' units, per unit of the one held
-    const auto unit_step = [&](Eigen::Index c) { return v[c] / J.col(cols[static_cast<size_t>(c)]).norm(); };
+    const auto unit_step = [&](Eigen::Index c) { return v[c] / J.col(at[static_cast<size_t>(cols[static_cast<size_t>(c)])]).norm(); };
     for (Eigen::Index c = 0; c < v.size(); ++c)
       if (c != pick && std::abs(v[c]) >= 0.2) {
         char part[96];

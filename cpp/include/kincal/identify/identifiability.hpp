@@ -52,8 +52,10 @@ inline bool held_unseen(const IdentifyResult& res, int i) {
 /// held; what hold_unseen_frames held excluded. (The probe stations and the drift come on top.)
 std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data, const IdentifyResult& res);
 
-void hold_unseen_frames(const PointModel& pm, const MeasurementSet& data, const std::vector<double>& x,
-                        const IdentifyOptions& opt, IdentifyResult& res);
+/// frames: the frames-only evaluation at the start (PointModel::at_frames_only), which the frames'
+/// fit then starts from.
+void hold_unseen_frames(const PointState& frames, const MeasurementSet& data, const IdentifyOptions& opt,
+                        IdentifyResult& res);
 
 /// The data's residuals (every row's block, then one per artifact term) and their Jacobian.
 struct Linearization {
@@ -77,13 +79,16 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
                                  std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
                                  const std::vector<double>& prior_sd = {});
 
-/// The condition number and the observability index of the free parameters (the unit-scaled
-/// Jacobian at res.x), into res.
 /// Whether the rows (their Jacobian J at x, the artifact's terms included) see a uniform scaling of
 /// every length: what is left of it in the rows against what its parts alone would show (a probe
 /// campaign without a known length leaves almost nothing: only the gravity torques' centres of
 /// mass, given in mm, see it at all).
 bool scale_seen(const PointModel& pm, const Eigen::MatrixXd& J, const std::vector<double>& x);
-void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res);
+/// The condition number and the observability index of the free parameters (the unit-scaled
+/// Jacobian at res.x), into res. jacobian: the rows' Jacobian at res.x when the caller has it
+/// (row-major, a row per residual, a column per parameter, as all_residuals with every column;
+/// used only when the data have no artifact terms), else null: evaluated here.
+void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res,
+                   const double* jacobian = nullptr);
 
 }  // namespace kincal

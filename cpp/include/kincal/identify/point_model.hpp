@@ -221,10 +221,11 @@ int row_residuals(const PointState& pm, const Measurement& m, ResidualKind kind,
 
 /// The residuals of every row of data at pm's parameters (residual_size(residual_kind(data)) per
 /// row, in order, into r; r null: not kept) and, when J is not null, the Jacobian's columns
-/// `columns` in that order (row-major: a row per residual, columns.size() wide). The rows are
+/// `columns` in that order (row-major: a row per residual, columns.size() wide; or, when column_stride
+/// is not 0, column-major: residual k of column c at J[c * column_stride + k]). The rows are
 /// evaluated on the process's thread pool, 256 rows or more per thread; nothing is allocated per row.
 void all_residuals(const PointState& pm, const MeasurementSet& data, double orientation_weight,
-                   const std::vector<int>& columns, double* r, double* J);
+                   const std::vector<int>& columns, double* r, double* J, size_t column_stride = 0);
 
 /// Every row's error at pm's parameters (mm): a point's distance from its prediction, a probe row's
 /// residual along its constraint (a sphere row's distance from the station's point, a plane or ballbar

@@ -312,9 +312,17 @@ TEST(Identifiability, OneToolAxisHoldsAReflectorsDepth) {
       EXPECT_EQ(res.x[i], res.start[i]) << L.names[i];
     }
   EXPECT_EQ(unseen, 1);
-  // what the data do determine: the targets relative to each other, along the axis too
-  for (int t = 1; t < 3; ++t)
-    EXPECT_NEAR(res.targets[static_cast<size_t>(t)].z() - res.targets[0].z(), kTargets[static_cast<size_t>(t)].z() - kTargets[0].z(), 0.5) << t;
+  // the targets' depths relative to each other do not slide either: the rows see them only through the
+  // tilt of the flange, which the one axis leaves partly to the robot's priors, so they are known to
+  // tenths of a mm, not to the noise (over KINCAL_TEST_SEED 1-30: -0.54 to 0.89 mm off; this test
+  // held them to 0.5 mm before, which three of the first twenty seeds missed), against the hundreds of
+  // mm an unheld depth slid (UR10 series D: 146-650 mm): no slide is within 2 mm
+  for (int t = 1; t < 3; ++t) {
+    const double off = res.targets[static_cast<size_t>(t)].z() - res.targets[0].z() -
+                       (kTargets[static_cast<size_t>(t)].z() - kTargets[0].z());
+    std::printf("target %d's depth relative to target 0: %.3f mm off\n", t, off);
+    EXPECT_LT(std::abs(off), 2.0) << t;
+  }
   const std::vector<double> e = point_errors(Model(res.calibrated), res.campaign, res.targets, held);
   double ss = 0;
   for (double v : e) ss += v * v;

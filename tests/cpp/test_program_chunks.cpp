@@ -51,8 +51,10 @@ std::vector<std::string> files_named(const std::string& prefix) {
 }
 
 // The kr500 with every effect: geometry and compliance, a transmission error of joint 2 fitted on a
-// narrow range of its angles (so that the program extrapolates it), backlash of joints 1 and 3, thermal
-// expansion.
+// narrow range of its angles (so that the program extrapolates it: Path's joint 2 runs at -50.4 to
+// -51.1 deg on the nominal model, and the calibration's errors move it by a degree or so: the range
+// ended at -50 deg until the robot of KINCAL_TEST_SEED=7 moved the whole path inside it; it now ends
+// 5 deg away), backlash of joints 1 and 3, thermal expansion.
 Robot every_effect_robot() {
   ModelSpec s = perturbed_spec(kr500_spec(), test::test_seed(8), 1.0, 0.05, 0.003);
   s.effects.push_back({Effect{"transmission_error", 1, {1, 2}}, {3e-4, -2e-4, 1e-4, 0.0}});
@@ -61,7 +63,7 @@ Robot every_effect_robot() {
   s.effects.push_back({Effect{"thermal_expansion", -1, {}}, {1.2e-5}});
   Campaign c;
   c.fitted_deg.assign(6, JointRange{-180.0, 180.0});
-  c.fitted_deg[1] = JointRange{-50.0, -45.0};
+  c.fitted_deg[1] = JointRange{-45.0, -40.0};
   return Robot{std::make_shared<Model>(kr500_spec()), std::make_shared<Model>(s), c};
 }
 

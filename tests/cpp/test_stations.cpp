@@ -244,21 +244,55 @@ TEST(Stations, SpheresWithALengthBarRecoverTheRobot) {
   EXPECT_LT(a.fit_rms, 0.02);  // the fit reaches the noise (0.005 mm per axis)
 }
 
+// The simulator places every sphere and ballbar pivot in reach (issue 32): a station whose seed pose
+// leaves too few of its touches reachable is placed again. Over 40 draws (truths and campaigns: the
+// kr500 with 1 mm / 0.05 deg errors and compliance; 6 spheres x 25 touches and 4 pivots x 40 in a 60 deg
+// cone, the ball 150 mm out) every station has all its touches; before, the ballbar of
+// KINCAL_TEST_SEED=10 in BlockFacesAndABallbarRecoverTheRobot was refused ("station S1 is out of the
+// robot's reach (18 of 40 touches)").
+TEST(Stations, EveryStationPlacedInReach) {
+  KINCAL_SEED_TRACE(91, 92);
+  for (unsigned k = 0; k < 20; ++k) {
+    const Model truth(truth_spec(91 + 100 * k, 0.003));
+    for (const MeasureKind kind : {MeasureKind::sphere, MeasureKind::distance}) {
+      const bool bar = kind == MeasureKind::distance;
+      const ProbeSimulationOptions so = probe_options(kind, bar ? 4 : 6, bar ? 40 : 25, 60, test::test_seed(92 + 100 * k));
+      MeasurementSet m;
+      ASSERT_NO_THROW(m = simulate_probe(truth, so)) << "draw " << k << (bar ? ", ballbar" : ", spheres");
+      std::vector<int> touches(static_cast<size_t>(so.stations), 0);
+      for (const Measurement& r : m.rows) ++touches[static_cast<size_t>(r.station)];
+      for (int t : touches) EXPECT_EQ(t, so.touches) << "draw " << k;
+    }
+  }
+}
+
 // Four faces of a 400 mm block (top, the one towards the robot and the two sideways; 40 touches each
 // in a 60 deg cone, 3 mm ball, touches over 70% of each face) with their 90 deg angles and the block's
 // edge between the sideways faces; and a ballbar of 150 mm at 4 pivots (40
 // rows each, 0.002 mm noise on its length). Truth and accuracy as above.
+// Random touches on four faces leave one direction mostly to the priors (BENCHMARKS.md, "Planning a
+// probe campaign"), so one draw says little: over 16 values of KINCAL_TEST_SEED a draw gave 0.028-0.41
+// mm (median 0.16; the default draw 0.083), and one of the 150 draws of KINCAL_TEST_SEED 1-30 0.61 mm
+// (9.8 times better than its nominal model). The claim is therefore on five draws (truth and touches
+// each their own): every one at least five times better than the nominal model, and their median
+// within issue 32's figure for a plain MAP fit of such touches on a similar robot (0.22-0.28 mm).
+// (A 120 mm block in a 35 deg cone: 3 mm, nothing determined.)
 TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
   KINCAL_SEED_TRACE(61, 62, 63, 64);
+  std::vector<double> identified;
+  for (unsigned k = 0; k < 5; ++k) {
+    const Model truth(truth_spec(61 + 100 * k, 0.003));
+    ProbeSimulationOptions planes = probe_options(MeasureKind::plane, 4, 40, 60, test::test_seed(62 + 100 * k));
+    planes.block_mm = 400;
+    const MeasurementSet faces = simulate_probe(truth, planes);
+    ASSERT_EQ(faces.artifact.size(), 4u);  // 3 angles, 1 edge
+    const Accuracy a = probe_accuracy(truth, faces, planes.probe, test::test_seed(63), "block faces");
+    EXPECT_LT(a.identified, a.nominal / 5) << "draw " << k;
+    identified.push_back(a.identified);
+  }
+  std::nth_element(identified.begin(), identified.begin() + 2, identified.end());
+  EXPECT_LT(identified[2], 0.28);  // the default draws: 0.083, 0.28, 0.34, 0.17, 0.20 mm (median 0.20)
   const Model truth(truth_spec(61, 0.003));
-  ProbeSimulationOptions planes = probe_options(MeasureKind::plane, 4, 40, 60, test::test_seed(62));
-  planes.block_mm = 400;
-  const MeasurementSet faces = simulate_probe(truth, planes);
-  ASSERT_EQ(faces.artifact.size(), 4u);  // 3 angles, 1 edge
-  const Accuracy a = probe_accuracy(truth, faces, planes.probe, test::test_seed(63), "block faces");
-  // measured 0.083 mm (0.038 before the simulator drew a touch's two face coordinates in a fixed order;
-  // four faces scatter 0.01-0.12 mm over seeds). A 120 mm block in a 35 deg cone: 3 mm, nothing determined
-  EXPECT_LT(a.identified, 0.1);
   ProbeSimulationOptions bar = probe_options(MeasureKind::distance, 4, 40, 60, test::test_seed(64));
   bar.noise_mm = 0.002;
   const Accuracy b = probe_accuracy(truth, simulate_probe(truth, bar), bar.probe, test::test_seed(63), "ballbar");
@@ -269,7 +303,9 @@ TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
 // Without a known length the overall scale is not seen: the result says so, and the ball centres the
 // fit predicts on 200 random configurations equal those of the fit with the length after the best
 // similarity transform (rotation, translation and scale: Umeyama) to 0.01 mm. Truth, campaign: the
-// spheres above (6 x 25 touches, 60 deg cone, 0.005 mm noise). A tracker campaign sees the scale.
+// spheres above (6 x 25 touches, 60 deg cone, 0.005 mm noise). A tracker campaign sees the scale (60
+// poses: 40, without priors, left base.rz barely determined on one of 30 draws, KINCAL_TEST_SEED=5,
+// and identify refused them before any scale was looked at).
 TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
   KINCAL_SEED_TRACE(51, 52, 53);
   const Model truth(truth_spec(51, 0.003)), nominal(kr500_spec());
@@ -290,7 +326,7 @@ TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
               sim.topLeftCorner<3, 3>().determinant() > 0 ? std::cbrt(sim.topLeftCorner<3, 3>().determinant()) : 0.0, rms);
   EXPECT_LT(rms, 0.01);
   SimulationOptions tracker;
-  tracker.poses = 40;
+  tracker.poses = 60;
   tracker.seed = test::test_seed(54);
   EXPECT_TRUE(identify(nominal, simulate(truth, tracker), opt).scale_determined);
 }

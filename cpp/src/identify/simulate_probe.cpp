@@ -14,6 +14,9 @@ namespace kincal {
 
 namespace {
 
+/// The places a sphere or a pivot is given before the simulation gives up on a station.
+constexpr int kStationAttempts = 20;
+
 /// A random rotation taking the direction `axis` (unit) within `cone` rad of itself, turned about
 /// the tool's own axis by up to +-60 deg.
 Mat3 tilt(std::mt19937_64& rng, const Vec3& axis, double cone) {
@@ -180,58 +183,68 @@ MeasurementSet simulate_probe(const Model& truth, const ProbeSimulationOptions& 
     const std::string name = opt.kind == MeasureKind::plane ? faces[s] : "S" + std::to_string(s + 1);
     m.station_names.push_back(name);
     m.station_kinds.push_back(opt.kind);
-    Vec3 axis;   // the probe's mean direction (the tool's z in the seed pose, or towards the face)
-    Vec3 centre, normal = Vec3::UnitZ();
-    VecQ ref;
-    Eigen::Isometry3d seed;
-    if (opt.kind == MeasureKind::plane) {
-      ref = block.q0;
-      seed = block.frame;
-      normal = Block::normal(s);
-      centre = block.centre(s);
-      axis = -normal;  // the probe points into the face
-    } else {
-      seed = seed_pose(ref);
-      centre = seed * opt.probe;
-      axis = seed.linear().col(2);
-      // the pivot on the probe's axis beyond the ball (the bar cannot pass through the tool)
-      if (opt.kind == MeasureKind::distance) centre += axis * opt.length_mm;
-      points.push_back(centre);
-    }
-    int made = 0, tries = 0;
-    while (made < opt.touches) {
-      if (++tries > 40 * opt.touches)
-        throw InputError("simulate: station " + name + " is out of the robot's reach (" + std::to_string(made) +
-                         " of " + std::to_string(opt.touches) + " touches)");
-      Measurement row;
-      row.pose = static_cast<int>(m.rows.size());
-      row.kind = opt.kind;
-      row.station = s;
-      Vec3 c;
-      Mat3 r;
+    // a sphere's centre or a pivot placed where too few of its touches are in reach is placed again
+    // (a seed pose at the edge of the workspace); a block's face stays where the block stands
+    for (int attempt = 1;; ++attempt) {
+      Vec3 axis;   // the probe's mean direction (the tool's z in the seed pose, or towards the face)
+      Vec3 centre, normal = Vec3::UnitZ();
+      VecQ ref;
+      Eigen::Isometry3d seed;
       if (opt.kind == MeasureKind::plane) {
-        // a point of the face (70% of it; the plate's ring), the ball centre radius + noise off it,
-        // the probe into it
-        const double u = ud(rng), v = ud(rng);
-        const Vec3 on = block.point(s, u, v);
-        c = on + normal * (opt.radius_mm + opt.noise_mm * nd(rng));
-        r = tilt(rng, axis, cone) * block.turn(s);
-        row.radius_mm = opt.radius_mm;
-      } else if (opt.kind == MeasureKind::sphere) {
-        c = centre + Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
-        r = tilt(rng, axis, cone) * seed.linear();
+        ref = block.q0;
+        seed = block.frame;
+        normal = Block::normal(s);
+        centre = block.centre(s);
+        axis = -normal;  // the probe points into the face
       } else {
-        // the bar's direction (pivot to ball) within the cone about the probe's axis reversed, the
-        // tool turned within half of it
-        const Vec3 d = tilt(rng, -axis, cone) * -axis;
-        c = centre + d * opt.length_mm;
-        r = tilt(rng, axis, 0.5 * cone) * seed.linear();
-        row.length_mm = opt.length_mm + opt.noise_mm * nd(rng);
+        seed = seed_pose(ref);
+        centre = seed * opt.probe;
+        axis = seed.linear().col(2);
+        // the pivot on the probe's axis beyond the ball (the bar cannot pass through the tool)
+        if (opt.kind == MeasureKind::distance) centre += axis * opt.length_mm;
+        points.push_back(centre);
       }
-      if (!place.reach(c, r, ref, random_dir(), row)) continue;
-      row.line = 0;
-      m.rows.push_back(row);
-      ++made;
+      const size_t first_row = m.rows.size();
+      int made = 0, tries = 0;
+      while (made < opt.touches) {
+        if (++tries > 40 * opt.touches) break;
+        Measurement row;
+        row.pose = static_cast<int>(m.rows.size());
+        row.kind = opt.kind;
+        row.station = s;
+        Vec3 c;
+        Mat3 r;
+        if (opt.kind == MeasureKind::plane) {
+          // a point of the face (70% of it; the plate's ring), the ball centre radius + noise off it,
+          // the probe into it
+          const double u = ud(rng), v = ud(rng);
+          const Vec3 on = block.point(s, u, v);
+          c = on + normal * (opt.radius_mm + opt.noise_mm * nd(rng));
+          r = tilt(rng, axis, cone) * block.turn(s);
+          row.radius_mm = opt.radius_mm;
+        } else if (opt.kind == MeasureKind::sphere) {
+          c = centre + Vec3(nd(rng), nd(rng), nd(rng)) * opt.noise_mm;
+          r = tilt(rng, axis, cone) * seed.linear();
+        } else {
+          // the bar's direction (pivot to ball) within the cone about the probe's axis reversed, the
+          // tool turned within half of it
+          const Vec3 d = tilt(rng, -axis, cone) * -axis;
+          c = centre + d * opt.length_mm;
+          r = tilt(rng, axis, 0.5 * cone) * seed.linear();
+          row.length_mm = opt.length_mm + opt.noise_mm * nd(rng);
+        }
+        if (!place.reach(c, r, ref, random_dir(), row)) continue;
+        row.line = 0;
+        m.rows.push_back(row);
+        ++made;
+      }
+      if (made == opt.touches) break;
+      m.rows.resize(first_row);
+      if (opt.kind != MeasureKind::plane) points.pop_back();
+      if (opt.kind == MeasureKind::plane || attempt == kStationAttempts)
+        throw InputError("simulate: station " + name + " is out of the robot's reach (" + std::to_string(made) + " of " +
+                         std::to_string(opt.touches) + " touches" +
+                         (opt.kind == MeasureKind::plane ? "" : " at the last of " + std::to_string(attempt) + " places") + ")");
     }
   }
   // (the stations are in the base frame, the artifact's lengths and angles in any)

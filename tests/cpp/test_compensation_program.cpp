@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
 using namespace kincal;
 
 namespace {
@@ -19,16 +22,17 @@ struct Stats {
 // Truth: a kr500 with 1 mm / 0.05 deg geometric errors and joint compliance (seed 5). Desired
 // poses are where that robot goes at random configurations inside the limits (1 deg margin) and
 // more than min_sing_deg from its singularities, so every pose is reachable. No noise.
-Stats run(bool finite_difference, bool corrected_start, double min_sing_deg, int n) {
+Stats run(bool finite_difference, bool corrected_start, double min_sing_deg, int n, unsigned robot_seed = 5,
+          unsigned pose_seed = 31) {
   auto nom = std::make_shared<Model>(kr500_spec());
-  auto cal = std::make_shared<Model>(perturbed_spec(kr500_spec(), test::test_seed(5), 1.0, 0.05, 0.003));
+  auto cal = std::make_shared<Model>(perturbed_spec(kr500_spec(), test::test_seed(robot_seed), 1.0, 0.05, 0.003));
   const Robot robot{nom, cal};
   ProgramOptions opt;
   opt.corrected_start = corrected_start;
   opt.comp.finite_difference = finite_difference;
   opt.comp.epsilon = 1e-18;  // |F| < 1e-9: the accuracy asked for (the paper's 1e-15 is the default)
   opt.comp.max_iterations = 30;
-  std::mt19937_64 rng(test::test_seed(31));
+  std::mt19937_64 rng(test::test_seed(pose_seed));
   Stats st;
   while (st.poses < n) {
     const Vec6 q = test::random_q(*nom, rng, 1.0);
@@ -48,25 +52,39 @@ Stats run(bool finite_difference, bool corrected_start, double min_sing_deg, int
   return st;
 }
 
-void expect_999(const Stats& s, const char* what) {
+double expect_999(const Stats& s, const char* what, double at_least = 0.999) {
   const double rate = static_cast<double>(s.within5) / s.poses;
   std::printf("%s: %d poses, %.4f%% within 5 iterations, %d failed, worst %.2e mm %.2e deg\n", what, s.poses,
               100 * rate, s.failed, s.worst_mm, s.worst_deg);
-  EXPECT_GE(rate, 0.999) << what;
+  EXPECT_GE(rate, at_least) << what;
   EXPECT_LT(s.worst_mm, 1e-9) << what;
   EXPECT_LT(s.worst_deg, 1e-9) << what;
+  return rate;
+}
+
+// The same on five calibrated robots (each its own errors and poses): a robot's rate depends on how
+// many of its poses fall 1-2 deg from the elbow's singularity, where some take 6-7 iterations (16
+// robots, KINCAL_TEST_SEED 0-15: 99.70-100%, median 99.96%; the slow poses of the 99.70% robot all lay
+// 1.07-1.79 deg from it). Claimed: 99.9% in the median of the five, and no robot below 99.5%.
+void expect_999_over_robots(bool finite_difference, const char* what) {
+  std::vector<double> rates;
+  for (unsigned k = 0; k < 5; ++k)
+    rates.push_back(expect_999(run(finite_difference, true, 1.0, test::count(5000), 5 + 100 * k, 31 + 100 * k), what,
+                               0.995));
+  std::nth_element(rates.begin(), rates.begin() + 2, rates.end());
+  EXPECT_GE(rates[2], 0.999) << what << ": the median robot";
 }
 
 }  // namespace
 
 TEST(Compensation, AnalyticConvergesWithinFiveIterations) {
-  KINCAL_SEED_TRACE(5, 31);
-  expect_999(run(false, true, 1.0, test::count(5000)), "analytic, corrected start, >1 deg from singularities");
+  KINCAL_SEED_TRACE(5, 31, 105, 131);
+  expect_999_over_robots(false, "analytic, corrected start, >1 deg from singularities");
 }
 
 TEST(Compensation, FiniteDifferenceConvergesWithinFiveIterations) {
-  KINCAL_SEED_TRACE(5, 31);
-  expect_999(run(true, true, 1.0, test::count(5000)), "finite differences, corrected start, >1 deg");
+  KINCAL_SEED_TRACE(5, 31, 105, 131);
+  expect_999_over_robots(true, "finite differences, corrected start, >1 deg");
 }
 
 // The paper's start (nominal IK solution, no correction): Newton's basin shrinks near the

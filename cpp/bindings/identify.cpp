@@ -428,6 +428,7 @@ void define_identify_result(py::module_& m) {
       .def_property_readonly("nominal_setups", [](const PyIdentifyResult& r) { return placements(r.r.nominal_campaign); },
                              "the placements fitted on the nominal geometry")
       .def_property_readonly("iterations", [](const PyIdentifyResult& r) { return r.r.iterations; })
+      .def_property_readonly("chord_steps", [](const PyIdentifyResult& r) { return r.r.chord_steps; })
       .def_property_readonly("initial_cost", [](const PyIdentifyResult& r) { return r.r.initial_cost; })
       .def_property_readonly("final_cost", [](const PyIdentifyResult& r) { return r.r.final_cost; })
       .def_property_readonly("rms_mm", [](const PyIdentifyResult& r) { return r.r.rms_mm; })

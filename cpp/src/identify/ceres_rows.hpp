@@ -16,13 +16,14 @@
 
 namespace kincal::ceres_rows {
 
-/// The Gauss-Newton tail, where a step's Jacobian serves the next point too: the residuals moved by
-/// less than this fraction of their norm since it was evaluated. Measured on kincal bench's kr500
-/// campaign (1000 poses) and the UR10's series B, least squares and the defaults: the steps before
-/// the last moved the residuals by 0.016-2.4 of their norm, the last (the one that is then taken
-/// with the Jacobian of the step before) by 5.6e-5-3.6e-4. The fit still ends where the gradient
-/// with a Jacobian computed afresh vanishes (tests/python/test_identify.py,
-/// test_the_fit_stops_at_the_optimum).
+/// The Gauss-Newton tail, where a step's Jacobian serves the next point too (for one step): the
+/// residuals moved by less than this fraction of their norm (the raw residuals, before a robust
+/// loss's weights) since it was evaluated. Measured on kincal bench's kr500 campaign (1000 poses) and
+/// the UR10's series B, least squares and the defaults: the steps before the last moved the residuals
+/// by 0.016-2.4 of their norm, the last (after which the Jacobian of the step before is kept) by
+/// 5.6e-5-3.6e-4. A chord step converges to where the carried-over Jacobian's gradient vanishes; the
+/// fits still end where a Gauss-Newton step with a Jacobian computed afresh moves the points by under
+/// 1e-6 mm (tests/python/test_identify.py, test_the_fit_stops_at_the_optimum).
 constexpr double kChordTail = 1e-3;
 
 /// Fills residuals and Jacobians of every row once per evaluation point (the cost functions read).
@@ -51,23 +52,25 @@ class AllRows : public ceres::EvaluationCallback {
     j_.resize(RS_ * d.rows.size() * K_);
   }
   void PrepareForEvaluation(bool jacobians, bool /*new_point*/) override {
-    // rows already evaluated at this very point (Ceres's repeated calls, or the seed) are kept
-    if (valid_ && z_ == at_ && (!jacobians || have_j_)) return;
+    // rows already evaluated at this very point (Ceres's repeated calls, or the seed) are kept (a
+    // Jacobian carried over from the point before only while carrying over is allowed)
+    if (valid_ && z_ == at_ && (!jacobians || (have_j_ && (j_exact_ || !exact_only_)))) return;
     // the Jacobian asked for at a point whose residuals are at hand (a step Ceres just accepted): in
     // the Gauss-Newton tail, where the residuals moved by less than kChordTail of their norm since the
-    // point the Jacobian was computed at, that Jacobian serves here too (a chord step: the parameters
-    // moved by so little that the Jacobian changed by far less than the step's own precision; the
-    // iteration still converges to where the gradient vanishes, and the step after it is judged by
-    // residuals computed afresh)
-    if (jacobians && valid_ && z_ == at_ && in_tail()) {
+    // point the Jacobian was computed at, that Jacobian serves here too, for one step (a chord step:
+    // the next step is taken with it, and judged by residuals computed afresh; the Jacobian after it
+    // is computed again)
+    if (jacobians && valid_ && z_ == at_ && j_exact_ && !exact_only_ && in_tail()) {
       j_at_ = z_;
       have_j_ = true;
+      j_exact_ = false;
+      ++chord_steps;
       return;
     }
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
     state_ = state_.with_params(x_);
     all_residuals(state_, d_, w_, kept_, r_.data(), jacobians ? j_.data() : nullptr);
-    if (jacobians) j_at_ = z_, r_of_j_ = r_;
+    if (jacobians) j_at_ = z_, r_of_j_ = r_, j_exact_ = true;
     std::vector<double> grad(jacobians ? x_.size() : 0);
     for (size_t k = 0; k < d_.artifact.size(); ++k) {
       ar_[k] = state_.artifact_residual(d_.artifact[k], jacobians ? grad.data() : nullptr);
@@ -90,10 +93,14 @@ class AllRows : public ceres::EvaluationCallback {
       ar_[a] = start.residuals[n + a];
       for (int k = 0; k < F_; ++k) aj_[a * F_ + k] = start.jacobian(static_cast<Eigen::Index>(n + a), free_[k]);
     }
-    valid_ = have_j_ = true;
+    valid_ = have_j_ = j_exact_ = true;
     at_ = j_at_ = z_;
     r_of_j_ = r_;
   }
+  /// From now on every Jacobian is computed at the point it serves (the covariance's).
+  void exact_only() { exact_only_ = true; }
+  /// The steps Ceres took with the Jacobian of the point before (chord steps).
+  int chord_steps = 0;
   void finish() {
     for (int k = 0; k < F_; ++k) x_[free_[k]] = z_[k];
   }
@@ -112,8 +119,8 @@ class AllRows : public ceres::EvaluationCallback {
       for (int k = 0; k < F_; ++k) out[k] = in[at_col_[k]];
   }
   /// The rows' Jacobian of every parameter (row-major, a row per residual; Columns::every) that
-  /// served at the current point (evaluated there, or in the Gauss-Newton tail at the point before),
-  /// else null.
+  /// served at the current point (evaluated there, or after a chord step at the point before: its
+  /// residuals within kChordTail of these), else null.
   const double* jacobian_here() const {
     return K_ == static_cast<int>(x_.size()) && j_at_ == z_ ? j_.data() : nullptr;
   }
@@ -136,6 +143,8 @@ class AllRows : public ceres::EvaluationCallback {
   std::vector<int> at_col_;             // the free parameter k's column in j_
   std::vector<double> j_at_;            // the point j_ serves (evaluated there, or a tail step away)
   std::vector<double> r_of_j_;          // the residuals where j_ was evaluated
+  bool j_exact_ = false;                // j_ was evaluated at j_at_ (not carried over by a chord step)
+  bool exact_only_ = false;             // no chord steps any more (exact_only())
 
   /// Whether the residuals at hand moved by less than kChordTail of their norm from those where the
   /// Jacobian was evaluated.

@@ -79,7 +79,8 @@ void solve(ceres::Problem& problem, AllRows& all, ceres::LossFunction* loss, con
            ceres::Solver::Summary& summary, Report report, const std::vector<PenaltyTerm>& penalties = {},
            double artifact_weight = 1.0) {
   // without a loss the rows' blocks are sized for the cache (a block's Jacobian about 32 KB)
-  const size_t per_block = loss ? 1 : std::max<size_t>(1, 4096 / static_cast<size_t>(all.row_size() * all.size()));
+  const size_t per_block =
+      loss ? 1 : std::max<size_t>(1, 4096 / static_cast<size_t>(std::max(1, all.row_size() * all.size())));
   for (size_t i = 0; i < all.rows(); i += per_block)
     problem.AddResidualBlock(new RowCost(all, i, std::min(per_block, all.rows() - i)), loss, all.z());
   for (size_t k = 0; k < all.artifact_terms(); ++k)
@@ -200,6 +201,7 @@ void covariance(ceres::Problem& problem, AllRows& all, const ceres::Solver::Summ
   ceres::Problem::EvaluateOptions eo;  // the free parameters only
   eo.parameter_blocks = {all.z()};
   ceres::CRSMatrix crs;
+  all.exact_only();  // the Jacobian at the solution itself, not one a chord step carried over
   if (!problem.Evaluate(eo, nullptr, nullptr, nullptr, &crs)) return;
   const int F = static_cast<int>(free_idx.size()), nres = all.row_size() * static_cast<int>(all.rows());
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
@@ -243,6 +245,7 @@ class Stage2 {
     kincal::solve(*problem_, *all_, loss_.get(), opt_, summary, Report::progress, terms, artifact_weight);
     if (first_) initial_cost = summary.initial_cost, first_ = false;
     iterations += static_cast<int>(summary.iterations.size()) - 1;
+    chord_steps += all_->chord_steps;
     ++passes_;
     // the first pass that did not converge is what the result reports (a later one converging from
     // a point it left unfinished does not make the whole fit converged)
@@ -282,7 +285,7 @@ class Stage2 {
   ceres::Problem& problem() { return *problem_; }
   AllRows& rows() { return *all_; }
   ceres::Solver::Summary summary;
-  int iterations = 0;
+  int iterations = 0, chord_steps = 0;
   double initial_cost = 0;
 
  private:
@@ -328,7 +331,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   // stage 1: the frames on the nominal geometry; then what the data cannot determine is held (or,
   // with priors, left to them)
   const PointState frames_only = pm.at_frames_only(x, data);  // every row's flange frame once
-  hold_unseen_frames(frames_only, data, opt, res);
+  hold_unseen_frames(pm, frames_only, data, opt, res);
   fit_frames(pm, frames_only, nominal, data, opt, x, res);
   res.prior_sd = prior_sds(res.layout, opt);
   const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd);
@@ -365,6 +368,7 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   }
   res.loss_scale_mm = s2.scale();
   res.iterations = s2.iterations;
+  res.chord_steps = s2.chord_steps;
   res.initial_cost = s2.initial_cost;
   res.final_cost = s2.summary.final_cost;
   res.termination = s2.summary.BriefReport();

@@ -26,19 +26,26 @@ std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data,
   return frames;
 }
 
-void hold_unseen_frames(const PointState& frames_only, const MeasurementSet& data, const IdentifyOptions& opt,
-                        IdentifyResult& res) {
+void hold_unseen_frames(const PointModel& pm, const PointState& frames_only, const MeasurementSet& data,
+                        const IdentifyOptions& opt, IdentifyResult& res) {
   if (data.has_probe() || data.rows.empty()) return;
   const ParamLayout& L = res.layout;
   const auto on_tool = [&](int i) {  // a target's offset, or the tool frame a 6-D row measures
     return (i >= L.targets && i < L.effects) || (data.orientation && i >= L.tool && i < L.tool + 6);
   };
   // the frames' columns alone, from the frames-only evaluation (every row's flange frame once; the
-  // same columns as the full linearization's at x, without the robot's own)
+  // same columns as the full linearization's at x, without the robot's own), but where 6-D rows move
+  // the tool frame of a robot with compliance: the tool's columns then carry the payload's torque,
+  // which the frames-only rows leave out
   const std::vector<int> frames = frame_columns(L, data, res);
   const Eigen::Index F = static_cast<Eigen::Index>(frames.size());
   Eigen::MatrixXd J(static_cast<Eigen::Index>(residual_size(residual_kind(data)) * data.rows.size()), F);
-  all_residuals(frames_only, data, opt.orientation_weight, frames, nullptr, J.data(), static_cast<size_t>(J.rows()));
+  if (data.orientation && !L.loaded.empty()) {
+    const Eigen::MatrixXd full = detail::linearize(pm, data, frames_only.x(), opt.orientation_weight).jacobian;
+    for (Eigen::Index c = 0; c < F; ++c) J.col(c) = full.col(frames[static_cast<size_t>(c)]).head(J.rows());
+  } else {
+    all_residuals(frames_only, data, opt.orientation_weight, frames, nullptr, J.data(), static_cast<size_t>(J.rows()));
+  }
   std::vector<Eigen::Index> at(static_cast<size_t>(L.size), -1);  // a parameter's column in J
   std::vector<int> cols;  // what the frames' fit moves (frame_columns), where the rows see it at all
   for (Eigen::Index c = 0; c < F; ++c) {

@@ -54,8 +54,8 @@ std::vector<int> frame_columns(const ParamLayout& L, const MeasurementSet& data,
 
 /// frames: the frames-only evaluation at the start (PointModel::at_frames_only), which the frames'
 /// fit then starts from.
-void hold_unseen_frames(const PointState& frames, const MeasurementSet& data, const IdentifyOptions& opt,
-                        IdentifyResult& res);
+void hold_unseen_frames(const PointModel& pm, const PointState& frames, const MeasurementSet& data,
+                        const IdentifyOptions& opt, IdentifyResult& res);
 
 /// The data's residuals (every row's block, then one per artifact term) and their Jacobian.
 struct Linearization {

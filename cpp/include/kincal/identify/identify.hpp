@@ -95,6 +95,7 @@ struct IdentifyResult {
   std::vector<EffectValue> effects;       ///< identified values of the extra effects
   double t_ref = 20.0;                    ///< reference temperature of thermal_expansion
   int iterations = 0;
+  int chord_steps = 0;  ///< of the iterations, the steps taken with the Jacobian of the point before
   double initial_cost = 0, final_cost = 0;
   double rms_mm = 0, max_mm = 0;          ///< on the fitted rows
   double condition_number = 0, observability_index = 0;

@@ -3,6 +3,7 @@
 // started per evaluation, and a loop's per-thread scratch is indexed by the slot the pool gives.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 
@@ -23,5 +24,15 @@ std::size_t pool_threads();
 /// from a second user thread) runs serially on its caller (slot 0). After fork() the child starts a
 /// new pool.
 void parallel_pieces(std::size_t n, std::size_t grain, std::size_t max_threads, const PieceFunction& f);
+
+/// The fewest measurement rows worth a thread of their own in the identification's evaluations.
+constexpr std::size_t kRowsPerThread = 256;
+
+/// Runs f over [0, n) in one contiguous piece per thread, with at least `at_least` indices a thread
+/// (fewer do not pay for the hand-over).
+inline void parallel_rows(std::size_t n, std::size_t at_least, const PieceFunction& f) {
+  const std::size_t threads = std::min(pool_threads(), n / at_least + 1);
+  parallel_pieces(n, (n + threads - 1) / threads, threads, f);
+}
 
 }  // namespace kincal::detail

@@ -244,8 +244,7 @@ std::shared_ptr<const FlangeCache> PointEval::compute_flanges(const MeasurementS
   const int n = layout_.dof;
   out->rows.resize(data.rows.size());
   out->first = data.rows.data();
-  const size_t rows = data.rows.size(), threads = std::min(pool_threads(), rows / 256 + 1);
-  parallel_pieces(rows, (rows + threads - 1) / threads, threads, [&](size_t begin, size_t end, size_t) {
+  parallel_rows(data.rows.size(), kRowsPerThread, [&](size_t begin, size_t end, size_t) {
     for (size_t i = begin; i < end; ++i) {
       const Measurement& m = data.rows[i];
       FlangeCache::Flange& f = out->rows[i];

@@ -50,11 +50,9 @@ void all_residuals(const PointState& pm, const MeasurementSet& data, double orie
                    const std::vector<int>& columns, double* r, double* J, size_t column_stride) {
   const ResidualKind kind = residual_kind(data);
   const size_t RS = residual_size(kind), P = pm.layout().size, F = columns.size(), n = data.rows.size();
-  // at least 256 rows per thread (fewer do not pay for the hand-over), one contiguous piece each
-  const size_t threads = std::min(detail::pool_threads(), n / 256 + 1), grain = (n + threads - 1) / threads;
   // every thread's scratch: a row's full Jacobian (6 x P) and its orientation part (3 x P)
-  std::vector<double> scratch(J ? threads * 9 * P : 0);
-  detail::parallel_pieces(n, grain, threads, [&](size_t begin, size_t end, size_t slot) {
+  std::vector<double> scratch(J ? detail::pool_threads() * 9 * P : 0);
+  detail::parallel_rows(n, detail::kRowsPerThread, [&](size_t begin, size_t end, size_t slot) {
     double* full = J ? &scratch[slot * 9 * P] : nullptr;
     double row_r[6];
     for (size_t i = begin; i < end; ++i) {

@@ -46,18 +46,16 @@ void hold_unseen_frames(const PointModel& pm, const PointState& frames_only, con
   } else {
     all_residuals(frames_only, data, opt.orientation_weight, frames, nullptr, J.data(), static_cast<size_t>(J.rows()));
   }
-  std::vector<Eigen::Index> at(static_cast<size_t>(L.size), -1);  // a parameter's column in J
-  std::vector<int> cols;  // what the frames' fit moves (frame_columns), where the rows see it at all
-  for (Eigen::Index c = 0; c < F; ++c) {
-    at[static_cast<size_t>(frames[static_cast<size_t>(c)])] = c;
-    if (J.col(c).norm() > 0) cols.push_back(frames[static_cast<size_t>(c)]);
-  }
+  std::vector<Eigen::Index> cols;  // J's columns the rows see at all (column c: parameter frames[c])
+  for (Eigen::Index c = 0; c < F; ++c)
+    if (J.col(c).norm() > 0) cols.push_back(c);
+  const auto param = [&](Eigen::Index k) { return frames[static_cast<size_t>(cols[static_cast<size_t>(k)])]; };
   // the smallest singular value of the unit-scaled columns: below the weak tolerance its direction is
   // held by one parameter, the largest part of it on the tool when the tool takes a fair share (the
   // depth of a reflector along the axis every orientation shares), else the largest; again until none
   while (!cols.empty()) {
     Eigen::MatrixXd A(J.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (size_t c = 0; c < cols.size(); ++c) A.col(static_cast<Eigen::Index>(c)) = J.col(at[static_cast<size_t>(cols[c])]).normalized();
+    for (size_t c = 0; c < cols.size(); ++c) A.col(static_cast<Eigen::Index>(c)) = J.col(cols[c]).normalized();
     // the smallest singular value and its right vector from the (few columns') normal matrix: its
     // eigenvalues are the squares, exact to about 1e-15 beside the weak tolerance's square 4e-6 (with
     // fewer residuals than columns the smallest is 0, its vector in the null space)
@@ -68,22 +66,22 @@ void hold_unseen_frames(const PointModel& pm, const PointState& frames_only, con
     Eigen::Index pick = 0, pick_tool = -1;
     for (Eigen::Index c = 0; c < v.size(); ++c) {
       if (std::abs(v[c]) > std::abs(v[pick])) pick = c;
-      if (on_tool(cols[static_cast<size_t>(c)]) && (pick_tool < 0 || std::abs(v[c]) > std::abs(v[pick_tool]))) pick_tool = c;
+      if (on_tool(param(c)) && (pick_tool < 0 || std::abs(v[c]) > std::abs(v[pick_tool]))) pick_tool = c;
     }
     if (pick_tool >= 0 && std::abs(v[pick_tool]) >= 0.5 * std::abs(v[pick])) pick = pick_tool;
     std::string with;  // the direction in the parameters' units, per unit of the one held
-    const auto unit_step = [&](Eigen::Index c) { return v[c] / J.col(at[static_cast<size_t>(cols[static_cast<size_t>(c)])]).norm(); };
+    const auto unit_step = [&](Eigen::Index c) { return v[c] / J.col(cols[static_cast<size_t>(c)]).norm(); };
     for (Eigen::Index c = 0; c < v.size(); ++c)
       if (c != pick && std::abs(v[c]) >= 0.2) {
         char part[96];
         std::snprintf(part, sizeof part, "%s%+.3g %s", with.empty() ? "" : ", ", unit_step(c) / unit_step(pick),
-                      L.names[cols[static_cast<size_t>(c)]].c_str());
+                      L.names[param(c)].c_str());
         with += part;
       }
     char buf[320];
     std::snprintf(buf, sizeof buf, "%s: these rows see it only through %.1e of its effect, moving with %s (do all the tool's "
                   "orientations share an axis?)", kUnseenFrame, sigma, with.empty() ? "nothing else" : with.c_str());
-    res.fix(cols[static_cast<size_t>(pick)], buf);
+    res.fix(param(pick), buf);
     cols.erase(cols.begin() + pick);
   }
 }

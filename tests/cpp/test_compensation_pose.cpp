@@ -93,9 +93,10 @@ TEST(Compensation, BlockSolveMatchesPivotedLu) {
 }
 
 // The default iteration (the Jacobian reused while a step shrinks |F| tenfold, the first step
-// corrected by its second-order term, the rotation vector's rates taken as the angular velocity)
-// against Newton's iteration with a fresh Jacobian at every step and no correction (reuse_contraction
-// 0, second_order false): the same convergence and the same solutions on 2000 random poses of a
+// corrected by its second-order term, the rotation vector's rates taken as the angular velocity; with
+// effects, the actual angles solved on the chain and the commands by a fixed point) against Newton's
+// iteration on the whole model with a fresh Jacobian at every step and no correction
+// (reuse_contraction 0, second_order false, split_effects false): the same convergence and the same solutions on 2000 random poses of a
 // kr500 with 1 mm / 0.05 deg geometric errors, with compliance (0.003 deg/kN m), and with compliance,
 // transmission error (harmonics 1, 2) and backlash on joints 1-3 (seed 7; poses: the nominal FK at
 // random configurations more than 1 deg from every singularity, started at that configuration).
@@ -121,6 +122,7 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
   reuse.epsilon = newton.epsilon = 1e-18;
   newton.reuse_contraction = 0;
   newton.second_order = false;
+  newton.split_effects = false;
   for (const Model& cal : models) {
     int converged = 0, converged_newton = 0, both = 0, poses = 0;
     long it_reuse = 0, it_newton = 0;
@@ -187,4 +189,68 @@ TEST(Compensation, SecondOrderTermMatchesTheDeviation) {
   std::printf("remainder ratio per halving of the step: mean %.2f, worst %.2f\n", mean_ratio / n, worst_ratio);
   EXPECT_GT(mean_ratio / n, 7.0);
   EXPECT_GT(worst_ratio, 6.0);
+}
+
+// The split iteration's F at its solution is the whole model's: on 300 random poses of a kr500 with 1
+// mm / 0.05 deg errors, compliance (0.003 deg/kN m), transmission error (harmonics 1, 2) and backlash
+// on joints 1-3 (seed 9), the residual it reports equals |pose_deviation| at the commands it returns
+// (to 1e-11, ten times the FK's own rounding at a 3 m reach: F there from the chain's F and Jacobian
+// at the actual angles, exact to O(|a(q) - a*|^2); 3.2e-12 at most over seeds 1-12)
+// and is below sqrt(epsilon); it took the fixed point (joint_iterations > 0) at every pose where
+// Newton's iteration on the whole model converges (a few near the stretched elbow have no solution). With a transmission error
+// on joint 4 as steep as 0.3 cos(q4) of the joint itself (its first harmonic 0.3 rad), where the fixed
+// point contracts by less than tenfold per step at most poses, it takes Newton's iteration on the
+// whole model there; either way it reaches the whole model's solution (to 1e-8 deg, both stopping at
+// |F|^2 < 1e-18 as in the test above).
+TEST(Compensation, SplitEffectsReportTheWholeModelsDeviation) {
+  KINCAL_SEED_TRACE(9);
+  const Model nom(kr500_spec());
+  ModelSpec spec = perturbed_spec(kr500_spec(), test::test_seed(9), 1.0, 0.05, 0.003);
+  for (int j = 0; j < 3; ++j) {
+    spec.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
+    spec.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
+  }
+  ModelSpec steep = spec;
+  steep.effects.push_back({Effect{"transmission_error", 3, {1}}, {0.3, 0.0}});
+  const Model cal(spec), cal_steep(steep);
+  std::mt19937_64 rng(test::test_seed(9));
+  const CompensationOptions opt;
+  CompensationOptions whole, tight, tight_whole;
+  whole.split_effects = false;
+  tight.epsilon = tight_whole.epsilon = 1e-18;
+  tight_whole.split_effects = false;
+  int poses = 0, reachable = 0, split = 0, converged_steep = 0, whole_steep = 0;
+  double worst_report = 0, worst_steep = 0;
+  while (poses < 300) {
+    const Vec6 q = test::random_q(nom, rng, 1.0);
+    if (test::singularity_distance_deg(nom, q) < 5.0) continue;
+    ++poses;
+    EffectContext ctx;
+    ctx.dir = VecQ::Constant(6, poses % 2 ? 1.0 : -1.0);
+    const Pose6 target = iso_to_pose(fk(nom, VecQ(q * kDeg)));
+    const CompensationResult r = compensate(cal, target, q, opt, ctx);
+    // near the nominal elbow's stretch some poses are beyond the compliant robot's reach: no solution
+    if (compensate(cal, target, q, whole, ctx).status != CompStatus::Converged) continue;
+    ++reachable;
+    ASSERT_EQ(r.status, CompStatus::Converged) << "pose " << poses;
+    const Vec6 f = pose_deviation(cal, r.q_deg, target, Residual::RotationVector, ctx);
+    worst_report = std::max(worst_report, std::abs(f.norm() - r.residual));
+    EXPECT_LT(f.squaredNorm(), opt.epsilon) << "pose " << poses;
+    split += r.joint_iterations > 0;
+    const CompensationResult s = compensate(cal_steep, target, q, tight, ctx),
+                             w = compensate(cal_steep, target, q, tight_whole, ctx);
+    if (s.status != CompStatus::Converged || w.status != CompStatus::Converged) continue;
+    ++converged_steep;
+    whole_steep += s.joint_iterations == 0;
+    worst_steep = std::max(worst_steep, (s.q_deg - w.q_deg).cwiseAbs().maxCoeff());
+  }
+  std::printf("split on %d of %d poses (%d reachable), |report - |F|| <= %.1e; steep: %d converged, %d by the whole model, worst "
+              "difference %.1e deg\n",
+              split, poses, reachable, worst_report, converged_steep, whole_steep, worst_steep);
+  EXPECT_EQ(split, reachable);
+  EXPECT_GE(reachable, 290);
+  EXPECT_LT(worst_report, 1e-11);
+  EXPECT_GE(converged_steep, 270);
+  EXPECT_GE(whole_steep, converged_steep / 2);
+  EXPECT_LT(worst_steep, 1e-8);
 }

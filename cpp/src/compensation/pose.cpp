@@ -136,12 +136,14 @@ struct DeviationEvaluator {
   AbcTrig tr;
   Vec3 phi;  // rotation vector of R_model R_desired^T (rad)
 
-  DeviationEvaluator(const Model& m, const Pose6& d, const EffectContext& c, Residual r)
+  // with_effects false: the chain at the given angles as the actual ones (the geometry and the
+  // thermal scale only), for the split iteration below
+  DeviationEvaluator(const Model& m, const Pose6& d, const EffectContext& c, Residual r, bool with_effects = true)
       : cal(m),
         desired(d),
         ctx(c),
         abc(r == Residual::Abc),
-        effects(m.has_compliance() || m.has_joint_effects()),
+        effects(with_effects && (m.has_compliance() || m.has_joint_effects())),
         scale(length_scale(m, c)) {
     if (!abc) rd_t = abc_to_rotation(d.abc).transpose();
   }
@@ -267,11 +269,14 @@ struct FactoredJacobian {
 // taken at the start and whenever the last step contracted |F| by less than opt.reuse_contraction;
 // the Jacobian changes little over the steps near a solution, so each reused step costs an
 // evaluation of F only. The stopping rule is the same |F|^2 < epsilon on the exact F.
-CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
-                                       const CompensationOptions& opt, const EffectContext& ctx) {
+// with_effects false: on the chain alone (the split below). When converged, f_out (if given) gets F
+// at the solution and j_out its Jacobian with the exact rates.
+CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0_deg, const CompensationOptions& opt,
+                          const EffectContext& ctx, bool with_effects, Vec6* f_out = nullptr,
+                          Mat6r* j_out = nullptr) {
   CompensationResult res;
   Vec6 q = q0_deg;
-  DeviationEvaluator ev(cal, desired, ctx, opt.residual);
+  DeviationEvaluator ev(cal, desired, ctx, opt.residual, with_effects);
   FactoredJacobian fac;
   Mat6r jf;
   Mat3 e;
@@ -285,6 +290,11 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
     const Vec6 f = ev.deviation_at(q, with_derivative);
     const double f2 = f.squaredNorm();
     auto finish = [&](CompStatus status) {
+      if (status == CompStatus::Converged && f_out) {
+        *f_out = f;
+        Mat3 e;
+        ev.jacobian(*j_out, e, true);
+      }
       res.q_deg = q;
       res.iterations = it;
       res.residual = std::sqrt(f2);
@@ -325,6 +335,61 @@ CompensationResult compensate_analytic(const Model& cal, const Pose6& desired, c
   }
 }
 
+// With compliance or joint effects the model's pose is the chain's at the actual angles,
+// F(q) = F_chain(a(q)), and a(q) = q + d(q) with d of 1e-2 deg and its derivative of 1e-4..1e-3. So
+// the pose is solved for the actual angles first, a*, by Newton's iteration on the chain alone (the
+// geometric cost: no gravity torque and no effect's derivative in it), then the commands by the fixed
+// point q <- q - (a(q) - a*), each step a gravity torque and the joint effects only, contracting
+// by the derivative of d. F at q follows from the chain's F and Jacobian at a*:
+// F(q) = F(a*) + J(a*) (a(q) - a*) + O(|a(q) - a*|^2), that remainder below 1e-20 mm where it is used
+// (|a(q) - a*| < 1e-5 deg). Where the fixed point does not contract tenfold per step (an effect as
+// steep as the joint itself) or the chain's iteration fails, Newton's iteration on the whole model.
+constexpr int kJointSteps = 8;
+constexpr double kJointStepTrusted = 1e-5;  // deg: the largest |a(q) - a*| at which F(q) is taken as above
+
+CompensationResult compensate_split(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
+                                    const CompensationOptions& opt, const EffectContext& ctx) {
+  Vec6 fa;
+  Mat6r ja;
+  CompensationResult res = newton(cal, desired, q0_deg, opt, ctx, false, &fa, &ja);
+  if (res.status != CompStatus::Converged) {
+    // where the chain's iteration stops, the commands one fixed-point step from its angles, and the
+    // whole model's F there (Newton's iteration on the whole model fails where the chain's does: it
+    // is the same iteration but for a joint-space map within 1e-3 of the identity)
+    const VecQ a = to_rad(res.q_deg);
+    res.q_deg -= (joint_angles(cal, a, ctx) - a) * (1 / kDeg);
+    const Vec6 f = pose_deviation(cal, res.q_deg, desired, opt.residual, ctx);
+    res.residual = f.norm();
+    res.position_error_mm = f.head<3>().norm();
+    res.orientation_error_deg = f.tail<3>().norm();
+    return res;
+  }
+  const Vec6 a_star = res.q_deg;
+  const VecQ a_rad = to_rad(a_star);
+  const JointAnglesNear actual(cal, a_rad, ctx);
+  Vec6 q = a_star, r_last = Vec6::Zero();
+  for (int k = 0; k < kJointSteps; ++k) {
+    const Vec6 r = (actual(to_rad(q)) - a_rad) * (1 / kDeg);
+    if (k > 0) {
+      if (r.cwiseAbs().maxCoeff() < kJointStepTrusted) {
+        const Vec6 f = fa + ja * r;
+        if (f.squaredNorm() < opt.epsilon) {
+          res.q_deg = q;
+          res.joint_iterations = k;
+          res.residual = f.norm();
+          res.position_error_mm = f.head<3>().norm();
+          res.orientation_error_deg = f.tail<3>().norm();
+          return res;
+        }
+      }
+      if (!(r.squaredNorm() < 0.01 * r_last.squaredNorm())) break;
+    }
+    r_last = r;
+    q -= r;
+  }
+  return newton(cal, desired, q0_deg, opt, ctx, true);
+}
+
 }  // namespace
 
 Mat6 pose_deviation_jacobian(const Model& cal, const Vec6& q_deg, const Pose6& desired, Residual residual,
@@ -359,7 +424,11 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Vec6
     return res;
   }
   if (cal.needs_dir() || cal.needs_temperature()) check_context(cal, ctx, "");
-  if (!opt.finite_difference) return compensate_analytic(cal, desired, q0_deg, opt, ctx);
+  if (!opt.finite_difference) {
+    if (opt.split_effects && (cal.has_compliance() || cal.has_joint_effects()))
+      return compensate_split(cal, desired, q0_deg, opt, ctx);
+    return newton(cal, desired, q0_deg, opt, ctx, true);
+  }
   // the paper's iteration with its finite-difference Jacobian (eq. 7)
   Vec6 q = q0_deg;
   Mat6r jf;

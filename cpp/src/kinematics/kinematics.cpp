@@ -120,10 +120,13 @@ namespace {
 // moment about joint j's origin of everything it carries, in frame j:
 // A_j = mc_j + M_j+1 t_j + Rx(alpha_j) Rz(th_j+1) A_j+1 (M_j+1: the mass beyond joint j). Then
 // tau_j = z . (A_j x g_j), z = (0, 0, 1) in its own frame. About a third of the walk's work.
-void gravity_torque_sc(const Model& m, const double* s, const double* c, VecQ& tau) {
-  const int n = m.dof();
+// N > 0: the joint count known at compile time (as walk_sc); tau has m.dof() entries.
+template <int N = 0>
+void gravity_torque_sc(const Model& m, const double* s, const double* c, double* tau) {
+  const int n = N > 0 ? N : m.dof();
   std::array<double, kMaxJoints> gx, gy;
   Vec3 v = m.c0_r().transpose() * m.gravity();
+#pragma GCC unroll 6
   for (int j = 0; j < n; ++j) {
     const double x = c[j] * v[0] + s[j] * v[1], y = c[j] * v[1] - s[j] * v[0];
     gx[j] = x;
@@ -131,10 +134,10 @@ void gravity_torque_sc(const Model& m, const double* s, const double* c, VecQ& t
     const Model::Link& l = m.link(j);
     v = Vec3(x, l.ca * y + l.sa * v[2], l.ca * v[2] - l.sa * y);
   }
-  tau.resize(n);
   Vec3 a = m.link(n - 1).mc;
   double mass = m.link(n - 1).m;
   tau[n - 1] = a[0] * gy[n - 1] - a[1] * gx[n - 1];
+#pragma GCC unroll 6
   for (int j = n - 2; j >= 0; --j) {
     const Model::Link& l = m.link(j);
     const double x = c[j + 1] * a[0] - s[j + 1] * a[1], y = s[j + 1] * a[0] + c[j + 1] * a[1];
@@ -147,7 +150,8 @@ void gravity_torque_sc(const Model& m, const double* s, const double* c, VecQ& t
 void gravity_torque_local(const Model& m, const double* q, VecQ& tau) {
   double s[kMaxJoints + 1], c[kMaxJoints + 1];
   joint_sincos<0>(m, q, s, c);
-  gravity_torque_sc(m, s, c, tau);
+  tau.resize(m.dof());
+  gravity_torque_sc(m, s, c, tau.data());
 }
 
 }  // namespace
@@ -261,6 +265,18 @@ VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ*
 
 namespace {
 
+// s, c of an angle x turned into those of x + d for a small d (|d| <= 0.01 rad): sin d and 1 - cos d
+// by their series, whose next terms are below 1e-17 there.
+inline void turn_sincos(double d, double& s, double& c) {
+  const double d2 = d * d;
+  const double sd = d - d * d2 * (1.0 / 6 - d2 * (1.0 / 120));
+  const double cd1 = d2 * (0.5 - d2 * (1.0 / 24 - d2 * (1.0 / 720)));  // 1 - cos d
+  const double s0 = s, c0 = c;
+  s = s0 + (c0 * sd - s0 * cd1);
+  c = c0 - (s0 * sd + c0 * cd1);
+}
+constexpr double kTurnMax = 0.01;  // rad: the largest d turn_sincos takes
+
 template <int N>
 void fk_frames_actual_n(const Model& m, const VecQ& q, const EffectContext& ctx, ChainFrames& f) {
   const int n = m.dof();
@@ -268,25 +284,19 @@ void fk_frames_actual_n(const Model& m, const VecQ& q, const EffectContext& ctx,
   joint_sincos<N>(m, q.data(), s, c);
   VecQ theta = q;
   if (m.has_compliance()) {
-    VecQ tau;
-    gravity_torque_sc(m, s, c, tau);
+    double tau[kMaxJoints] = {};
+    gravity_torque_sc<N>(m, s, c, tau);
     for (int j = 0; j < n; ++j) theta[j] += m.compliance(j) * tau[j];
   }
   if (m.has_joint_effects()) add_joint_effects(m, q, ctx, theta, nullptr);
-  // theta's sines and cosines from q's by the small angle d = theta - q: sin d and 1 - cos d by their
-  // series, whose next terms are below 1e-17 for |d| <= 0.01 rad (larger: sincos of theta itself)
+  // theta's sines and cosines from q's by the small angle theta - q (larger: sincos of theta itself)
   for (int j = 0; j < n; ++j) {
     const double d = theta[j] - q[j];
-    if (!(std::abs(d) <= 0.01)) {
+    if (!(std::abs(d) <= kTurnMax)) {
       fk_frames(m, theta, f);
       return;
     }
-    const double d2 = d * d;
-    const double sd = d - d * d2 * (1.0 / 6 - d2 * (1.0 / 120));
-    const double cd1 = d2 * (0.5 - d2 * (1.0 / 24 - d2 * (1.0 / 720)));  // 1 - cos d
-    const double sj = s[j], cj = c[j];
-    s[j] = sj + (cj * sd - sj * cd1);
-    c[j] = cj - (sj * sd + cj * cd1);
+    turn_sincos(d, s[j], c[j]);
   }
   Mat3 r = m.c0_r();
   Vec3 t = m.c0_t();
@@ -307,6 +317,57 @@ void fk_frames_actual(const Model& m, const VecQ& q, const EffectContext& ctx, C
     fk_frames_actual_n<6>(m, q, ctx, f);
   else
     fk_frames_actual_n<0>(m, q, ctx, f);
+}
+
+void JointTrig::set(const Model& m, const VecQ& q_rad) {
+  q = q_rad;
+  joint_sincos<0>(m, q.data(), s.data(), c.data());
+}
+
+void JointTrig::turn_to(const Model& m, const VecQ& q_rad) {
+  const int n = m.dof();
+  if (q.size() != n) return set(m, q_rad);
+  for (int j = 0; j < n; ++j)
+    if (!(std::abs(q_rad[j] - q[j]) <= kTurnMax)) return set(m, q_rad);
+  for (int j = 0; j < n; ++j) turn_sincos(q_rad[j] - q[j], s[j], c[j]);
+  q = q_rad;
+}
+
+void fk_frames(const Model& m, const JointTrig& trig, ChainFrames& f) {
+  Mat3 r = m.c0_r();
+  Vec3 t = m.c0_t();
+  auto visit = [&](int j, const Mat3& rj, const Vec3& tj) {
+    f.z[j] = rj.col(2);
+    f.o[j] = tj;
+  };
+  if (m.dof() == 6)
+    walk_sc<6>(m, trig.s.data(), trig.c.data(), r, t, visit);
+  else
+    walk_sc<0>(m, trig.s.data(), trig.c.data(), r, t, visit);
+  f.n = m.dof();
+  f.tool.linear() = r;
+  f.tool.translation() = t;
+  f.tool.makeAffine();
+}
+
+JointAnglesNear::JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx) : m_(m), ctx_(ctx) {
+  ref_.set(m, ref);
+}
+
+VecQ JointAnglesNear::operator()(const VecQ& q) const {
+  VecQ theta = q;
+  if (m_.has_compliance()) {
+    JointTrig t = ref_;
+    t.turn_to(m_, q);
+    double tau[kMaxJoints] = {};
+    if (m_.dof() == 6)
+      gravity_torque_sc<6>(m_, t.s.data(), t.c.data(), tau);
+    else
+      gravity_torque_sc<0>(m_, t.s.data(), t.c.data(), tau);
+    for (int j = 0; j < m_.dof(); ++j) theta[j] += m_.compliance(j) * tau[j];
+  }
+  if (m_.has_joint_effects()) add_joint_effects(m_, q, ctx_, theta, nullptr);
+  return theta;
 }
 
 Eigen::Isometry3d fk_model(const Model& m, const VecQ& q, const EffectContext& ctx) {

@@ -44,6 +44,10 @@ struct CompensationOptions {
   /// 1e-3..1e-2, and one fresh step more converges. Skipped where the correction is over half the step,
   /// and with the ABC residual.
   bool second_order = true;
+  /// With compliance or joint effects: the actual joint angles solved on the chain first, then the
+  /// commands from them by a fixed point (compensation/pose.cpp); false: Newton's iteration on the
+  /// whole model. Both stop on the same |F|^2 < epsilon.
+  bool split_effects = true;
 };
 
 enum class CompStatus { Converged, NotConverged, SingularJacobian, OrientationSingular, NotSixJoints };
@@ -52,6 +56,7 @@ const char* to_string(CompStatus s);
 struct CompensationResult {
   Vec6 q_deg;
   int iterations = 0;        ///< Newton updates made
+  int joint_iterations = 0;  ///< with split_effects: the fixed point's updates of the commands
   double residual = 0;       ///< |F| at q_deg (mm and degrees mixed as in eq. 9)
   double position_error_mm = 0, orientation_error_deg = 0;  ///< |dXYZ| and |dABC| at q_deg
   CompStatus status = CompStatus::NotConverged;

@@ -49,7 +49,9 @@ struct EffectKind {
   /// a five-bar link-length effect's basis, dl = sum_k p_k b_k(t1, t2) (the actuated angles, rad);
   /// nullptr for the others
   void (*link_basis)(const Effect&, double t1_rad, double t2_rad, double* b) = nullptr;
-  bool reads_dir() const { return needs == "dir"; }               ///< the direction of motion (dir1..dirN)
+  /// needs == "dir", once: compensation asks it for every effect at every evaluation
+  bool needs_dir = needs == "dir";
+  bool reads_dir() const { return needs_dir; }                    ///< the direction of motion (dir1..dirN)
   bool scales_lengths() const { return acts_on == "length_scale"; }  ///< scales the robot's lengths
   bool of_instrument() const { return acts_on == "instrument"; }    ///< the measurement's, never the robot's
 };

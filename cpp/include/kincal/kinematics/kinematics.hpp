@@ -71,6 +71,36 @@ VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ*
 /// Newton compensation. The same frames as fk_frames(m, joint_angles(m, q, ctx)) to rounding.
 void fk_frames_actual(const Model& m, const VecQ& q, const EffectContext& ctx, ChainFrames& f);
 
+/// The sines and cosines of every joint's angle (q + its offset) as the chain's walk uses them, kept
+/// with the angles they are of: an iteration that moves q by small steps turns them by series
+/// (turn_to) instead of computing them anew.
+struct JointTrig {
+  std::array<double, kMaxJoints + 1> s{}, c{};
+  VecQ q;  ///< the angles (rad) they are of
+  /// of q anew
+  void set(const Model& m, const VecQ& q);
+  /// of q, turned from the present angles by the difference where every joint moves by at most 0.01
+  /// rad (sin d and 1 - cos d by their series, the next terms below 1e-17), anew otherwise
+  void turn_to(const Model& m, const VecQ& q);
+};
+
+/// fk_frames from the sines and cosines of trig (at its angles).
+void fk_frames(const Model& m, const JointTrig& trig, ChainFrames& f);
+
+/// joint_angles at commands near one reference, the gravity torque from the reference's sines and
+/// cosines turned to them (JointTrig): the commands' fixed point in compensation evaluates it a few
+/// times within 1e-2 deg of one solution. The same angles as joint_angles(m, q, ctx) to rounding.
+class JointAnglesNear {
+ public:
+  JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx);
+  VecQ operator()(const VecQ& q) const;
+
+ private:
+  const Model& m_;
+  const EffectContext& ctx_;
+  JointTrig ref_;
+};
+
 /// The factor every length of the robot scales by (thermal expansion; 1 without it).
 inline double length_scale(const Model& m, const EffectContext& ctx) {
   return m.thermal_alpha() == 0 ? 1.0 : 1.0 + m.thermal_alpha() * (ctx.temperature_c - m.spec().t_ref_c);

@@ -33,6 +33,36 @@ std::pair<MeasurementSet, MeasurementSet> fit_and_held(const Model& truth, Simul
   return {std::move(fit), simulate(truth, so, test::truth_campaign())};
 }
 
+/// Standardized errors (estimate - truth) / standard deviation of identified parameters, gathered
+/// over 8 independent draws of 4 parameters each: whether the estimates are as near the truth as their
+/// standard deviations say. Under that claim each value is N(0, 1), and, whatever the correlations of
+/// the 4 within a draw, the largest of the 32 exceeds 4.5 with probability below 2.2e-4 (the union
+/// bound) and their RMS exceeds 1.81 with probability below 0.001 (the values of a draw identical at
+/// worst: 32 RMS^2 = 4 chi-square(8), above 26.1 with probability 0.001). A standard deviation 1.5x
+/// too small is found at about the rate of the former check, 3 sigma on one draw's two or four
+/// values, which fails about once in 370 draws per parameter and did on the draws of some
+/// KINCAL_TEST_SEED. Standard deviations larger than needed are not part of the claim (not checked).
+struct StandardizedErrors {
+  std::vector<double> z;
+  void add(double estimate, double truth, double stddev) { z.push_back((estimate - truth) / stddev); }
+  double rms() const {
+    double s = 0;
+    for (double v : z) s += v * v;
+    return std::sqrt(s / static_cast<double>(z.size()));
+  }
+  double max_abs() const {
+    double m = 0;
+    for (double v : z) m = std::max(m, std::abs(v));
+    return m;
+  }
+  void expect_standard(const char* what) const {
+    std::printf("%s: %zu standardized errors, RMS %.3f, largest %.2f\n", what, z.size(), rms(), max_abs());
+    ASSERT_EQ(z.size(), 32u);
+    EXPECT_LT(rms(), 1.81) << what;
+    EXPECT_LT(max_abs(), 4.5) << what;
+  }
+};
+
 }  // namespace
 
 TEST(Identify, NoiseFreeGeometricErrorsFittedExactly) {
@@ -83,19 +113,29 @@ TEST(Identify, Kr500WithComplianceReachesTheNoiseFloor) {
   const IdentifyResult rg = identify(nominal, fit, opt);
   const double geometric_only = rms(point_errors(Model(rg.calibrated), rg.campaign, rg.targets, held));
   EXPECT_GT(geometric_only, 1.5 * floor);
-  // the compliances of A2..A5 are recovered within 3 standard deviations; A6 carries no gravity
-  // torque (the head's centre of mass is on its axis), so its compliance is held and named
-  for (size_t i = 0; i < r.layout.loaded.size(); ++i) {
-    const int k = r.layout.compliance + static_cast<int>(i);
-    const double t = truth.spec().joints[r.layout.loaded[i]].compliance_deg_per_knm;
-    if (r.layout.loaded[i] == 5) {
-      EXPECT_TRUE(r.fixed[k]);
-      EXPECT_NE(r.fixed_reason[k].find("gravity torque too small"), std::string::npos);
-      continue;
+  // the compliances of A2..A5 are recovered as their standard deviations say: over 8 draws (truths
+  // and campaigns, this one first) the 32 standardized errors are standard (StandardizedErrors); A6
+  // carries no gravity torque (the head's centre of mass is on its axis), so its compliance is held
+  // and named. Until the twenty-fifth session each compliance of this draw alone was checked within
+  // 3 sigma, which KINCAL_TEST_SEED=19 failed (3.1 sigma on one of them).
+  StandardizedErrors z;
+  for (unsigned draw = 0; draw < 8; ++draw) {
+    const Model truth_d(truth_spec(21 + 1000 * draw, 0.003));
+    const IdentifyResult rd =
+        draw == 0 ? r : identify(nominal, fit_and_held(truth_d, so, 3 + 1000 * draw, 4 + 1000 * draw).first, IdentifyOptions());
+    for (size_t i = 0; i < rd.layout.loaded.size(); ++i) {
+      const int k = rd.layout.compliance + static_cast<int>(i);
+      const double t = truth_d.spec().joints[rd.layout.loaded[i]].compliance_deg_per_knm;
+      if (rd.layout.loaded[i] == 5) {
+        EXPECT_TRUE(rd.fixed[k]);
+        EXPECT_NE(rd.fixed_reason[k].find("gravity torque too small"), std::string::npos);
+        continue;
+      }
+      EXPECT_FALSE(rd.fixed[k]) << rd.layout.names[k];
+      z.add(rd.x[k], t, rd.stddev[k]);
     }
-    EXPECT_FALSE(r.fixed[k]) << r.layout.names[k];
-    EXPECT_NEAR(r.x[k], t, 3 * r.stddev[k]) << r.layout.names[k];
   }
+  z.expect_standard("compliances of A2..A5");
 }
 
 TEST(Identify, RobustLossIgnoresGrossOutliers) {
@@ -142,8 +182,12 @@ TEST(Identify, TooFewMeasurementsIsAnInputError) {
 TEST(Identify, HiddenTransmissionErrorIsRecovered) {
   KINCAL_SEED_TRACE(41, 11, 12);
   // truth: kr500 geometric errors + compliance + a transmission error on A2 (0.01 deg first
-  // harmonic, 0.005 deg second), 0.02 mm noise; identified with that effect in the model the
-  // held-out error reaches the noise floor and the harmonics are recovered within 3 sigma
+  // harmonic's sine, 0.005 deg second's cosine, the other two amplitudes 0), 0.02 mm noise;
+  // identified with that effect in the model the held-out error reaches the noise floor and the four
+  // amplitudes are recovered as their standard deviations say: over 8 draws (truths and campaigns,
+  // this one first) the 32 standardized errors are standard (StandardizedErrors). Until the
+  // twenty-fifth session the two nonzero amplitudes of this draw alone were checked within 3 sigma,
+  // which KINCAL_TEST_SEED=15 failed.
   const double d2r = kDeg;
   SimulationOptions so;
   so.poses = 150;
@@ -164,10 +208,16 @@ TEST(Identify, HiddenTransmissionErrorIsRecovered) {
   const IdentifyResult r = identify(nominal, fit, opt);
   const double after = rms(point_errors(Model(r.calibrated), r.campaign, r.targets, held));
   EXPECT_LT(after, 1.2 * 0.02 * std::sqrt(3.0));
-  ASSERT_EQ(r.effects.size(), 1u);
-  const int c = r.layout.effect_offset[0];
-  EXPECT_NEAR(r.x[c], 0.01 * d2r, 3 * r.stddev[c]);
-  EXPECT_NEAR(r.x[c + 3], 0.005 * d2r, 3 * r.stddev[c + 3]);
+  StandardizedErrors z;
+  for (unsigned draw = 0; draw < 8; ++draw) {
+    const Model truth_d(truth_spec(41 + 1000 * draw, 0.003));
+    so.seed = test::test_seed(11 + 1000 * draw);
+    const IdentifyResult rd = draw == 0 ? r : identify(nominal, simulate(truth_d, so, test::truth_campaign()), opt);
+    ASSERT_EQ(rd.effects.size(), 1u);
+    const int c = rd.layout.effect_offset[0];
+    for (int k = 0; k < 4; ++k) z.add(rd.x[c + k], te.p[k], rd.stddev[c + k]);
+  }
+  z.expect_standard("transmission error amplitudes");
 }
 
 TEST(Identify, SixDimensionalPosesDetermineTheToolOrientation) {

@@ -341,26 +341,62 @@ TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
 // with the defaults of kincal identify (priors on the robot): over KINCAL_TEST_SEED 1-30 the joint fit
 // was the better on 29 draws and 0.6% worse on one. Without priors (this test's fits until the
 // twenty-fourth session) the joint fit was 5.1% worse on one draw (seed 16), and on another (seed 7)
-// identify refused the joint campaign ("cannot determine base.z: too few or too similar poses") where
-// the tracker alone passes: the analysis of a mixed campaign without priors, not yet mended.
-TEST(Stations, ATrackerCampaignWithASphereStation) {
-  KINCAL_SEED_TRACE(71, 72, 73, 74);
-  const Model truth(truth_spec(71, 0.003)), nominal(kr500_spec());
-  const Vec3 probe(0, 0, 150);
+// identify refused the joint campaign: see the next test.
+struct MixedCampaign {
+  MeasurementSet tracker, both;
+};
+
+MixedCampaign tracker_and_sphere(const Model& truth, const Vec3& probe, unsigned tracker_seed, unsigned sphere_seed) {
   SimulationOptions tr;
   tr.poses = 60;
   tr.targets = {probe};
-  tr.seed = test::test_seed(72);
-  const MeasurementSet tracker = simulate(truth, tr);
-  const MeasurementSet sphere = simulate_probe(truth, probe_options(MeasureKind::sphere, 1, 25, 60, test::test_seed(73)));
-  MeasurementSet both = tracker;
-  both.station_names = sphere.station_names;
-  both.station_kinds = sphere.station_kinds;
+  tr.seed = tracker_seed;
+  MixedCampaign m;
+  m.tracker = simulate(truth, tr);
+  const MeasurementSet sphere = simulate_probe(truth, probe_options(MeasureKind::sphere, 1, 25, 60, sphere_seed));
+  m.both = m.tracker;
+  m.both.station_names = sphere.station_names;
+  m.both.station_kinds = sphere.station_kinds;
   for (Measurement r : sphere.rows) {
-    r.pose += static_cast<int>(tracker.rows.size());
-    both.rows.push_back(r);
+    r.pose += static_cast<int>(m.tracker.rows.size());
+    m.both.rows.push_back(r);
   }
-  const Accuracy alone = probe_accuracy(truth, tracker, probe, test::test_seed(74), "tracker alone", 1.0);
-  const Accuracy joint = probe_accuracy(truth, both, probe, test::test_seed(74), "tracker + a sphere", 1.0);
+  return m;
+}
+
+TEST(Stations, ATrackerCampaignWithASphereStation) {
+  KINCAL_SEED_TRACE(71, 72, 73, 74);
+  const Model truth(truth_spec(71, 0.003));
+  const Vec3 probe(0, 0, 150);
+  const MixedCampaign m = tracker_and_sphere(truth, probe, test::test_seed(72), test::test_seed(73));
+  const Accuracy alone = probe_accuracy(truth, m.tracker, probe, test::test_seed(74), "tracker alone", 1.0);
+  const Accuracy joint = probe_accuracy(truth, m.both, probe, test::test_seed(74), "tracker + a sphere", 1.0);
   EXPECT_LT(joint.identified, 1.05 * alone.identified);
 }
+
+// The same campaigns without priors: what the data determine is judged against a generic campaign
+// of the same rows' kinds, and the data's choice among equivalent parameters is no loss. On the draw
+// of KINCAL_TEST_SEED=7 in the test above (truth 2447241861, tracker 704224887, sphere 1397620085)
+// identify refused the joint campaign until the twenty-fifth session ("cannot determine base.z: too
+// few or too similar poses") where the tracker alone passes: in those data base.z is the sum of joints
+// 2-6's move_v less the target's x, and the greedy choice took joint 6's move_v before base.z, where
+// the generic campaign holds joint 6's move_v; both leave 13 parameters held. Now the data choose in
+// the generic campaign's basis first. Both draws (that one and the test's default): the joint
+// campaign is accepted and its ball centre within 0.03 mm of the truth (after the best rigid
+// transform; the nominal is 5-10 mm off), as is the tracker alone's.
+TEST(Stations, AMixedCampaignWithoutPriorsIsAccepted) {
+  struct Draw {
+    unsigned truth, tracker, sphere;
+  };
+  for (const Draw& d : {Draw{2447241861u, 704224887u, 1397620085u}, Draw{71, 72, 73}}) {
+    const Model truth(truth_spec(d.truth, 0.003));
+    const Vec3 probe(0, 0, 150);
+    const MixedCampaign m = tracker_and_sphere(truth, probe, d.tracker, d.sphere);
+    const Accuracy alone = probe_accuracy(truth, m.tracker, probe, 74, "tracker alone, no priors", 0.0);
+    const Accuracy joint = probe_accuracy(truth, m.both, probe, 74, "tracker + a sphere, no priors", 0.0);
+    EXPECT_GT(joint.nominal, 1.0);
+    EXPECT_LT(alone.identified, 0.03);
+    EXPECT_LT(joint.identified, 0.03);
+  }
+}
+

@@ -431,7 +431,15 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
     at_prior(lin, generic, order, opt, prior_sd, data.has_probe(), res);
     return start_at(pm, data, opt, res, xp, x, lin);
   }
-  select_independent(lin.jacobian, order, opt, res);
+  // the data choose among the parameters in the generic campaign's basis first: where they determine
+  // as many as it does, they may still pick other columns in the plain order (a sphere station beside
+  // a tracker's points: joint 6's move_v before base.z, the two a combination of the other joints'
+  // and the target's in these data, not in the generic campaign's), which is no loss of rank
+  std::vector<int> data_order;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int i : order)
+      if (generic.fixed[i] == (pass == 1)) data_order.push_back(i);
+  select_independent(lin.jacobian, data_order, opt, res);
   lin = start_at(pm, data, opt, res, xp, x, lin);
   std::string missing;
   int n_missing = 0;

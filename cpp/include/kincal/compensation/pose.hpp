@@ -13,7 +13,10 @@
 // and no factorisation; `reuse_contraction`), corrects its first step by the step's second-order term
 // (`second_order`), and takes the rotation vector's rates as the angular velocity (exact at the
 // solution, and used once |phi| < 0.05 rad): the same stopping rule on the exact F, at 0.76x the time
-// per pose (BENCHMARKS.md).
+// per pose (BENCHMARKS.md). With compliance or joint effects (`split_effects`) it solves for the
+// joints' actual angles a* on the chain alone, then for the commands q with a(q) = a* by a fixed point
+// that contracts by the effects' derivative (1e-4..1e-3 per step), F at q from the chain's F and
+// Jacobian at a*; where that fixed point does not contract tenfold per step, Newton on the whole model.
 #pragma once
 
 #include "kincal/kinematics/kinematics.hpp"

@@ -96,8 +96,8 @@ TEST(Compensation, BlockSolveMatchesPivotedLu) {
 // corrected by its second-order term, the rotation vector's rates taken as the angular velocity; with
 // effects, the actual angles solved on the chain and the commands by a fixed point) against Newton's
 // iteration on the whole model with a fresh Jacobian at every step and no correction
-// (reuse_contraction 0, second_order false, split_effects false): the same convergence and the same solutions on 2000 random poses of a
-// kr500 with 1 mm / 0.05 deg geometric errors, with compliance (0.003 deg/kN m), and with compliance,
+// (reuse_contraction 0, second_order false, split_effects false): the same convergence and the same
+// solutions on 2000 random poses of a kr500 with 1 mm / 0.05 deg geometric errors, with compliance (0.003 deg/kN m), and with compliance,
 // transmission error (harmonics 1, 2) and backlash on joints 1-3 (seed 7; poses: the nominal FK at
 // random configurations more than 1 deg from every singularity, started at that configuration).
 // Both stop at |F| < 1e-9, so the solutions agree to the joint-space image of that: 1e-8 deg, where
@@ -195,13 +195,13 @@ TEST(Compensation, SecondOrderTermMatchesTheDeviation) {
 // mm / 0.05 deg errors, compliance (0.003 deg/kN m), transmission error (harmonics 1, 2) and backlash
 // on joints 1-3 (seed 9), the residual it reports equals |pose_deviation| at the commands it returns
 // (to 1e-11, ten times the FK's own rounding at a 3 m reach: F there from the chain's F and Jacobian
-// at the actual angles, exact to O(|a(q) - a*|^2); 3.2e-12 at most over seeds 1-12)
-// and is below sqrt(epsilon); it took the fixed point (joint_iterations > 0) at every pose where
-// Newton's iteration on the whole model converges (a few near the stretched elbow have no solution). With a transmission error
-// on joint 4 as steep as 0.3 cos(q4) of the joint itself (its first harmonic 0.3 rad), where the fixed
-// point contracts by less than tenfold per step at most poses, it takes Newton's iteration on the
-// whole model there; either way it reaches the whole model's solution (to 1e-8 deg, both stopping at
-// |F|^2 < 1e-18 as in the test above).
+// at the actual angles, exact to O(|a(q) - a*|^2); 3.2e-12 at most over seeds 1-12) and is below
+// sqrt(epsilon); it took the fixed point (joint_iterations > 0) at every pose where Newton's iteration
+// on the whole model converges (a few near the stretched elbow have no solution). With a transmission
+// error on joint 4 as steep as 0.3 cos(q4) of the joint itself (its first harmonic 0.3 rad), where
+// the fixed point contracts by less than tenfold per step at most poses, it takes Newton's iteration
+// on the whole model there; either way it reaches the whole model's solution (to 1e-8 deg, both
+// stopping at |F|^2 < 1e-18 as in the test above).
 TEST(Compensation, SplitEffectsReportTheWholeModelsDeviation) {
   KINCAL_SEED_TRACE(9);
   const Model nom(kr500_spec());
@@ -244,8 +244,8 @@ TEST(Compensation, SplitEffectsReportTheWholeModelsDeviation) {
     whole_steep += s.joint_iterations == 0;
     worst_steep = std::max(worst_steep, (s.q_deg - w.q_deg).cwiseAbs().maxCoeff());
   }
-  std::printf("split on %d of %d poses (%d reachable), |report - |F|| <= %.1e; steep: %d converged, %d by the whole model, worst "
-              "difference %.1e deg\n",
+  std::printf("split on %d of %d poses (%d reachable), |report - |F|| <= %.1e; steep: %d converged, %d by the "
+              "whole model, worst difference %.1e deg\n",
               split, poses, reachable, worst_report, converged_steep, whole_steep, worst_steep);
   EXPECT_EQ(split, reachable);
   EXPECT_GE(reachable, 290);

@@ -122,7 +122,9 @@ TEST(Identify, Kr500WithComplianceReachesTheNoiseFloor) {
   for (unsigned draw = 0; draw < 8; ++draw) {
     const Model truth_d(truth_spec(21 + 1000 * draw, 0.003));
     const IdentifyResult rd =
-        draw == 0 ? r : identify(nominal, fit_and_held(truth_d, so, 3 + 1000 * draw, 4 + 1000 * draw).first, IdentifyOptions());
+        draw == 0 ? r
+                  : identify(nominal, fit_and_held(truth_d, so, 3 + 1000 * draw, 4 + 1000 * draw).first,
+                             IdentifyOptions());
     for (size_t i = 0; i < rd.layout.loaded.size(); ++i) {
       const int k = rd.layout.compliance + static_cast<int>(i);
       const double t = truth_d.spec().joints[rd.layout.loaded[i]].compliance_deg_per_knm;

@@ -333,23 +333,6 @@ void JointTrig::turn_to(const Model& m, const VecQ& q_rad) {
   q = q_rad;
 }
 
-void fk_frames(const Model& m, const JointTrig& trig, ChainFrames& f) {
-  Mat3 r = m.c0_r();
-  Vec3 t = m.c0_t();
-  auto visit = [&](int j, const Mat3& rj, const Vec3& tj) {
-    f.z[j] = rj.col(2);
-    f.o[j] = tj;
-  };
-  if (m.dof() == 6)
-    walk_sc<6>(m, trig.s.data(), trig.c.data(), r, t, visit);
-  else
-    walk_sc<0>(m, trig.s.data(), trig.c.data(), r, t, visit);
-  f.n = m.dof();
-  f.tool.linear() = r;
-  f.tool.translation() = t;
-  f.tool.makeAffine();
-}
-
 JointAnglesNear::JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx) : m_(m), ctx_(ctx) {
   ref_.set(m, ref);
 }

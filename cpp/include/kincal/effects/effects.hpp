@@ -7,8 +7,8 @@
 // (cpp/src/effects/effects.cpp) lists them. Adding an effect: its file, its id in EffectId and its
 // line in the registry. The joint-angle effects act on the commanded angle q: the joint stands at
 // q + dq(q, dir); compensation inverts them by a fixed point on q after solving the chain for the
-// actual angles (compensation/pose.hpp), or by Newton on the whole model where they are steep. Inside the core, angles
-// are radians; model files carry degrees (file_scale converts).
+// actual angles (compensation/pose.hpp), or by Newton on the whole model where they are steep. Inside
+// the core, angles are radians; model files carry degrees (file_scale converts).
 #pragma once
 
 #include <string>

@@ -72,8 +72,9 @@ VecQ joint_angles(const Model& m, const VecQ& q, const EffectContext& ctx, MatQ*
 void fk_frames_actual(const Model& m, const VecQ& q, const EffectContext& ctx, ChainFrames& f);
 
 /// The sines and cosines of every joint's angle (q + its offset) as the chain's walk uses them, kept
-/// with the angles they are of: an iteration that moves q by small steps turns them by series
-/// (turn_to) instead of computing them anew.
+/// with the angles they are of, to be turned by series (turn_to) to angles a small step away instead
+/// of computed anew (JointAnglesNear). (Kept from one Newton step of the chain's FK to the next they
+/// made the FK slower than its own sincos: BENCHMARKS.md.)
 struct JointTrig {
   std::array<double, kMaxJoints + 1> s{}, c{};
   VecQ q;  ///< the angles (rad) they are of
@@ -83,9 +84,6 @@ struct JointTrig {
   /// rad (sin d and 1 - cos d by their series, the next terms below 1e-17), anew otherwise
   void turn_to(const Model& m, const VecQ& q);
 };
-
-/// fk_frames from the sines and cosines of trig (at its angles).
-void fk_frames(const Model& m, const JointTrig& trig, ChainFrames& f);
 
 /// joint_angles at commands near one reference, the gravity torque from the reference's sines and
 /// cosines turned to them (JointTrig): the commands' fixed point in compensation evaluates it a few

@@ -189,7 +189,11 @@ struct DeviationEvaluator {
   // solve. With exact false (Newton's steps), the rotation vector's rates are taken as the angular
   // velocity itself (E = I): they differ by a factor I + O(|phi|) and phi -> 0 at the solution, so
   // the iteration converges as fast (quadratically) at a lower cost; the ABC rates are always exact.
-  void jacobian(Mat6r& jf, Mat3& e, bool exact = true) const {
+  //
+  // wrist: where E = I (Newton's fast steps), the position rows taken at the wrist (joint 5's origin)
+  // directly, z_j x (wrist - o_j): FactoredJacobian's row operation already done (it adds d x w to
+  // the tool's velocity, d = tool - wrist); returns whether it was.
+  bool jacobian(Mat6r& jf, Mat3& e, bool exact = true, bool wrist = false) const {
     Mat3 e_inv;
     // (far from the solution, as from a previous pose's joints, the exact rates: |phi| > 0.05 rad)
     const bool rated = abc || exact || phi.squaredNorm() > 2.5e-3;
@@ -197,18 +201,20 @@ struct DeviationEvaluator {
       rates(e, e_inv);
     else
       e.setIdentity();
-    const Vec3 tip = frames.tool.translation();
+    const bool at_wrist = wrist && !rated;
+    const Vec3 point = at_wrist ? frames.o[4] : Vec3(frames.tool.translation());
     const double ks = kDeg * scale;
 #pragma GCC unroll 6
     for (int j = 0; j < 6; ++j) {
       const Vec3& z = frames.z[j];
-      jf.col(j).head<3>() = z.cross(tip - frames.o[j]) * ks;
+      jf.col(j).head<3>() = z.cross(point - frames.o[j]) * ks;
       if (rated)
         jf.col(j).tail<3>() = e_inv * z;
       else
         jf.col(j).tail<3>() = z;
     }
     if (effects) jf = (jf * dqd.topLeftCorner<6, 6>()).eval();
+    return at_wrist;
   }
 
   // Half the second derivative of F along a step (deg of q) at the last deviation_at, in F's units:
@@ -247,20 +253,31 @@ struct DeviationEvaluator {
 // alike, after which the arm's position block alone is singular only where the arm is; then
 // BlockSolver's 3x3 blocks.
 struct FactoredJacobian {
-  Mat3 shift;  // the row operation: f_position += shift * f_orientation
+  // the row operation f_position += shift * f_orientation; with E = I, shift = skew(dk): a cross product
+  Mat3 shift;
+  Vec3 dk;
+  bool cross = false;
   BlockSolver blocks;
 
-  // returns |det jf| (0 when singular)
-  double factor(const DeviationEvaluator& ev, Mat6r& jf, const Mat3& e) {
+  // returns |det jf| (0 when singular); at_wrist: jf's position rows already at the wrist, E = I
+  double factor(const DeviationEvaluator& ev, Mat6r& jf, const Mat3& e, bool at_wrist) {
     const Vec3 d = ev.frames.tool.translation() - ev.frames.o[4];
-    shift = (kDeg * ev.scale) * skew3(d) * e;  // mm per degree of the orientation rates
-    jf.topRows<3>() += shift * jf.bottomRows<3>();
+    cross = at_wrist;
+    if (at_wrist) {
+      dk = (kDeg * ev.scale) * d;
+    } else {
+      shift = (kDeg * ev.scale) * skew3(d) * e;  // mm per degree of the orientation rates
+      jf.topRows<3>() += shift * jf.bottomRows<3>();
+    }
     return blocks.factor(jf);
   }
 
   // f becomes the step
   void solve(Vec6& f) const {
-    f.head<3>() += shift * f.tail<3>();
+    if (cross)
+      f.head<3>() += dk.cross(f.tail<3>());
+    else
+      f.head<3>() += shift * f.tail<3>();
     blocks.solve(f);
   }
 };
@@ -311,8 +328,8 @@ CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0
     const bool fresh = reused || !(f2 < reuse2 * f2_last) || !(f2 < 1e-6);
     if (fresh) {
       if (reuse2 == 0 && !with_derivative) ev.derivative_at(q);
-      ev.jacobian(jf, e, false);
-      const double det = fac.factor(ev, jf, e);
+      const bool at_wrist = ev.jacobian(jf, e, false, true);
+      const double det = fac.factor(ev, jf, e, at_wrist);
       if (!(det > 1e-18) || !std::isfinite(det)) return finish(CompStatus::SingularJacobian);
     }
     reused = !fresh;

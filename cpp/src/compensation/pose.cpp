@@ -190,9 +190,9 @@ struct DeviationEvaluator {
   // velocity itself (E = I): they differ by a factor I + O(|phi|) and phi -> 0 at the solution, so
   // the iteration converges as fast (quadratically) at a lower cost; the ABC rates are always exact.
   //
-  // wrist: where E = I (Newton's fast steps), the position rows taken at the wrist (joint 5's origin)
-  // directly, z_j x (wrist - o_j): FactoredJacobian's row operation already done (it adds d x w to
-  // the tool's velocity, d = tool - wrist); returns whether it was.
+  // wrist: the position rows taken at the wrist (joint 5's origin), z_j x (wrist - o_j), which is
+  // FactoredJacobian's row operation done: it adds d x w to the tool's velocity (d = tool - wrist,
+  // w = E times the orientation rows, z_j for column j whatever E is). Returns whether E = I.
   bool jacobian(Mat6r& jf, Mat3& e, bool exact = true, bool wrist = false) const {
     Mat3 e_inv;
     // (far from the solution, as from a previous pose's joints, the exact rates: |phi| > 0.05 rad)
@@ -201,8 +201,7 @@ struct DeviationEvaluator {
       rates(e, e_inv);
     else
       e.setIdentity();
-    const bool at_wrist = wrist && !rated;
-    const Vec3 point = at_wrist ? frames.o[4] : Vec3(frames.tool.translation());
+    const Vec3 point = wrist ? frames.o[4] : Vec3(frames.tool.translation());
     const double ks = kDeg * scale;
 #pragma GCC unroll 6
     for (int j = 0; j < 6; ++j) {
@@ -214,7 +213,7 @@ struct DeviationEvaluator {
         jf.col(j).tail<3>() = z;
     }
     if (effects) jf = (jf * dqd.topLeftCorner<6, 6>()).eval();
-    return at_wrist;
+    return !rated;
   }
 
   // Half the second derivative of F along a step (deg of q) at the last deviation_at, in F's units:
@@ -251,33 +250,28 @@ struct DeviationEvaluator {
 // rows are first moved from the tool point to the wrist (joint 5's origin): v_wrist = v_tool + d x w
 // with d = tool - wrist and w = E (orientation rates), a row operation of determinant 1 on jf and f
 // alike, after which the arm's position block alone is singular only where the arm is; then
-// BlockSolver's 3x3 blocks.
+// BlockSolver's 3x3 blocks. The Jacobian comes with its rows at the wrist already
+// (DeviationEvaluator::jacobian's wrist); f's are moved here, by a cross product.
 struct FactoredJacobian {
-  // the row operation f_position += shift * f_orientation; with E = I, shift = skew(dk): a cross product
-  Mat3 shift;
-  Vec3 dk;
-  bool cross = false;
+  Vec3 dk;        // d, in mm per degree of the orientation rates
+  Mat3 e;         // E, where it is not the identity
+  bool rates = false;
   BlockSolver blocks;
 
-  // returns |det jf| (0 when singular); at_wrist: jf's position rows already at the wrist, E = I
-  double factor(const DeviationEvaluator& ev, Mat6r& jf, const Mat3& e, bool at_wrist) {
-    const Vec3 d = ev.frames.tool.translation() - ev.frames.o[4];
-    cross = at_wrist;
-    if (at_wrist) {
-      dk = (kDeg * ev.scale) * d;
-    } else {
-      shift = (kDeg * ev.scale) * skew3(d) * e;  // mm per degree of the orientation rates
-      jf.topRows<3>() += shift * jf.bottomRows<3>();
-    }
+  // returns |det jf| (0 when singular); identity: E = I
+  double factor(const DeviationEvaluator& ev, const Mat6r& jf, const Mat3& e_rates, bool identity) {
+    dk = (kDeg * ev.scale) * (ev.frames.tool.translation() - ev.frames.o[4]);
+    rates = !identity;
+    if (rates) e = e_rates;
     return blocks.factor(jf);
   }
 
   // f becomes the step
   void solve(Vec6& f) const {
-    if (cross)
-      f.head<3>() += dk.cross(f.tail<3>());
+    if (rates)
+      f.head<3>() += dk.cross(e * f.tail<3>());
     else
-      f.head<3>() += shift * f.tail<3>();
+      f.head<3>() += dk.cross(f.tail<3>());
     blocks.solve(f);
   }
 };
@@ -328,8 +322,8 @@ CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0
     const bool fresh = reused || !(f2 < reuse2 * f2_last) || !(f2 < 1e-6);
     if (fresh) {
       if (reuse2 == 0 && !with_derivative) ev.derivative_at(q);
-      const bool at_wrist = ev.jacobian(jf, e, false, true);
-      const double det = fac.factor(ev, jf, e, at_wrist);
+      const bool identity = ev.jacobian(jf, e, false, true);
+      const double det = fac.factor(ev, jf, e, identity);
       if (!(det > 1e-18) || !std::isfinite(det)) return finish(CompStatus::SingularJacobian);
     }
     reused = !fresh;

@@ -11,6 +11,38 @@
 
 using namespace kincal;
 
+namespace {
+
+// A kr500 with 1 mm / 0.05 deg geometric errors (seed), joint compliance (0.003 deg/kN m), and a
+// transmission error (harmonics 1, 2) and a backlash on joints 1-3.
+ModelSpec every_effect_spec(unsigned seed) {
+  ModelSpec spec = perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.003);
+  for (int j = 0; j < 3; ++j) {
+    spec.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
+    spec.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
+  }
+  return spec;
+}
+
+// The next random configuration (1 deg inside the limits) more than min_sing_deg from the nominal
+// singularities, its nominal pose, and the directions of motion into it (all +1 or all -1, by
+// `index`'s parity).
+struct RandomPose {
+  Vec6 q;
+  Pose6 target;
+  EffectContext ctx;
+};
+RandomPose random_pose(const Model& nom, std::mt19937_64& rng, double min_sing_deg, int index) {
+  RandomPose p;
+  do p.q = test::random_q(nom, rng, 1.0);
+  while (test::singularity_distance_deg(nom, p.q) < min_sing_deg);
+  p.ctx.dir = VecQ::Constant(6, index % 2 ? 1.0 : -1.0);
+  p.target = iso_to_pose(fk(nom, VecQ(p.q * kDeg)));
+  return p;
+}
+
+}  // namespace
+
 TEST(Compensation, FiniteDifferenceAndAnalyticAgree) {
   KINCAL_SEED_TRACE(6);
   const Model cal(perturbed_spec(kr500_spec(), test::test_seed(6), 1.0, 0.05, 0.003));
@@ -111,13 +143,9 @@ TEST(Compensation, BlockSolveMatchesPivotedLu) {
 TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
   KINCAL_SEED_TRACE(7, 17);
   const Model nom(kr500_spec());
-  ModelSpec effects = perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, 0.003);
-  for (int j = 0; j < 3; ++j) {
-    effects.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
-    effects.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
-  }
   const Model models[] = {Model(perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, 0.0)),
-                          Model(perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, 0.003)), Model(effects)};
+                          Model(perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, 0.003)),
+                          Model(every_effect_spec(test::test_seed(7)))};
   std::mt19937_64 rng(test::test_seed(17));
   CompensationOptions reuse, newton;
   reuse.epsilon = newton.epsilon = 1e-18;
@@ -129,12 +157,7 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
     long it_reuse = 0, it_newton = 0;
     double worst = 0;
     while (poses < 2000) {
-      const Vec6 q = test::random_q(nom, rng, 1.0);
-      if (test::singularity_distance_deg(nom, q) < 1.0) continue;
-      ++poses;
-      EffectContext ctx;
-      ctx.dir = VecQ::Constant(6, poses % 2 ? 1.0 : -1.0);
-      const Pose6 target = iso_to_pose(fk(nom, VecQ(q * kDeg)));
+      const auto [q, target, ctx] = random_pose(nom, rng, 1.0, ++poses);
       const CompensationResult a = compensate(cal, target, q, reuse, ctx), b = compensate(cal, target, q, newton, ctx);
       // near the singularities either may fail where the other converges: count both
       if (b.status == CompStatus::Converged && (b.q_deg - q).cwiseAbs().maxCoeff() > 30) continue;  // wandered
@@ -206,11 +229,7 @@ TEST(Compensation, SecondOrderTermMatchesTheDeviation) {
 TEST(Compensation, SplitEffectsReportTheWholeModelsDeviation) {
   KINCAL_SEED_TRACE(9);
   const Model nom(kr500_spec());
-  ModelSpec spec = perturbed_spec(kr500_spec(), test::test_seed(9), 1.0, 0.05, 0.003);
-  for (int j = 0; j < 3; ++j) {
-    spec.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
-    spec.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
-  }
+  const ModelSpec spec = every_effect_spec(test::test_seed(9));
   ModelSpec steep = spec;
   steep.effects.push_back({Effect{"transmission_error", 3, {1}}, {0.3, 0.0}});
   const Model cal(spec), cal_steep(steep);
@@ -223,12 +242,7 @@ TEST(Compensation, SplitEffectsReportTheWholeModelsDeviation) {
   int poses = 0, reachable = 0, split = 0, converged_steep = 0, whole_steep = 0;
   double worst_report = 0, worst_steep = 0;
   while (poses < 300) {
-    const Vec6 q = test::random_q(nom, rng, 1.0);
-    if (test::singularity_distance_deg(nom, q) < 5.0) continue;
-    ++poses;
-    EffectContext ctx;
-    ctx.dir = VecQ::Constant(6, poses % 2 ? 1.0 : -1.0);
-    const Pose6 target = iso_to_pose(fk(nom, VecQ(q * kDeg)));
+    const auto [q, target, ctx] = random_pose(nom, rng, 5.0, ++poses);
     const CompensationResult r = compensate(cal, target, q, opt, ctx);
     // near the nominal elbow's stretch some poses are beyond the compliant robot's reach: no solution,
     // or one the whole model's iteration wandered to (over 30 deg away; 1437 deg once, seed 15)

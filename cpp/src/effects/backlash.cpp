@@ -7,7 +7,8 @@
 namespace kincal {
 
 const EffectKind& backlash_kind() {
-  static const EffectKind k{
+  static const EffectKind k = [] {
+    EffectKind e{
       EffectId::backlash, "backlash", "serial", "joint", "dir", "joint_angle",
       "an offset of the joint angle that depends on the approach direction: b dir (deg)", false, false, 1,
       [](const Effect&) { return std::vector<std::string>{"backlash"}; },
@@ -16,6 +17,9 @@ const EffectKind& backlash_kind() {
         b[0] = dir;
         if (db) db[0] = 0;
       }};
+    e.angle_free = true;
+    return e;
+  }();
   return k;
 }
 

@@ -239,20 +239,23 @@ void check_context(const Model& m, const EffectContext& ctx, const std::string& 
 
 namespace {
 
+// One joint effect's angle added to out, its derivative to dqd.
+inline void add_joint_effect(const EffectValue& ev, const VecQ& q, const EffectContext& ctx, VecQ& out, MatQ* dqd) {
+  double b[128], db[128];
+  const int j = ev.effect.joint;
+  joint_basis(ev.effect, q[j], ev.effect.kind().reads_dir() ? ctx.dir[j] : 0.0, b, dqd ? db : nullptr);
+  double d = 0, dd = 0;
+  for (size_t k = 0; k < ev.p.size(); ++k) {
+    d += ev.p[k] * b[k];
+    if (dqd) dd += ev.p[k] * db[k];
+  }
+  out[j] += d;
+  if (dqd) (*dqd)(j, j) += dd;
+}
+
 // The joint effects' angles (transmission error, backlash, ...) added to out, their derivative to dqd.
 void add_joint_effects(const Model& m, const VecQ& q, const EffectContext& ctx, VecQ& out, MatQ* dqd) {
-  double b[128], db[128];
-  for (const EffectValue& ev : m.joint_effects()) {
-    const int j = ev.effect.joint;
-    joint_basis(ev.effect, q[j], ev.effect.kind().reads_dir() ? ctx.dir[j] : 0.0, b, dqd ? db : nullptr);
-    double d = 0, dd = 0;
-    for (size_t k = 0; k < ev.p.size(); ++k) {
-      d += ev.p[k] * b[k];
-      if (dqd) dd += ev.p[k] * db[k];
-    }
-    out[j] += d;
-    if (dqd) (*dqd)(j, j) += dd;
-  }
+  for (const EffectValue& ev : m.joint_effects()) add_joint_effect(ev, q, ctx, out, dqd);
 }
 
 }  // namespace
@@ -324,32 +327,94 @@ void JointTrig::set(const Model& m, const VecQ& q_rad) {
   joint_sincos<0>(m, q.data(), s.data(), c.data());
 }
 
-void JointTrig::turn_to(const Model& m, const VecQ& q_rad) {
-  const int n = m.dof();
-  if (q.size() != n) return set(m, q_rad);
-  for (int j = 0; j < n; ++j)
-    if (!(std::abs(q_rad[j] - q[j]) <= kTurnMax)) return set(m, q_rad);
-  for (int j = 0; j < n; ++j) turn_sincos(q_rad[j] - q[j], s[j], c[j]);
-  q = q_rad;
-}
+namespace {
+// rad: the largest bound on the remainder of JointAnglesNear's series of the harmonic joint effects
+// (their angles are 1e-4 rad in size, theta's rounding 2e-16 rad)
+constexpr double kSeriesLeft = 1e-18;
+}  // namespace
 
 JointAnglesNear::JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx) : m_(m), ctx_(ctx) {
   ref_.set(m, ref);
+  for (int j = 0; j < m.dof(); ++j) {
+    taylor_[j].fill(0.0);
+    remainder_[j] = 0;
+    series_[j] = false;
+  }
+  double b[128], db[128];
+  for (const EffectValue& ev : m.joint_effects()) {
+    const EffectKind& kind = ev.effect.kind();
+    if (!kind.harmonic && !kind.angle_free) {
+      other_effects_ = true;
+      continue;
+    }
+    const int j = ev.effect.joint;
+    series_[j] = true;
+    joint_basis(ev.effect, ref[j], kind.reads_dir() ? ctx.dir[j] : 0.0, b, db);
+    std::array<double, 6>& c = taylor_[j];
+    if (kind.angle_free) {
+      for (size_t l = 0; l < ev.p.size(); ++l) c[0] += ev.p[l] * b[l];
+      continue;
+    }
+    // each basis function f (sin or cos of k q): f'' = -k^2 f, f''' = -k^2 f', f'''' = k^4 f, ...
+    for (size_t i = 0; i < ev.effect.harmonics.size(); ++i) {
+      const double k2 = static_cast<double>(ev.effect.harmonics[i]) * ev.effect.harmonics[i];
+      for (size_t l = 2 * i; l < 2 * i + 2; ++l) {
+        const double p = ev.p[l], f = p * b[l], f1 = p * db[l];
+        c[0] += f;
+        c[1] += f1;
+        c[2] -= k2 * f * (1.0 / 2);
+        c[3] -= k2 * f1 * (1.0 / 6);
+        c[4] += k2 * k2 * f * (1.0 / 24);
+        c[5] += k2 * k2 * f1 * (1.0 / 120);
+        remainder_[j] += std::abs(p) * k2 * k2 * k2 * (1.0 / 720);
+      }
+    }
+  }
 }
 
 VecQ JointAnglesNear::operator()(const VecQ& q) const {
-  VecQ theta = q;
+  const int n = m_.dof();
+  VecQ theta(n);  // (not a copy of q: that one called memcpy, 3% of compensation with effects)
   if (m_.has_compliance()) {
-    JointTrig t = ref_;
-    t.turn_to(m_, q);
+    // the reference's sines and cosines turned to q (all of q's anew where a joint is farther)
+    std::array<double, kMaxJoints + 1> s = ref_.s, c = ref_.c;
+    bool near = true;
+    for (int j = 0; j < n; ++j) {
+      const double d = q[j] - ref_.q[j];
+      near = near && std::abs(d) <= kTurnMax;
+      turn_sincos(d, s[j], c[j]);
+    }
+    if (!near) joint_sincos<0>(m_, q.data(), s.data(), c.data());
     double tau[kMaxJoints] = {};
-    if (m_.dof() == 6)
-      gravity_torque_sc<6>(m_, t.s.data(), t.c.data(), tau);
+    if (n == 6)
+      gravity_torque_sc<6>(m_, s.data(), c.data(), tau);
     else
-      gravity_torque_sc<0>(m_, t.s.data(), t.c.data(), tau);
-    for (int j = 0; j < m_.dof(); ++j) theta[j] += m_.compliance(j) * tau[j];
+      gravity_torque_sc<0>(m_, s.data(), c.data(), tau);
+    for (int j = 0; j < n; ++j) theta[j] = q[j] + m_.compliance(j) * tau[j];
+  } else {
+    theta = q;
   }
-  if (m_.has_joint_effects()) add_joint_effects(m_, q, ctx_, theta, nullptr);
+  if (m_.has_joint_effects()) {
+    // the harmonic effects by their series where its remainder is below kSeriesLeft, at q itself
+    // (with the others) elsewhere
+    std::array<bool, kMaxJoints> exact{};
+    bool any_exact = other_effects_;
+    for (int j = 0; j < n; ++j) {
+      if (!series_[j]) continue;
+      const double d = q[j] - ref_.q[j], d2 = d * d;
+      if (remainder_[j] * (d2 * d2 * d2) <= kSeriesLeft) {
+        const std::array<double, 6>& t = taylor_[j];
+        theta[j] += t[0] + d * (t[1] + d * (t[2] + d * (t[3] + d * (t[4] + d * t[5]))));
+      } else {
+        exact[j] = true;
+        any_exact = true;
+      }
+    }
+    if (any_exact)
+      for (const EffectValue& ev : m_.joint_effects())
+        if (exact[ev.effect.joint] || !(ev.effect.kind().harmonic || ev.effect.kind().angle_free))
+          add_joint_effect(ev, q, ctx_, theta, nullptr);
+  }
   return theta;
 }
 

@@ -52,6 +52,8 @@ struct EffectKind {
   void (*link_basis)(const Effect&, double t1_rad, double t2_rad, double* b) = nullptr;
   /// needs == "dir", once: compensation asks it for every effect at every evaluation
   bool needs_dir = needs == "dir";
+  /// a joint-angle effect whose basis does not depend on the joint angle (backlash: dir only)
+  bool angle_free = false;
   bool reads_dir() const { return needs_dir; }                    ///< the direction of motion (dir1..dirN)
   bool scales_lengths() const { return acts_on == "length_scale"; }  ///< scales the robot's lengths
   bool of_instrument() const { return acts_on == "instrument"; }    ///< the measurement's, never the robot's

@@ -76,18 +76,19 @@ void fk_frames_actual(const Model& m, const VecQ& q, const EffectContext& ctx, C
 /// of computed anew (JointAnglesNear). (Kept from one Newton step of the chain's FK to the next they
 /// made the FK slower than its own sincos: BENCHMARKS.md.)
 struct JointTrig {
-  std::array<double, kMaxJoints + 1> s{}, c{};
+  std::array<double, kMaxJoints + 1> s, c;  ///< set by set() (no zeroing: it cost the fixed point 5%)
   VecQ q;  ///< the angles (rad) they are of
   /// of q anew
   void set(const Model& m, const VecQ& q);
-  /// of q, turned from the present angles by the difference where every joint moves by at most 0.01
-  /// rad (sin d and 1 - cos d by their series, the next terms below 1e-17), anew otherwise
-  void turn_to(const Model& m, const VecQ& q);
 };
 
-/// joint_angles at commands near one reference, the gravity torque from the reference's sines and
-/// cosines turned to them (JointTrig): the commands' fixed point in compensation evaluates it a few
-/// times within 1e-2 deg of one solution. The same angles as joint_angles(m, q, ctx) to rounding.
+/// joint_angles at commands near one reference: the commands' fixed point in compensation evaluates
+/// it a few times within 1e-2 deg of one solution. The gravity torque from the reference's sines and
+/// cosines turned to q (sin d and 1 - cos d by their series where every joint moves by at most 0.01
+/// rad, the next terms below 1e-17; anew otherwise); the harmonic joint effects (transmission error,
+/// joint map) on each joint by their Taylor series about the reference, of degree 5, where its
+/// remainder is below 1e-18 rad (at q itself otherwise), and the angle-free ones (backlash) from the
+/// reference. The same angles as joint_angles(m, q, ctx) to rounding.
 class JointAnglesNear {
  public:
   JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx);
@@ -97,6 +98,13 @@ class JointAnglesNear {
   const Model& m_;
   const EffectContext& ctx_;
   JointTrig ref_;
+  /// per joint: the harmonic and angle-free effects' angle as a polynomial in q - ref (Taylor
+  /// coefficients), and the bound of its remainder's coefficient, sum over orders k of
+  /// k^6 |amplitude| / 6!
+  std::array<std::array<double, 6>, kMaxJoints> taylor_;  // (the first dof() set)
+  std::array<double, kMaxJoints> remainder_;
+  std::array<bool, kMaxJoints> series_;  ///< the joint has such effects
+  bool other_effects_ = false;  ///< joint effects of other kinds: at q itself
 };
 
 /// The factor every length of the robot scales by (thermal expansion; 1 without it).

@@ -281,10 +281,11 @@ struct FactoredJacobian {
 // the Jacobian changes little over the steps near a solution, so each reused step costs an
 // evaluation of F only. The stopping rule is the same |F|^2 < epsilon on the exact F.
 // with_effects false: on the chain alone (the split below). When converged, f_out (if given) gets F
-// at the solution and j_out its Jacobian with the exact rates.
+// at the solution, j_out its Jacobian with the exact rates and trig_out the solution's sines and
+// cosines (from its FK).
 CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0_deg, const CompensationOptions& opt,
                           const EffectContext& ctx, bool with_effects, Vec6* f_out = nullptr,
-                          Mat6r* j_out = nullptr) {
+                          Mat6r* j_out = nullptr, JointTrig* trig_out = nullptr) {
   CompensationResult res;
   Vec6 q = q0_deg;
   DeviationEvaluator ev(cal, desired, ctx, opt.residual, with_effects);
@@ -305,6 +306,11 @@ CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0
         *f_out = f;
         Mat3 e;
         ev.jacobian(*j_out, e, true);
+        if (trig_out) {
+          trig_out->q = to_rad(q);
+          trig_out->s = ev.frames.s;
+          trig_out->c = ev.frames.c;
+        }
       }
       res.q_deg = q;
       res.iterations = it;
@@ -362,7 +368,8 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
                                     const CompensationOptions& opt, const EffectContext& ctx) {
   Vec6 fa;
   Mat6r ja;
-  CompensationResult res = newton(cal, desired, q0_deg, opt, ctx, false, &fa, &ja);
+  JointTrig trig;
+  CompensationResult res = newton(cal, desired, q0_deg, opt, ctx, false, &fa, &ja, &trig);
   if (res.status != CompStatus::Converged) {
     // where the chain's iteration stops, the commands one fixed-point step from its angles, and the
     // whole model's F there. Newton's iteration on the whole model is the same but for a joint-space
@@ -380,8 +387,8 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
     return res;
   }
   const Vec6 a_star = res.q_deg;
-  const VecQ a_rad = to_rad(a_star);
-  const JointAnglesNear actual(cal, a_rad, ctx);
+  const VecQ& a_rad = trig.q;  // a* (rad), with the sines and cosines of the chain's last FK
+  const JointAnglesNear actual(cal, trig, ctx);
   Vec6 q = a_star, r_last = Vec6::Zero();
   for (int k = 0; k < kJointSteps; ++k) {
     const Vec6 r = (actual(to_rad(q)) - a_rad) * (1 / kDeg);

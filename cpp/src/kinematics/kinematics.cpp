@@ -84,12 +84,19 @@ Eigen::Isometry3d fk(const Model& m, const VecQ& q) {
 }
 
 void fk_frames(const Model& m, const VecQ& q, ChainFrames& f) {
-  Mat3 r;
-  Vec3 t;
-  walk(m, q, r, t, [&](int j, const Mat3& rj, const Vec3& tj) {
+  Mat3 r = m.c0_r();  // (before the sines and cosines, as walk_n)
+  Vec3 t = m.c0_t();
+  auto visit = [&](int j, const Mat3& rj, const Vec3& tj) {
     f.z[j] = rj.col(2);
     f.o[j] = tj;
-  });
+  };
+  if (m.dof() == 6) {
+    joint_sincos<6>(m, q.data(), f.s.data(), f.c.data());
+    walk_sc<6>(m, f.s.data(), f.c.data(), r, t, visit);
+  } else {
+    joint_sincos<0>(m, q.data(), f.s.data(), f.c.data());
+    walk_sc<0>(m, f.s.data(), f.c.data(), r, t, visit);
+  }
   f.n = m.dof();
   f.tool.linear() = r;
   f.tool.translation() = t;
@@ -120,9 +127,11 @@ namespace {
 // moment about joint j's origin of everything it carries, in frame j:
 // A_j = mc_j + M_j+1 t_j + Rx(alpha_j) Rz(th_j+1) A_j+1 (M_j+1: the mass beyond joint j). Then
 // tau_j = z . (A_j x g_j), z = (0, 0, 1) in its own frame. About a third of the walk's work.
-// N > 0: the joint count known at compile time (as walk_sc); tau has m.dof() entries.
-template <int N = 0>
-void gravity_torque_sc(const Model& m, const double* s, const double* c, double* tau) {
+// N > 0: the joint count known at compile time (as walk_sc). out(j, tau_j) takes each torque (its
+// callers add the deflection there: an array of torques stored one by one and read two at a time
+// stalled the fixed point of compensation on the failed store forwarding).
+template <int N = 0, class Out>
+void gravity_torque_sc(const Model& m, const double* s, const double* c, Out&& out) {
   const int n = N > 0 ? N : m.dof();
   std::array<double, kMaxJoints> gx, gy;
   Vec3 v = m.c0_r().transpose() * m.gravity();
@@ -136,14 +145,14 @@ void gravity_torque_sc(const Model& m, const double* s, const double* c, double*
   }
   Vec3 a = m.link(n - 1).mc;
   double mass = m.link(n - 1).m;
-  tau[n - 1] = a[0] * gy[n - 1] - a[1] * gx[n - 1];
+  out(n - 1, a[0] * gy[n - 1] - a[1] * gx[n - 1]);
 #pragma GCC unroll 6
   for (int j = n - 2; j >= 0; --j) {
     const Model::Link& l = m.link(j);
     const double x = c[j + 1] * a[0] - s[j + 1] * a[1], y = s[j + 1] * a[0] + c[j + 1] * a[1];
     a = l.mc + mass * l.t + Vec3(x, l.ca * y - l.sa * a[2], l.sa * y + l.ca * a[2]);
     mass += l.m;
-    tau[j] = a[0] * gy[j] - a[1] * gx[j];
+    out(j, a[0] * gy[j] - a[1] * gx[j]);
   }
 }
 
@@ -151,7 +160,7 @@ void gravity_torque_local(const Model& m, const double* q, VecQ& tau) {
   double s[kMaxJoints + 1], c[kMaxJoints + 1];
   joint_sincos<0>(m, q, s, c);
   tau.resize(m.dof());
-  gravity_torque_sc(m, s, c, tau.data());
+  gravity_torque_sc(m, s, c, [&](int j, double t) { tau[j] = t; });
 }
 
 }  // namespace
@@ -283,13 +292,12 @@ constexpr double kTurnMax = 0.01;  // rad: the largest d turn_sincos takes
 template <int N>
 void fk_frames_actual_n(const Model& m, const VecQ& q, const EffectContext& ctx, ChainFrames& f) {
   const int n = m.dof();
-  double s[kMaxJoints + 1], c[kMaxJoints + 1];
+  double* s = f.s.data();
+  double* c = f.c.data();
   joint_sincos<N>(m, q.data(), s, c);
   VecQ theta = q;
   if (m.has_compliance()) {
-    double tau[kMaxJoints] = {};
-    gravity_torque_sc<N>(m, s, c, tau);
-    for (int j = 0; j < n; ++j) theta[j] += m.compliance(j) * tau[j];
+    gravity_torque_sc<N>(m, s, c, [&](int j, double t) { theta[j] += m.compliance(j) * t; });
   }
   if (m.has_joint_effects()) add_joint_effects(m, q, ctx, theta, nullptr);
   // theta's sines and cosines from q's by the small angle theta - q (larger: sincos of theta itself)
@@ -335,6 +343,18 @@ constexpr double kSeriesLeft = 1e-18;
 
 JointAnglesNear::JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx) : m_(m), ctx_(ctx) {
   ref_.set(m, ref);
+  prepare_effects();
+}
+
+JointAnglesNear::JointAnglesNear(const Model& m, const JointTrig& ref, const EffectContext& ctx)
+    : m_(m), ctx_(ctx), ref_(ref) {
+  prepare_effects();
+}
+
+void JointAnglesNear::prepare_effects() {
+  const Model& m = m_;
+  const VecQ& ref = ref_.q;
+  const EffectContext& ctx = ctx_;
   for (int j = 0; j < m.dof(); ++j) {
     taylor_[j].fill(0.0);
     remainder_[j] = 0;
@@ -385,12 +405,11 @@ VecQ JointAnglesNear::operator()(const VecQ& q) const {
       turn_sincos(d, s[j], c[j]);
     }
     if (!near) joint_sincos<0>(m_, q.data(), s.data(), c.data());
-    double tau[kMaxJoints] = {};
+    auto deflect = [&](int j, double t) { theta[j] = q[j] + m_.compliance(j) * t; };
     if (n == 6)
-      gravity_torque_sc<6>(m_, s.data(), c.data(), tau);
+      gravity_torque_sc<6>(m_, s.data(), c.data(), deflect);
     else
-      gravity_torque_sc<0>(m_, s.data(), c.data(), tau);
-    for (int j = 0; j < n; ++j) theta[j] = q[j] + m_.compliance(j) * tau[j];
+      gravity_torque_sc<0>(m_, s.data(), c.data(), deflect);
   } else {
     theta = q;
   }

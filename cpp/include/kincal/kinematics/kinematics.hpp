@@ -31,6 +31,7 @@ struct ChainFrames {
   std::array<Vec3, kMaxJoints> z, o;
   Eigen::Isometry3d tool;
   int n = 0;
+  std::array<double, kMaxJoints + 1> s, c;  ///< the sines and cosines of the angles walked (+ offsets)
 };
 
 /// FK keeping the joint frames, so that the Jacobian can follow only when it is needed.
@@ -92,6 +93,8 @@ struct JointTrig {
 class JointAnglesNear {
  public:
   JointAnglesNear(const Model& m, const VecQ& ref, const EffectContext& ctx);
+  /// the reference's sines and cosines given (as ChainFrames keeps them)
+  JointAnglesNear(const Model& m, const JointTrig& ref, const EffectContext& ctx);
   VecQ operator()(const VecQ& q) const;
 
  private:
@@ -105,6 +108,7 @@ class JointAnglesNear {
   std::array<double, kMaxJoints> remainder_;
   std::array<bool, kMaxJoints> series_;  ///< the joint has such effects
   bool other_effects_ = false;  ///< joint effects of other kinds: at q itself
+  void prepare_effects();
 };
 
 /// The factor every length of the robot scales by (thermal expansion; 1 without it).

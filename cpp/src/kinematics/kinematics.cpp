@@ -369,12 +369,16 @@ void JointAnglesNear::prepare_effects() {
     }
     const int j = ev.effect.joint;
     series_[j] = true;
-    joint_basis(ev.effect, ref[j], kind.reads_dir() ? ctx.dir[j] : 0.0, b, db);
     std::array<double, 6>& c = taylor_[j];
     if (kind.angle_free) {
+      joint_basis(ev.effect, ref[j], kind.reads_dir() ? ctx.dir[j] : 0.0, b);
       for (size_t l = 0; l < ev.p.size(); ++l) c[0] += ev.p[l] * b[l];
       continue;
     }
+    // the harmonic basis from the reference's sine and cosine (of q + offset), turned back by the offset
+    const double sq = ref_.s[j] * m.offset_cos(j) - ref_.c[j] * m.offset_sin(j);
+    const double cq = ref_.c[j] * m.offset_cos(j) + ref_.s[j] * m.offset_sin(j);
+    harmonic_basis(ev.effect.harmonics, sq, cq, b, db);
     // each basis function f (sin or cos of k q): f'' = -k^2 f, f''' = -k^2 f', f'''' = k^4 f, ...
     for (size_t i = 0; i < ev.effect.harmonics.size(); ++i) {
       const double k2 = static_cast<double>(ev.effect.harmonics[i]) * ev.effect.harmonics[i];

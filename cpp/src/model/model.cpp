@@ -145,6 +145,7 @@ void Model::compile_links() {
     }
     const Mat3 rz_back = Eigen::AngleAxisd(-theta, Vec3::UnitZ()).toRotationMatrix();
     l.offset = carried + theta;
+    offset_cs_[j] = {std::cos(l.offset), std::sin(l.offset)};
     carried = phi;
     l.ca = std::cos(alpha);
     l.sa = std::sin(alpha);

@@ -110,6 +110,9 @@ class Model {
   const Vec3& gravity() const { return g_; }
   /// compliance in rad per N mm (internal unit)
   double compliance(int j) const { return k_[j]; }
+  /// cos and sin of link(j).offset: sin q, cos q of a joint angle from those of q + offset
+  double offset_cos(int j) const { return offset_cs_[j][0]; }
+  double offset_sin(int j) const { return offset_cs_[j][1]; }
 
  private:
   // the constructor's steps, in order
@@ -137,6 +140,7 @@ class Model {
   alignas(64) std::array<Link, kMaxJoints> links_;
   Mat3 last_r_;
   Vec3 g_;
+  std::array<std::array<double, 2>, kMaxJoints> offset_cs_{};
 };
 
 using ModelPtr = std::shared_ptr<const Model>;

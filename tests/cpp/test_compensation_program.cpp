@@ -53,16 +53,19 @@ Stats run(bool finite_difference, bool corrected_start, double min_sing_deg, int
 }
 
 // The iteration stops on its own evaluation of F and the check evaluates F again by pose_deviation
-// (fk_model): the two round apart by up to about 1e-12 mm at the kr500's 3 m reach (the ulp of 3000 mm
-// is 4.5e-13), and the chord steps and the commands' fixed point converge linearly, so the last
-// iterate may stop just under 1e-9 (9.97e-10..1e-9 at KINCAL_TEST_SEED 2, 4, 5, 7, 9, with the split and
-// without it): the position is checked to 1e-9 mm plus that rounding. Until the twenty-fifth session
-// it was checked to 1e-9 exactly, and seeds 2, 4 and 5 evaluated 1.00016e-9 mm there.
-constexpr double kFkRoundingMm = 1e-12;
+// (fk_model): the two round apart. Each rounds the FK (the ulp of 3000 mm is 4.5e-13 mm) and the
+// actual joint angles q + d(q) (with compliance or joint effects; an ulp of an angle between 2 and 4
+// rad is 4.4e-16 rad, which moves the tool 1.3e-12 mm at the kr500's 3 m reach), and the chord steps
+// and the commands' fixed point converge linearly, so the last iterate may stop just under 1e-9 mm:
+// the position is checked to 1e-9 mm plus 5e-12. Measured over KINCAL_TEST_SEED 1-40 (the three tests
+// below, 11 runs of 5000 poses per seed): at most 1.88e-12 mm above 1e-9 at 0390887 (seed 33) and
+// 1.38e-12 since the twenty-sixth session (seed 10). Until then the allowance was 1e-12 (the FK's
+// rounding alone), which seed 33 exceeded on 0390887 already; until the twenty-fifth session it was 0.
+constexpr double kFkRoundingMm = 5e-12;
 
 double expect_999(const Stats& s, const char* what, double at_least = 0.999) {
   const double rate = static_cast<double>(s.within5) / s.poses;
-  std::printf("%s: %d poses, %.4f%% within 5 iterations, %d failed, worst %.2e mm %.2e deg\n", what, s.poses,
+  std::printf("%s: %d poses, %.4f%% within 5 iterations, %d failed, worst %.5e mm %.2e deg\n", what, s.poses,
               100 * rate, s.failed, s.worst_mm, s.worst_deg);
   EXPECT_GE(rate, at_least) << what;
   EXPECT_LT(s.worst_mm, 1e-9 + kFkRoundingMm) << what;

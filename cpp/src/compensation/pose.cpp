@@ -389,10 +389,23 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
   const Vec6 a_star = res.q_deg;
   const VecQ& a_rad = trig.q;  // a* (rad), with the sines and cosines of the chain's last FK
   const JointAnglesNear actual(cal, trig, ctx);
-  Vec6 q = a_star, r_last = Vec6::Zero();
+  // r(a*) and the band of D, the derivative of d, there: the steps are (I + D_band)^-1 r by the series
+  // I - D_band + D_band^2
+  double lo[kMaxJoints], dg[kMaxJoints], up[kMaxJoints];
+  Vec6 r = (actual.at_reference(lo, dg, up) - a_rad) * (1 / kDeg), r_last;
+  auto band = [&](const Vec6& v) {
+    Vec6 w;
+    for (int j = 0; j < 6; ++j) w[j] = dg[j] * v[j] + (j > 0 ? lo[j] * v[j - 1] : 0.0) + (j < 5 ? up[j] * v[j + 1] : 0.0);
+    return w;
+  };
+  auto step = [&](const Vec6& v) {
+    const Vec6 dv = band(v);
+    return Vec6(v - dv + band(dv));
+  };
+  Vec6 q = a_star;
   for (int k = 0; k < kJointSteps; ++k) {
-    const Vec6 r = (actual(to_rad(q)) - a_rad) * (1 / kDeg);
     if (k > 0) {
+      r = (actual(to_rad(q)) - a_rad) * (1 / kDeg);
       if (r.cwiseAbs().maxCoeff() < kJointStepTrusted) {
         const Vec6 f = fa + ja * r;
         if (f.squaredNorm() < opt.epsilon) {
@@ -407,7 +420,7 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
       if (!(r.squaredNorm() < 0.01 * r_last.squaredNorm())) break;
     }
     r_last = r;
-    q -= r;
+    q -= step(r);
   }
   return newton(cal, desired, q0_deg, opt, ctx, true);
 }

@@ -156,6 +156,41 @@ void gravity_torque_sc(const Model& m, const double* s, const double* c, Out&& o
   }
 }
 
+// gravity_torque_sc with the diagonal of its derivative and the one next to it (the derivative is
+// symmetric: d tau_j / d q_j+1 = d tau_j+1 / d q_j), diag[j] = d tau_j / d q_j and
+// next[j] = d tau_j / d q_j+1, in the same two recursions. In frame j (after joint j's rotation)
+// tau_j = (A_j x g_j)_z: turning joint j turns g_j by -z x g_j; turning joint j+1 turns what A_j
+// carries beyond it, Rx(alpha_j) (z x Rz(th_j+1) A_j+1).
+template <int N = 0>
+void gravity_torque_band_sc(const Model& m, const double* s, const double* c, double* tau, double* diag, double* next) {
+  const int n = N > 0 ? N : m.dof();
+  std::array<double, kMaxJoints> gx, gy;
+  Vec3 v = m.c0_r().transpose() * m.gravity();
+#pragma GCC unroll 6
+  for (int j = 0; j < n; ++j) {
+    const double x = c[j] * v[0] + s[j] * v[1], y = c[j] * v[1] - s[j] * v[0];
+    gx[j] = x;
+    gy[j] = y;
+    const Model::Link& l = m.link(j);
+    v = Vec3(x, l.ca * y + l.sa * v[2], l.ca * v[2] - l.sa * y);
+  }
+  Vec3 a = m.link(n - 1).mc;
+  double mass = m.link(n - 1).m;
+  tau[n - 1] = a[0] * gy[n - 1] - a[1] * gx[n - 1];
+  diag[n - 1] = -(a[0] * gx[n - 1] + a[1] * gy[n - 1]);
+  next[n - 1] = 0;
+#pragma GCC unroll 6
+  for (int j = n - 2; j >= 0; --j) {
+    const Model::Link& l = m.link(j);
+    const double x = c[j + 1] * a[0] - s[j + 1] * a[1], y = s[j + 1] * a[0] + c[j + 1] * a[1];
+    a = l.mc + mass * l.t + Vec3(x, l.ca * y - l.sa * a[2], l.sa * y + l.ca * a[2]);
+    mass += l.m;
+    tau[j] = a[0] * gy[j] - a[1] * gx[j];
+    diag[j] = -(a[0] * gx[j] + a[1] * gy[j]);
+    next[j] = -y * gy[j] - l.ca * x * gx[j];
+  }
+}
+
 void gravity_torque_local(const Model& m, const double* q, VecQ& tau) {
   double s[kMaxJoints + 1], c[kMaxJoints + 1];
   joint_sincos<0>(m, q, s, c);
@@ -394,6 +429,39 @@ void JointAnglesNear::prepare_effects() {
       }
     }
   }
+}
+
+VecQ JointAnglesNear::at_reference(double* lower, double* diag, double* upper) const {
+  const int n = m_.dof();
+  VecQ theta(n);
+  if (m_.has_compliance()) {
+    double tau[kMaxJoints], dg[kMaxJoints], nx[kMaxJoints];
+    if (n == 6)
+      gravity_torque_band_sc<6>(m_, ref_.s.data(), ref_.c.data(), tau, dg, nx);
+    else
+      gravity_torque_band_sc<0>(m_, ref_.s.data(), ref_.c.data(), tau, dg, nx);
+    for (int j = 0; j < n; ++j) {
+      const double k = m_.compliance(j);
+      theta[j] = ref_.q[j] + k * tau[j];
+      diag[j] = k * dg[j];
+      upper[j] = k * nx[j];
+      lower[j] = j > 0 ? k * nx[j - 1] : 0.0;
+    }
+  } else {
+    theta = ref_.q;
+    for (int j = 0; j < n; ++j) lower[j] = diag[j] = upper[j] = 0;
+  }
+  if (m_.has_joint_effects()) {
+    for (int j = 0; j < n; ++j)
+      if (series_[j]) {
+        theta[j] += taylor_[j][0];
+        diag[j] += taylor_[j][1];
+      }
+    if (other_effects_)  // (their derivative left out)
+      for (const EffectValue& ev : m_.joint_effects())
+        if (!(ev.effect.kind().harmonic || ev.effect.kind().angle_free)) add_joint_effect(ev, ref_.q, ctx_, theta, nullptr);
+  }
+  return theta;
 }
 
 VecQ JointAnglesNear::operator()(const VecQ& q) const {

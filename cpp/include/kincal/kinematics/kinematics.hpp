@@ -96,6 +96,11 @@ class JointAnglesNear {
   /// the reference's sines and cosines given (as ChainFrames keeps them)
   JointAnglesNear(const Model& m, const JointTrig& ref, const EffectContext& ctx);
   VecQ operator()(const VecQ& q) const;
+  /// at the reference itself, with the band of the derivative of the angles' offset theta - q there
+  /// (joint j's with respect to q_j-1, q_j and q_j+1: lower[j], diag[j], upper[j]; the compliance's
+  /// and the harmonic and angle-free effects', other effects' left out): the preconditioner of the
+  /// commands' fixed point in compensation
+  VecQ at_reference(double* lower, double* diag, double* upper) const;
 
  private:
   const Model& m_;

@@ -5,25 +5,9 @@
 namespace kincal::harmonic {
 
 void basis(const std::vector<int>& orders, double q, double* b, double* db) {
-  // sin(kq), cos(kq) of each order from sin q, cos q
+  // sin(kq), cos(kq) of each order from sin q, cos q by the angle-addition rule
   double s1, c1;
   fastmath::sincos(q, s1, c1);
-  harmonic_basis(orders, s1, c1, b, db);
-}
-
-std::vector<std::string> names(const std::string& prefix, const std::vector<int>& orders) {
-  std::vector<std::string> n;
-  for (int k : orders) n.push_back(prefix + "sin" + std::to_string(k)), n.push_back(prefix + "cos" + std::to_string(k));
-  return n;
-}
-
-std::vector<std::string> units(const Effect& e) { return std::vector<std::string>(2 * e.harmonics.size(), "rad"); }
-
-}  // namespace kincal::harmonic
-
-namespace kincal {
-
-void harmonic_basis(const std::vector<int>& orders, double s1, double c1, double* b, double* db) {
   int have = 1;
   double sk = s1, ck = c1;
   for (size_t i = 0; i < orders.size(); ++i) {
@@ -41,4 +25,12 @@ void harmonic_basis(const std::vector<int>& orders, double s1, double c1, double
   }
 }
 
-}  // namespace kincal
+std::vector<std::string> names(const std::string& prefix, const std::vector<int>& orders) {
+  std::vector<std::string> n;
+  for (int k : orders) n.push_back(prefix + "sin" + std::to_string(k)), n.push_back(prefix + "cos" + std::to_string(k));
+  return n;
+}
+
+std::vector<std::string> units(const Effect& e) { return std::vector<std::string>(2 * e.harmonics.size(), "rad"); }
+
+}  // namespace kincal::harmonic

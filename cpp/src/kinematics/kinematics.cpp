@@ -388,46 +388,53 @@ JointAnglesNear::JointAnglesNear(const Model& m, const JointTrig& ref, const Eff
 
 void JointAnglesNear::prepare_effects() {
   const Model& m = m_;
-  const VecQ& ref = ref_.q;
-  const EffectContext& ctx = ctx_;
   for (int j = 0; j < m.dof(); ++j) {
     taylor_[j].fill(0.0);
-    remainder_[j] = 0;
+    remainder_[j] = m.harmonic_bound(j);
     series_[j] = false;
   }
-  double b[128], db[128];
+  // the harmonic terms: sin q and cos q from the reference's sines and cosines of q + offset turned
+  // back by the offset, sin kq and cos kq by angle addition; each term's derivatives are k^n times
+  // itself (f'' = -k^2 f, f''' = -k^2 f', f'''' = k^4 f, ...)
+  int last = -1;
+  double sq = 0, cq = 1;
+  for (const Model::HarmonicTerm& h : m.harmonic_terms()) {
+    const int j = h.joint;
+    if (j != last) {
+      sq = ref_.s[j] * m.offset_cos(j) - ref_.c[j] * m.offset_sin(j);
+      cq = ref_.c[j] * m.offset_cos(j) + ref_.s[j] * m.offset_sin(j);
+      last = j;
+      series_[j] = true;
+    }
+    double sk = sq, ck = cq;
+    for (int i = 1; i < h.k; ++i) {
+      const double t = sk * cq + ck * sq;
+      ck = ck * cq - sk * sq;
+      sk = t;
+    }
+    const double k = h.k, k2 = k * k;
+    const double f = h.sin_amp * sk + h.cos_amp * ck, f1 = k * (h.sin_amp * ck - h.cos_amp * sk);
+    std::array<double, 6>& c = taylor_[j];
+    c[0] += f;
+    c[1] += f1;
+    c[2] -= k2 * f * (1.0 / 2);
+    c[3] -= k2 * f1 * (1.0 / 6);
+    c[4] += k2 * k2 * f * (1.0 / 24);
+    c[5] += k2 * k2 * f1 * (1.0 / 120);
+  }
+  // the angle-free effects (backlash) at the reference; the others at each q
+  double b[128];
   for (const EffectValue& ev : m.joint_effects()) {
     const EffectKind& kind = ev.effect.kind();
-    if (!kind.harmonic && !kind.angle_free) {
+    if (kind.harmonic) continue;
+    if (!kind.angle_free) {
       other_effects_ = true;
       continue;
     }
     const int j = ev.effect.joint;
     series_[j] = true;
-    std::array<double, 6>& c = taylor_[j];
-    if (kind.angle_free) {
-      joint_basis(ev.effect, ref[j], kind.reads_dir() ? ctx.dir[j] : 0.0, b);
-      for (size_t l = 0; l < ev.p.size(); ++l) c[0] += ev.p[l] * b[l];
-      continue;
-    }
-    // the harmonic basis from the reference's sine and cosine (of q + offset), turned back by the offset
-    const double sq = ref_.s[j] * m.offset_cos(j) - ref_.c[j] * m.offset_sin(j);
-    const double cq = ref_.c[j] * m.offset_cos(j) + ref_.s[j] * m.offset_sin(j);
-    harmonic_basis(ev.effect.harmonics, sq, cq, b, db);
-    // each basis function f (sin or cos of k q): f'' = -k^2 f, f''' = -k^2 f', f'''' = k^4 f, ...
-    for (size_t i = 0; i < ev.effect.harmonics.size(); ++i) {
-      const double k2 = static_cast<double>(ev.effect.harmonics[i]) * ev.effect.harmonics[i];
-      for (size_t l = 2 * i; l < 2 * i + 2; ++l) {
-        const double p = ev.p[l], f = p * b[l], f1 = p * db[l];
-        c[0] += f;
-        c[1] += f1;
-        c[2] -= k2 * f * (1.0 / 2);
-        c[3] -= k2 * f1 * (1.0 / 6);
-        c[4] += k2 * k2 * f * (1.0 / 24);
-        c[5] += k2 * k2 * f1 * (1.0 / 120);
-        remainder_[j] += std::abs(p) * k2 * k2 * k2 * (1.0 / 720);
-      }
-    }
+    joint_basis(ev.effect, ref_.q[j], kind.reads_dir() ? ctx_.dir[j] : 0.0, b);
+    for (size_t l = 0; l < ev.p.size(); ++l) taylor_[j][0] += ev.p[l] * b[l];
   }
 }
 

@@ -67,6 +67,13 @@ void Model::take_effects(const std::string& who) {
     } else {
       joint_effects_.push_back(ev);
       needs_dir_ = needs_dir_ || kind.reads_dir();
+      if (kind.harmonic)  // a sine and a cosine amplitude per order, in the order of the harmonics
+        for (size_t i = 0; i < ev.effect.harmonics.size(); ++i) {
+          const int k = ev.effect.harmonics[i];
+          harmonic_terms_.push_back({ev.effect.joint, k, ev.p[2 * i], ev.p[2 * i + 1]});
+          const double k6 = std::pow(static_cast<double>(k), 6);
+          harmonic_bound_[ev.effect.joint] += k6 * (std::abs(ev.p[2 * i]) + std::abs(ev.p[2 * i + 1])) / 720;
+        }
     }
   }
   spec_.effects = rest;

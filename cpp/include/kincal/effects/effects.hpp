@@ -107,10 +107,6 @@ Effect joint_map(int joint, int order);
 /// effect's own checks); throws InputError with `who` in front of the cause.
 void check_effect(const Effect& e, int dof, const std::string& who);
 
-/// sin(k q), cos(k q) of each harmonic order k (in b, in pairs: a harmonic kind's basis) from sin q
-/// and cos q by the angle-addition rule, their derivatives with respect to q in db when not null.
-void harmonic_basis(const std::vector<int>& orders, double sin_q, double cos_q, double* b, double* db = nullptr);
-
 /// The basis of a joint-angle effect (transmission_error, joint_map, backlash): dq = sum_k p_k b_k(q, dir).
 /// Writes size() values to b and, when db is not null, their derivatives with respect to q.
 void joint_basis(const Effect& e, double q_rad, double dir, double* b, double* db = nullptr);

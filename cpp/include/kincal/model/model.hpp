@@ -83,6 +83,15 @@ class Model {
   /// effects on the joint angles besides compliance (transmission error, backlash)
   bool has_joint_effects() const { return !joint_effects_.empty(); }
   const std::vector<EffectValue>& joint_effects() const { return joint_effects_; }
+  /// the harmonic joint effects (transmission error, joint map) term by term: the order k and the
+  /// sine and cosine amplitudes (rad) on a joint, dq_j = s sin(k q_j) + c cos(k q_j)
+  struct HarmonicTerm {
+    int joint, k;
+    double sin_amp, cos_amp;
+  };
+  const std::vector<HarmonicTerm>& harmonic_terms() const { return harmonic_terms_; }
+  /// joint j's harmonic terms' bound of their sum's sixth derivative over 6!: sum k^6 (|s| + |c|) / 720
+  double harmonic_bound(int j) const { return harmonic_bound_[j]; }
   bool needs_dir() const { return needs_dir_; }                  ///< backlash: dir1..dirN needed
   bool needs_temperature() const { return thermal_alpha_ != 0; }  ///< thermal expansion: T needed
   double thermal_alpha() const { return thermal_alpha_; }         ///< 1/degC (0: none)
@@ -128,6 +137,8 @@ class Model {
   std::array<bool, kMaxJoints> loaded_{};
   bool has_compliance_ = false;
   std::vector<EffectValue> joint_effects_;
+  std::vector<HarmonicTerm> harmonic_terms_;
+  std::array<double, kMaxJoints> harmonic_bound_{};
   bool needs_dir_ = false;
   double thermal_alpha_ = 0;
   std::array<Vec3, kMaxJoints> w_, p_;

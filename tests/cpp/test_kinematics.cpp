@@ -261,8 +261,9 @@ TEST(Kinematics, JointAnglesBandAtTheReferenceIsTheDerivativesBand) {
       EffectContext ctx;
       ctx.dir = VecQ::Constant(6, i % 2 ? 1.0 : -1.0);
       const JointAnglesNear near(m, ref, ctx);
-      double lo[kMaxJoints], dg[kMaxJoints], up[kMaxJoints];
-      const VecQ theta = near.at_reference(lo, dg, up);
+      JointBand band;
+      const VecQ theta = near.at_reference(band);
+      const auto &lo = band.lower, &dg = band.diag, &up = band.upper;
       MatQ dqd;
       const VecQ exact = joint_angles(m, ref, ctx, &dqd);
       const double scale = (dqd - MatQ::Identity(6, 6)).cwiseAbs().maxCoeff();

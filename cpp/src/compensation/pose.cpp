@@ -396,17 +396,8 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
   // r(a*) and D_band there; the steps (I + D_band)^-1 r by the series I - D_band + D_band^2 (its
   // remainder D_band^3 r is 1e-9 of r at |D| ~ 1e-3; a D too large for it shows as a step that does
   // not contract tenfold, and the whole model's Newton takes over)
-  double lo[kMaxJoints], dg[kMaxJoints], up[kMaxJoints];
-  Vec6 r = (actual.at_reference(lo, dg, up) - a_rad) * (1 / kDeg), r_last;
-  auto band = [&](const Vec6& v) {
-    Vec6 w;
-    for (int j = 0; j < 6; ++j) w[j] = dg[j] * v[j] + (j > 0 ? lo[j] * v[j - 1] : 0.0) + (j < 5 ? up[j] * v[j + 1] : 0.0);
-    return w;
-  };
-  auto step = [&](const Vec6& v) {
-    const Vec6 dv = band(v);
-    return Vec6(v - dv + band(dv));
-  };
+  JointBand band;
+  Vec6 r = (actual.at_reference(band) - a_rad) * (1 / kDeg), r_last;
   Vec6 q = a_star;
   for (int k = 0; k < kJointSteps; ++k) {
     if (k > 0) {
@@ -425,7 +416,7 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
       if (!(r.squaredNorm() < 0.01 * r_last.squaredNorm())) break;
     }
     r_last = r;
-    q -= step(r);
+    q -= band.inverse_times(r);
   }
   return newton(cal, desired, q0_deg, opt, ctx, true);
 }

@@ -77,10 +77,19 @@ void fk_frames_actual(const Model& m, const VecQ& q, const EffectContext& ctx, C
 /// of computed anew (JointAnglesNear). (Kept from one Newton step of the chain's FK to the next they
 /// made the FK slower than its own sincos: BENCHMARKS.md.)
 struct JointTrig {
-  std::array<double, kMaxJoints + 1> s, c;  ///< set by set() (no zeroing: it cost the fixed point 5%)
+  std::array<double, kMaxJoints + 1> s, c;  ///< (not zeroed: set() writes them)
   VecQ q;  ///< the angles (rad) they are of
   /// of q anew
   void set(const Model& m, const VecQ& q);
+};
+
+/// The band of the derivative of the joint angles' offset theta - q at a reference (joint j's with
+/// respect to q_j-1, q_j and q_j+1), as JointAnglesNear::at_reference gives it: the preconditioner of
+/// the commands' fixed point in compensation.
+struct JointBand {
+  std::array<double, kMaxJoints> lower, diag, upper;
+  /// (I + band)^-1 v by the series I - band + band^2 (6 joints)
+  Vec6 inverse_times(const Vec6& v) const;
 };
 
 /// joint_angles at commands near one reference: the commands' fixed point in compensation evaluates
@@ -96,11 +105,9 @@ class JointAnglesNear {
   /// the reference's sines and cosines given (as ChainFrames keeps them)
   JointAnglesNear(const Model& m, const JointTrig& ref, const EffectContext& ctx);
   VecQ operator()(const VecQ& q) const;
-  /// at the reference itself, with the band of the derivative of the angles' offset theta - q there
-  /// (joint j's with respect to q_j-1, q_j and q_j+1: lower[j], diag[j], upper[j]; the compliance's
-  /// and the harmonic and angle-free effects', other effects' left out): the preconditioner of the
-  /// commands' fixed point in compensation
-  VecQ at_reference(double* lower, double* diag, double* upper) const;
+  /// at the reference itself, with the band of the derivative there (the compliance's and the
+  /// harmonic and angle-free effects'; other effects' left out)
+  VecQ at_reference(JointBand& band) const;
 
  private:
   const Model& m_;

@@ -69,7 +69,6 @@ inline void walk(const Model& m, const VecQ& q, Mat3& r, Vec3& t, Visit&& visit)
     walk_n<0>(m, q.data(), r, t, visit);
 }
 
-
 // The gravity torque alone, without rotation matrices: two recursions of 3-vectors in the joints' own
 // frames (the frame right after each joint's rotation, as walk_n visits it). Forward, gravity in
 // frame j: g_0 = Rz(th_0)^T C0^T g, g_j+1 = Rz(th_j+1)^T Rx(alpha_j)^T g_j. Backward, the first
@@ -109,7 +108,7 @@ inline void gravity_torque_sc(const Model& m, const double* s, const double* c, 
   }
 }
 
-// s, c of an angle x turned into those of x + d for a small d (|d| <= 0.01 rad): sin d and 1 - cos d
+// s, c of an angle x turned into those of x + d for a small d (|d| <= kTurnMax): sin d and 1 - cos d
 // by their series, whose next terms are below 1e-17 there.
 inline void turn_sincos(double d, double& s, double& c) {
   const double d2 = d * d;

@@ -13,17 +13,6 @@ using namespace kincal;
 
 namespace {
 
-// A kr500 with 1 mm / 0.05 deg geometric errors (seed), joint compliance (0.003 deg/kN m), and a
-// transmission error (harmonics 1, 2) and a backlash on joints 1-3.
-ModelSpec every_effect_spec(unsigned seed) {
-  ModelSpec spec = perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.003);
-  for (int j = 0; j < 3; ++j) {
-    spec.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
-    spec.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
-  }
-  return spec;
-}
-
 // The next random configuration (1 deg inside the limits) more than min_sing_deg from the nominal
 // singularities, its nominal pose, and the directions of motion into it (all +1 or all -1, by
 // `index`'s parity).
@@ -145,7 +134,7 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
   const Model nom(kr500_spec());
   const Model models[] = {Model(perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, 0.0)),
                           Model(perturbed_spec(kr500_spec(), test::test_seed(7), 1.0, 0.05, 0.003)),
-                          Model(every_effect_spec(test::test_seed(7)))};
+                          Model(test::every_effect_spec(test::test_seed(7)))};
   std::mt19937_64 rng(test::test_seed(17));
   CompensationOptions reuse, newton;
   reuse.epsilon = newton.epsilon = 1e-18;
@@ -229,7 +218,7 @@ TEST(Compensation, SecondOrderTermMatchesTheDeviation) {
 TEST(Compensation, SplitEffectsReportTheWholeModelsDeviation) {
   KINCAL_SEED_TRACE(9);
   const Model nom(kr500_spec());
-  const ModelSpec spec = every_effect_spec(test::test_seed(9));
+  const ModelSpec spec = test::every_effect_spec(test::test_seed(9));
   ModelSpec steep = spec;
   steep.effects.push_back({Effect{"transmission_error", 3, {1}}, {0.3, 0.0}});
   const Model cal(spec), cal_steep(steep);

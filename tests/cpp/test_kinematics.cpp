@@ -159,11 +159,7 @@ TEST(Kinematics, DerivativesMatchFiniteDifferences) {
 // takes sincos of theta itself beyond 0.01 rad.
 TEST(Kinematics, ActualFramesInOnePassEqualTheFramesAtTheActualAngles) {
   KINCAL_SEED_TRACE(10);
-  ModelSpec effects = perturbed_spec(kr500_spec(), test::test_seed(10), 1.0, 0.05, 0.003);
-  for (int j = 0; j < 3; ++j) {
-    effects.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
-    effects.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
-  }
+  const ModelSpec effects = test::every_effect_spec(test::test_seed(10));
   ModelSpec soft = perturbed_spec(kr500_spec(), test::test_seed(10), 1.0, 0.05, 0.1);
   std::mt19937_64 rng(test::test_seed(10));
   for (const ModelSpec& spec : {effects, soft}) {
@@ -190,6 +186,14 @@ TEST(Kinematics, ActualFramesInOnePassEqualTheFramesAtTheActualAngles) {
   }
 }
 
+// A model's spec with a joint map of order 3 on joint 4 and a transmission error of harmonics 1 and
+// 12 (amplitudes 1e-3 rad) on joint 5 added: higher orders, whose series reach less far.
+static ModelSpec with_more_effects(ModelSpec spec) {
+  spec.effects.push_back({joint_map(3, 3), {3e-4, -2e-4, 1e-4, 2e-4, -5e-5, 7e-5}});
+  spec.effects.push_back({Effect{"transmission_error", 4, {1, 12}}, {1e-3, -1e-3, 1e-3, 1e-3}});
+  return spec;
+}
+
 // JointAnglesNear (the commands' fixed point in compensation: the gravity torque from the
 // reference's sines and cosines turned to q, the harmonic joint effects by their Taylor series of
 // degree 5 about the reference, backlash from it) against joint_angles at q itself. A kr500 with
@@ -202,14 +206,8 @@ TEST(Kinematics, ActualFramesInOnePassEqualTheFramesAtTheActualAngles) {
 // both ways are taken. Every angle agrees to rounding (measured: printed), held to 1e-14 rad.
 TEST(Kinematics, JointAnglesNearAReferenceEqualJointAngles) {
   KINCAL_SEED_TRACE(13);
-  ModelSpec effects = perturbed_spec(kr500_spec(), test::test_seed(13), 1.0, 0.05, 0.003);
-  for (int j = 0; j < 3; ++j) {
-    effects.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
-    effects.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
-  }
-  ModelSpec more = effects;
-  more.effects.push_back({joint_map(3, 3), {3e-4, -2e-4, 1e-4, 2e-4, -5e-5, 7e-5}});
-  more.effects.push_back({Effect{"transmission_error", 4, {1, 12}}, {1e-3, -1e-3, 1e-3, 1e-3}});
+  const ModelSpec effects = test::every_effect_spec(test::test_seed(13));
+  const ModelSpec more = with_more_effects(effects);
   const ModelSpec soft = perturbed_spec(kr500_spec(), test::test_seed(13), 1.0, 0.05, 0.1);
   std::mt19937_64 rng(test::test_seed(13));
   std::normal_distribution<double> normal;
@@ -243,14 +241,8 @@ TEST(Kinematics, JointAnglesNearAReferenceEqualJointAngles) {
 // derivative is 1e-5 at most), held to 1e-9; the angles themselves to 1e-14 rad.
 TEST(Kinematics, JointAnglesBandAtTheReferenceIsTheDerivativesBand) {
   KINCAL_SEED_TRACE(14);
-  ModelSpec effects = perturbed_spec(kr500_spec(), test::test_seed(14), 1.0, 0.05, 0.003);
-  for (int j = 0; j < 3; ++j) {
-    effects.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
-    effects.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
-  }
-  ModelSpec more = effects;
-  more.effects.push_back({joint_map(3, 3), {3e-4, -2e-4, 1e-4, 2e-4, -5e-5, 7e-5}});
-  more.effects.push_back({Effect{"transmission_error", 4, {1, 12}}, {1e-3, -1e-3, 1e-3, 1e-3}});
+  const ModelSpec effects = test::every_effect_spec(test::test_seed(14));
+  const ModelSpec more = with_more_effects(effects);
   const ModelSpec ur10 = perturbed_spec(ur10_spec(), test::test_seed(14), 1.0, 0.05, 0.003);
   std::mt19937_64 rng(test::test_seed(14));
   for (const ModelSpec& spec : {effects, more, ur10}) {

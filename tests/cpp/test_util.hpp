@@ -77,6 +77,18 @@ inline std::string seed_note(std::initializer_list<unsigned> defaults) {
                                   : " (the defaults: KINCAL_TEST_SEED unset)");
 }
 
+// A kr500 with 1 mm / 0.05 deg geometric errors (seed), joint compliance (0.003 deg/kN m), and a
+// transmission error (harmonics 1, 2) and a backlash on joints 1-3: the compensation benchmark's
+// model with every effect.
+inline ModelSpec every_effect_spec(unsigned seed) {
+  ModelSpec spec = perturbed_spec(kr500_spec(), seed, 1.0, 0.05, 0.003);
+  for (int j = 0; j < 3; ++j) {
+    spec.effects.push_back({Effect{"transmission_error", j, {1, 2}}, {2e-4, -1e-4, 5e-5, 8e-5}});
+    spec.effects.push_back({Effect{"backlash", j, {}}, {-2e-4}});
+  }
+  return spec;
+}
+
 inline Vec6 random_q(const Model& m, std::mt19937_64& rng, double margin_deg = 0) {
   Vec6 q;
   for (int j = 0; j < 6; ++j) {

@@ -34,7 +34,6 @@ void JointAnglesNear::prepare_effects() {
   const Model& m = m_;
   for (int j = 0; j < m.dof(); ++j) {
     taylor_[j].fill(0.0);
-    remainder_[j] = m.harmonic_bound(j);
     series_[j] = false;
   }
   // the harmonic terms: sin q and cos q from the reference's sines and cosines of q + offset turned
@@ -158,7 +157,7 @@ VecQ JointAnglesNear::operator()(const VecQ& q) const {
     for (int j = 0; j < n; ++j) {
       if (!series_[j]) continue;
       const double d = q[j] - ref_.q[j], d2 = d * d;
-      if (remainder_[j] * (d2 * d2 * d2) <= kSeriesLeft) {
+      if (m_.harmonic_bound(j) * (d2 * d2 * d2) <= kSeriesLeft) {
         const std::array<double, 6>& t = taylor_[j];
         theta[j] += t[0] + d * (t[1] + d * (t[2] + d * (t[3] + d * (t[4] + d * t[5]))));
       } else {

@@ -114,10 +114,8 @@ class JointAnglesNear {
   const EffectContext& ctx_;
   JointTrig ref_;
   /// per joint: the harmonic and angle-free effects' angle as a polynomial in q - ref (Taylor
-  /// coefficients), and the bound of its remainder's coefficient, sum over orders k of
-  /// k^6 |amplitude| / 6!
+  /// coefficients; its remainder's bound is the model's, Model::harmonic_bound)
   std::array<std::array<double, 6>, kMaxJoints> taylor_;  // (the first dof() set)
-  std::array<double, kMaxJoints> remainder_;
   std::array<bool, kMaxJoints> series_;  ///< the joint has such effects
   bool other_effects_ = false;  ///< joint effects of other kinds: at q itself
   void prepare_effects();

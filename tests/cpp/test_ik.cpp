@@ -4,14 +4,34 @@
 
 #include "test_util.hpp"
 
+#include <Eigen/SVD>
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 using namespace kincal;
 
 namespace {
 
-// Checks that every solution reproduces the pose and that the generating configuration is among them.
-void check_round_trip(const Model& m, const IkSolver& ik, const Vec6& q, double& worst_p, double& worst_r) {
+// The pose determines the angles only as well as the Jacobian is conditioned: where two branches
+// nearly meet, the rounding of the pose (1e-12 rad) moves the solution by about c / sigma_min, sigma_min
+// the smallest singular value of the geometric Jacobian (rows in mm and rad per rad). Seed 38 of
+// AnyOffsetsRoundTrip draws a random wrist at sigma_min 5.8e-6: its two wrist solutions 0.13 deg
+// apart, the generator found 4.7e-6 deg off (c = 4.8e-13 rad), the pose reproduced to 2e-10 mm. So
+// the generator is asked for to 1e-6 deg times kDetermined / sigma_min where sigma_min is below
+// kDetermined (where c / sigma_min stays below 3e-8 deg), to 1e-6 deg elsewhere.
+constexpr double kDetermined = 1e-3;
+
+// Checks that every solution reproduces the pose and that the generating configuration is among them
+// (to 1e-6 deg, widened near a singularity as above; ++widened where it is).
+void check_round_trip(const Model& m, const IkSolver& ik, const Vec6& q, double& worst_p, double& worst_r,
+                      int& widened) {
+  Eigen::Isometry3d tool;
+  Jac jac;
+  fk_jacobian(m, VecQ(q * kDeg), tool, jac);
+  const double sigma_min = Eigen::JacobiSVD<Jac>(jac).singularValues().minCoeff();
+  widened += sigma_min < kDetermined;
+  const double tol_deg = 1e-6 * std::max(1.0, kDetermined / sigma_min);
   const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
   const IkSolutions s = ik.solve(t, IkOptions(q));
   ASSERT_EQ(s.status, IkStatus::Ok);
@@ -25,7 +45,7 @@ void check_round_trip(const Model& m, const IkSolver& ik, const Vec6& q, double&
     worst_r = std::max(worst_r, test::rot_dist(ti.linear(), t.linear()));
     double d = 0;
     for (int j = 0; j < 6; ++j) d = std::max(d, std::abs(std::remainder(s.sol[i].q_deg[j] - q[j], 360.0)));
-    found = found || d < 1e-6;
+    found = found || d < tol_deg;
   }
   EXPECT_TRUE(found) << "the generating configuration is not among the " << s.count << " solutions";
 }
@@ -68,7 +88,10 @@ TEST(Ik, Kr500AllSolutionsRoundTrip) {
   const IkSolver ik(m);
   std::mt19937_64 rng(test::test_seed(21));
   double wp = 0, wr = 0;
-  for (int i = 0, n = test::count(5000); i < n; ++i) check_round_trip(m, ik, test::random_q(m, rng), wp, wr);
+  int widened = 0;
+  const int n = test::count(5000);
+  for (int i = 0; i < n; ++i) check_round_trip(m, ik, test::random_q(m, rng), wp, wr, widened);
+  EXPECT_LT(widened, n / 50);
   EXPECT_LT(wp, 1e-9);  // mm
   EXPECT_LT(wr, 1e-9);  // rad
 }
@@ -77,7 +100,7 @@ TEST(Ik, AnyOffsetsRoundTrip) {
   KINCAL_SEED_TRACE(22);
   std::mt19937_64 rng(test::test_seed(22));
   double wp = 0, wr = 0;
-  int robots = 0, inexact23 = 0;
+  int robots = 0, inexact23 = 0, widened = 0;
   for (int r = 0; r < 200; ++r) {
     const bool orthogonal = r % 2 == 1;  // half with the flip-symmetric wrist, half with any wrist
     const Model m(random_robot(rng, orthogonal, r % 4 >= 2));
@@ -89,12 +112,14 @@ TEST(Ik, AnyOffsetsRoundTrip) {
     for (int i = 0; i < 50; ++i) {
       Vec6 q;
       for (int j = 0; j < 6; ++j) q[j] = std::uniform_real_distribution<double>(-180, 180)(rng);
-      check_round_trip(m, ik, q, wp, wr);
+      check_round_trip(m, ik, q, wp, wr, widened);
     }
   }
   EXPECT_EQ(robots, 200);
   EXPECT_GT(inexact23, 20);  // both paths of the elbow taken
-  std::printf("FK(IK(T)) - T on 200 random robots: %.2e mm, %.2e rad\n", wp, wr);
+  EXPECT_LT(widened, 200);   // of 10,000 configurations: 46-94 at seeds 1-45
+  std::printf("FK(IK(T)) - T on 200 random robots: %.2e mm, %.2e rad; the generator asked for to a widened "
+              "tolerance at %d of 10000 configurations (near a singularity)\n", wp, wr, widened);
   EXPECT_LT(wp, 1e-9);
   EXPECT_LT(wr, 1e-9);
 }

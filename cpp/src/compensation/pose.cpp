@@ -110,6 +110,13 @@ inline AbcTrig abc_trig(const Mat3& r) {
 
 inline VecQ to_rad(const Vec6& q) { return q * kDeg; }
 
+// the result's figures of F at its angles
+inline void set_residual(CompensationResult& res, const Vec6& f) {
+  res.residual = f.norm();
+  res.position_error_mm = f.head<3>().norm();
+  res.orientation_error_deg = f.tail<3>().norm();
+}
+
 }  // namespace
 
 Vec6 pose_deviation(const Model& cal, const Vec6& q_deg, const Pose6& desired, Residual residual,
@@ -314,9 +321,7 @@ CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0
       }
       res.q_deg = q;
       res.iterations = it;
-      res.residual = std::sqrt(f2);
-      res.position_error_mm = f.head<3>().norm();
-      res.orientation_error_deg = f.tail<3>().norm();
+      set_residual(res, f);
       res.status = status;
       return res;
     };
@@ -366,19 +371,6 @@ CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0
 // is far smaller but near a singularity). Where r does not contract tenfold per step (an effect as
 // steep as the joint itself) or the chain's iteration fails, Newton's iteration on the whole model.
 constexpr int kJointSteps = 8;
-
-// Whether F(q) = F(a*) + J(a*) r is within the stop, |F|^2 < epsilon, row by row (f: F where it is):
-// the first step's F fails on its first row (1e-4 mm against epsilon's 3e-8), where the whole product
-// cost a sixth of a command evaluation.
-bool converged_at(const Vec6& fa, const Mat6r& ja, const Vec6& r, double epsilon, Vec6& f) {
-  double f2 = 0;
-  for (int i = 0; i < 6; ++i) {
-    f[i] = fa[i] + ja.row(i).dot(r);
-    f2 += f[i] * f[i];
-    if (!(f2 < epsilon)) return false;
-  }
-  return true;
-}
 constexpr double kJointStepTrusted = 1e-5;  // deg: the largest |a(q) - a*| at which F(q) is taken as above
 
 CompensationResult compensate_split(const Model& cal, const Pose6& desired, const Vec6& q0_deg,
@@ -398,9 +390,7 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
     const VecQ a = to_rad(res.q_deg);
     res.q_deg -= (joint_angles(cal, a, ctx) - a) * (1 / kDeg);
     const Vec6 f = pose_deviation(cal, res.q_deg, desired, opt.residual, ctx);
-    res.residual = f.norm();
-    res.position_error_mm = f.head<3>().norm();
-    res.orientation_error_deg = f.tail<3>().norm();
+    set_residual(res, f);
     return res;
   }
   const Vec6 a_star = res.q_deg;
@@ -415,13 +405,17 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
   for (int k = 0; k < kJointSteps; ++k) {
     if (k > 0) {
       r = (actual(to_rad(q)) - a_rad) * (1 / kDeg);
+      // F(q) near a*, row by row: the first step's fails on its first row (1e-4 mm against 3e-8)
       Vec6 f;
-      if (r.cwiseAbs().maxCoeff() < kJointStepTrusted && converged_at(fa, ja, r, opt.epsilon, f)) {
+      double f2 = r.cwiseAbs().maxCoeff() < kJointStepTrusted ? 0.0 : opt.epsilon;
+      for (int i = 0; i < 6 && f2 < opt.epsilon; ++i) {
+        f[i] = fa[i] + ja.row(i).dot(r);
+        f2 += f[i] * f[i];
+      }
+      if (f2 < opt.epsilon) {
         res.q_deg = q;
         res.joint_iterations = k;
-        res.residual = f.norm();
-        res.position_error_mm = f.head<3>().norm();
-        res.orientation_error_deg = f.tail<3>().norm();
+        set_residual(res, f);
         return res;
       }
       if (!(r.squaredNorm() < 0.01 * r_last.squaredNorm())) break;
@@ -478,9 +472,7 @@ CompensationResult compensate(const Model& cal, const Pose6& desired, const Vec6
     Vec6 f = deviation_of(fk_model(cal, to_rad(q), ctx), desired, opt.residual);
     res.q_deg = q;
     res.iterations = it;
-    res.residual = f.norm();
-    res.position_error_mm = f.head<3>().norm();
-    res.orientation_error_deg = f.tail<3>().norm();
+    set_residual(res, f);
     if (f.squaredNorm() < opt.epsilon) {
       res.status = CompStatus::Converged;
       return res;

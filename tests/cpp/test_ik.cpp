@@ -19,7 +19,8 @@ namespace {
 // AnyOffsetsRoundTrip draws a random wrist at sigma_min 5.8e-6: its two wrist solutions 0.13 deg
 // apart, the generator found 4.7e-6 deg off (c = 4.8e-13 rad), the pose reproduced to 2e-10 mm. So
 // the generator is asked for to 1e-6 deg times kDetermined / sigma_min where sigma_min is below
-// kDetermined (where c / sigma_min stays below 3e-8 deg), to 1e-6 deg elsewhere.
+// kDetermined (where c / sigma_min stays below 3e-8 deg), to 1e-6 deg elsewhere, and never to more
+// than 0.01 deg.
 constexpr double kDetermined = 1e-3;
 
 // Checks that every solution reproduces the pose and that the generating configuration is among them
@@ -31,7 +32,8 @@ void check_round_trip(const Model& m, const IkSolver& ik, const Vec6& q, double&
   fk_jacobian(m, VecQ(q * kDeg), tool, jac);
   const double sigma_min = Eigen::JacobiSVD<Jac>(jac).singularValues().minCoeff();
   widened += sigma_min < kDetermined;
-  const double tol_deg = 1e-6 * std::max(1.0, kDetermined / sigma_min);
+  // (at most 0.01 deg, far below the gap between branches that rounding cannot tell apart)
+  const double tol_deg = std::min(1e-2, 1e-6 * std::max(1.0, kDetermined / sigma_min));
   const Eigen::Isometry3d t = fk(m, VecQ(q * kDeg));
   const IkSolutions s = ik.solve(t, IkOptions(q));
   ASSERT_EQ(s.status, IkStatus::Ok);
@@ -91,7 +93,7 @@ TEST(Ik, Kr500AllSolutionsRoundTrip) {
   int widened = 0;
   const int n = test::count(5000);
   for (int i = 0; i < n; ++i) check_round_trip(m, ik, test::random_q(m, rng), wp, wr, widened);
-  EXPECT_LT(widened, n / 50);
+  EXPECT_LE(50 * widened, n);
   EXPECT_LT(wp, 1e-9);  // mm
   EXPECT_LT(wr, 1e-9);  // rad
 }

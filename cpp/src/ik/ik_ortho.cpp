@@ -21,7 +21,6 @@ struct Shoulder {
 // An arm branch (q1, q3) of the ortho form, in the order of solve_vector's loops
 struct Arm {
   Angle a3, a2;
-  Vec3 v6;  // C G w5 turned back by -q1 and -(q2 + sigma q3)
   bool clamped;
   int i1;  // its shoulder branch
 };
@@ -59,7 +58,7 @@ int elbow_arms(const IkSolver::Constants& kc, const Branch& br, const Angle* q1s
     Angle t3[2];
     sub3_elbow_angles(kc, h.a, h.ca, h.sa, t3);
     const int b3 = br.pick(t3, h.n3, 2);
-    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, Vec3::Zero(), h.clamped, i1};
+    for (int i3 = br.begin(b3); i3 < br.end(b3, h.n3); ++i3) arm[na++] = Arm{t3[i3], Angle{}, h.clamped, i1};
   }
   return na;
 }
@@ -167,13 +166,13 @@ void IkSolver::fill_ortho(IkForm form, const Vec3& c) {
   o.w4 = o.ct * w_[3];
   o.w5 = o.ct * w_[4];
   o.n = o.ct * k_.n;
-  o.m = o.ct * k_.m;
 }
 
 // The ortho-parallel robots: the subproblems of solve_vector in the frame C of axes 1 and 2, where a
-// rotation about axis 1 (axis 2, 3) turns components 2 and 3 (1 and 3) only, and the wrist's in the
-// frame (w4, w5, w4 x w5), with v6 = w5: each rotation is a plane rotation of two numbers. The arm
-// branches (q1, q3) go through each stage together, so that their independent arctangents overlap.
+// rotation about axis 1 (axis 2, 3) turns components 2 and 3 (1 and 3) only: each rotation is a
+// plane rotation of two numbers; the wrist's three angles come from its images of w6 and w5 in the
+// frame (w4, w5, w4 x w5) directly. The arm branches (q1, q3) go through each stage together, so that
+// their independent arctangents overlap.
 // Same branches in the same order; a wrist centre on axis 1 (or out of reach) goes to solve_vector.
 IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const {
   const double* ref_deg = opt.reference_deg;
@@ -216,32 +215,36 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
       arm[k].a2 = from_xy(x2[k], y2[k]);
     }
   }
-  // q4, q5 (sub2 of the wrist) and q6 of the first wrist solution of each arm branch
+  // q4, q5 and q6 of the first wrist solution of each arm branch (the one solve_vector's subproblem 2
+  // gives first: sin q5 = -tau r), each from one arctangent of the wrist's images. The wrist is
+  // orthonormal (w4 . w5 = 0, w6 = tau w4, n = w4 x w5), so in the frame (w4, w5, n)
+  // e = R456 w6 = tau (c5, s5 s4, -s5 c4) (r = |(e2, e3)| = |s5|), and with f = R456 w5,
+  // w4 . f = tau s5 s6 and w4 . (e x f) = e2 f3 - e3 f2 = tau s5 c6. No angle waits for another's
+  // cosine and sine: q4 and q5 of an arm are one pair of arctangents, q6 of two arms another.
   Angle t4[4][2], t5[4][2], a6[4];
   int n45[4];
+  double x6[4] = {1, 1, 1, 1}, y6[4] = {0, 0, 0, 0};
   for (int k = 0; k < na; ++k) {
     Arm& a = arm[k];
     // rotation about axis 2 by -(q2 + sigma q3) on components 1, 3
     const double c = a.a2.c * a.a3.c - o.sigma * a.a2.s * a.a3.s, s = a.a2.s * a.a3.c + o.sigma * a.a2.c * a.a3.s;
     const Vec3 &w1 = sh[a.i1].w6, &v1 = sh[a.i1].v6;
     const Vec3 w6(w1[0] * c - w1[2] * s, w1[1], w1[0] * s + w1[2] * c);
-    a.v6 = Vec3(v1[0] * c - v1[2] * s, v1[1], v1[0] * s + v1[2] * c);
-    tg.clamped = a.clamped;
-    n45[k] = sub2_dots(kc, o.w4.dot(w6), o.w5.dot(w6), o.n.dot(w6), o.m.dot(w6), t4[k], t5[k], true, tg);
-    a.clamped = tg.clamped;
-  }
-  // q6 takes w5 to rot(w5, -q5) rot(w4, -q4) R456 w5; in the frame (w4, w5, n) a turn about w4
-  // moves components 2, 3 and one about w5 components 1, 3; sub1 about tau w4 from (0, 1, 0);
-  // the arctangents two arm branches at a time
-  double x6[4] = {1, 1, 1, 1}, y6[4] = {0, 0, 0, 0};
-  for (int k = 0; k < na; ++k) {
-    if (n45[k] == 0) continue;
-    const Vec3& v = arm[k].v6;
-    const double e1 = o.w4.dot(v), e2 = o.w5.dot(v), e3 = o.n.dot(v);
-    const Angle &a4 = t4[k][0], &a5 = t5[k][0];
-    const double f2 = e2 * a4.c + e3 * a4.s, f3 = -e2 * a4.s + e3 * a4.c;
-    x6[k] = f2;
-    y6[k] = o.tau * (e1 * a5.s + f3 * a5.c);
+    const Vec3 v6(v1[0] * c - v1[2] * s, v1[1], v1[0] * s + v1[2] * c);
+    const double e1 = o.w4.dot(w6), e2 = o.w5.dot(w6), e3 = o.n.dot(w6);
+    const double f1 = o.w4.dot(v6), f2 = o.w5.dot(v6), f3 = o.n.dot(v6);
+    const double r = std::sqrt(e2 * e2 + e3 * e3), s5 = -o.tau * r, c5 = o.tau * e1;
+    x6[k] = e3 * f2 - e2 * f3;
+    y6[k] = -f1;
+    n45[k] = !std::isfinite(r + c5 + x6[k] + y6[k]) ? 0 : (r > 0 ? 2 : 1);
+    if (n45[k] == 0) {
+      x6[k] = 1;
+      y6[k] = 0;
+      continue;
+    }
+    fastmath::atan2x2(-e2, e3, s5, c5, t4[k][0].q, t5[k][0].q);
+    t5[k][0].c = c5;
+    t5[k][0].s = s5;
   }
   for (int k = 0; k < na; k += 2) {
     if (k + 1 < na) {

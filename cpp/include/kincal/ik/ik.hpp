@@ -129,7 +129,7 @@ class IkSolver {
     double pw3_1 = 0, pw3_3 = 0, p32_1 = 0, p32_3 = 0;  ///< C (pw - p3) and C (p3 - p2), components 1 and 3
     double sigma = 1;         ///< w3 = sigma w2
     double tau = 1;           ///< w6 = tau w4
-    Vec3 w4 = Vec3::Zero(), w5 = Vec3::Zero(), n = Vec3::Zero(), m = Vec3::Zero();  ///< C w4, C w5, C n, C m
+    Vec3 w4 = Vec3::Zero(), w5 = Vec3::Zero(), n = Vec3::Zero();  ///< C w4, C w5, C n
   };
   IkSolutions solve_vector(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const;
   IkSolutions solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions& opt, bool deliver_now) const;

@@ -23,7 +23,6 @@ const char* to_string(CompStatus s) {
 
 namespace {
 
-
 inline double wrap180(double a) {  // to [-180, 180] without std::remainder (slow)
   if (a > 180.0 || a < -180.0) a -= 360.0 * std::floor((a + 180.0) / 360.0);
   return a;
@@ -288,8 +287,9 @@ struct FactoredJacobian {
 // the Jacobian changes little over the steps near a solution, so each reused step costs an
 // evaluation of F only. The stopping rule is the same |F|^2 < epsilon on the exact F.
 // with_effects false: on the chain alone (the split below). When converged, f_out (if given) gets F
-// at the solution, j_out its Jacobian with the exact rates and trig_out the solution's sines and
-// cosines (from its FK).
+// at the solution, j_out its Jacobian and trig_out the solution's sines and cosines (from its FK);
+// j_out's rotation-vector rows as Newton's steps take them (E = I: E differs from I by |phi| / 2,
+// below 1e-9 where |F| has met the stop; the ABC rows exact).
 CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0_deg, const CompensationOptions& opt,
                           const EffectContext& ctx, bool with_effects, Vec6* f_out = nullptr,
                           Mat6r* j_out = nullptr, JointTrig* trig_out = nullptr) {
@@ -312,7 +312,7 @@ CompensationResult newton(const Model& cal, const Pose6& desired, const Vec6& q0
       if (status == CompStatus::Converged && f_out) {
         *f_out = f;
         Mat3 e;
-        ev.jacobian(*j_out, e, true);
+        ev.jacobian(*j_out, e, false);
         if (trig_out) {
           trig_out->q = to_rad(q);
           trig_out->s = ev.frames.s;

@@ -310,7 +310,12 @@ TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
 // and identify refused them before any scale was looked at). Over KINCAL_TEST_SEED 1-60 the centres
 // agree to 0.0021 mm in the median and beyond 0.01 mm on two draws (33: 0.0147 mm, 60: 0.0122). The
 // gap does not follow the scale between the two fits (the largest, 1.0011 at seed 43, agrees to
-// 0.0024 mm); its cause is not known.
+// 0.0024 mm); its cause is not known. Looked at in the twenty-eighth session: on seed 33 the two fits
+// hold different barely identifiable parameters (joint6.tilt_u with the length, not without it);
+// with none held (weak_tolerance 0) the gaps are 0.0045 (33) and 0.0146 mm (60), and with one known
+// length instead of the five distances from the first station 0.0154 and 0.0039 mm. A held parameter
+// (joint5.move_u for the scale among them) stays at its start where a change of scale would move it,
+// so the two fits need not be one similarity apart; that this is the whole cause is not shown.
 TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
   KINCAL_SEED_TRACE(51, 52, 53);
   const Model truth(truth_spec(51, 0.003)), nominal(kr500_spec());

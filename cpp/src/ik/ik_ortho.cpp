@@ -234,14 +234,11 @@ IkSolutions IkSolver::solve_ortho(const Mat3& gr, const Vec3& p, const IkOptions
     const double e1 = o.w4.dot(w6), e2 = o.w5.dot(w6), e3 = o.n.dot(w6);
     const double f1 = o.w4.dot(v6), f2 = o.w5.dot(v6), f3 = o.n.dot(v6);
     const double r = std::sqrt(e2 * e2 + e3 * e3), s5 = -o.tau * r, c5 = o.tau * e1;
-    x6[k] = e3 * f2 - e2 * f3;
-    y6[k] = -f1;
-    n45[k] = !std::isfinite(r + c5 + x6[k] + y6[k]) ? 0 : (r > 0 ? 2 : 1);
-    if (n45[k] == 0) {
-      x6[k] = 1;
-      y6[k] = 0;
-      continue;
-    }
+    const double x = e3 * f2 - e2 * f3, y = -f1;
+    n45[k] = !std::isfinite(r + c5 + x + y) ? 0 : (r > 0 ? 2 : 1);
+    if (n45[k] == 0) continue;  // (x6, y6 stay (1, 0) for the pair below)
+    x6[k] = x;
+    y6[k] = y;
     fastmath::atan2x2(-e2, e3, s5, c5, t4[k][0].q, t5[k][0].q);
     t5[k][0].c = c5;
     t5[k][0].s = s5;

@@ -203,7 +203,8 @@ static ModelSpec with_more_effects(ModelSpec spec) {
 // larger. 300 references each, q at steps of 1e-6..3e-2 rad from them in random directions: the
 // series' remainder bound (sum k^6 |p| / 720 |d|^6) is below its 1e-18 rad for the small steps and
 // above it for order 12 from 1e-3 rad on (4.1 |d|^6), the turned sines and cosines hold to 0.01 rad:
-// both ways are taken. Every angle agrees to rounding (measured: printed), held to 1e-14 rad.
+// both ways are taken. Every angle agrees to rounding (measured: printed), held to 1e-14 rad, by the
+// operator() and by at6 (compensation's fixed-size form).
 TEST(Kinematics, JointAnglesNearAReferenceEqualJointAngles) {
   KINCAL_SEED_TRACE(13);
   const ModelSpec effects = test::every_effect_spec(test::test_seed(13));
@@ -223,7 +224,9 @@ TEST(Kinematics, JointAnglesNearAReferenceEqualJointAngles) {
         VecQ dir(6);
         for (int j = 0; j < 6; ++j) dir[j] = normal(rng);
         const VecQ q = ref + step * dir / dir.cwiseAbs().maxCoeff();
-        worst = std::max(worst, (near(q) - joint_angles(m, q, ctx)).cwiseAbs().maxCoeff());
+        const VecQ exact = joint_angles(m, q, ctx);
+        worst = std::max(worst, (near(q) - exact).cwiseAbs().maxCoeff());
+        worst = std::max(worst, (VecQ(near.at6(q)) - exact).cwiseAbs().maxCoeff());  // the fixed-size form
       }
     }
     std::printf("joint angles near a reference: worst %.1e rad\n", worst);

@@ -394,17 +394,17 @@ CompensationResult compensate_split(const Model& cal, const Pose6& desired, cons
     return res;
   }
   const Vec6 a_star = res.q_deg;
-  const VecQ& a_rad = trig.q;  // a* (rad), with the sines and cosines of the chain's last FK
+  const Vec6 a_rad = trig.q;  // a* (rad), with the sines and cosines of the chain's last FK
   const JointAnglesNear actual(cal, trig, ctx);
   // r(a*) and D_band there; the steps (I + D_band)^-1 r by the series I - D_band + D_band^2 (its
   // remainder D_band^3 r is 1e-9 of r at |D| ~ 1e-3; a D too large for it shows as a step that does
   // not contract tenfold, and the whole model's Newton takes over)
   JointBand band;
-  Vec6 r = (actual.at_reference(band) - a_rad) * (1 / kDeg), r_last;
+  Vec6 r = (actual.at_reference(band) - a_rad) * (1 / kDeg), r_last = r;
   Vec6 q = a_star;
   for (int k = 0; k < kJointSteps; ++k) {
     if (k > 0) {
-      r = (actual(to_rad(q)) - a_rad) * (1 / kDeg);
+      r = (actual.at6(q * kDeg) - a_rad) * (1 / kDeg);
       // F(q) near a*, row by row: the first step's fails on its first row (1e-4 mm against 3e-8)
       Vec6 f;
       double f2 = r.cwiseAbs().maxCoeff() < kJointStepTrusted ? 0.0 : opt.epsilon;

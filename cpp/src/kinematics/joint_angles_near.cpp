@@ -3,7 +3,9 @@
 #include "chain_recursions.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace kincal {
 
@@ -128,26 +130,26 @@ VecQ JointAnglesNear::at_reference(JointBand& band) const {
   return theta;
 }
 
-VecQ JointAnglesNear::operator()(const VecQ& q) const {
-  const int n = m_.dof();
-  VecQ theta(n);  // (not a copy of q: that one called memcpy, 3% of compensation with effects)
+// joint_angles at q from the reference (operator(), at6)
+template <int N>
+void JointAnglesNear::evaluate(const double* q, double* theta) const {
+  const int n = N > 0 ? N : m_.dof();
   if (m_.has_compliance()) {
     // the reference's sines and cosines turned to q (all of q's anew where a joint is farther)
-    std::array<double, kMaxJoints + 1> s = ref_.s, c = ref_.c;
+    double s[kMaxJoints + 1], c[kMaxJoints + 1];
+    if constexpr (N == 0) std::fill(s, s + kMaxJoints + 1, 0.0), std::fill(c, c + kMaxJoints + 1, 1.0);
     bool near = true;
     for (int j = 0; j < n; ++j) {
       const double d = q[j] - ref_.q[j];
       near = near && std::abs(d) <= kTurnMax;
+      s[j] = ref_.s[j];
+      c[j] = ref_.c[j];
       turn_sincos(d, s[j], c[j]);
     }
-    if (!near) joint_sincos<0>(m_, q.data(), s.data(), c.data());
-    auto deflect = [&](int j, double t, double, double) { theta[j] = q[j] + m_.compliance(j) * t; };
-    if (n == 6)
-      gravity_torque_sc<6>(m_, s.data(), c.data(), deflect);
-    else
-      gravity_torque_sc<0>(m_, s.data(), c.data(), deflect);
+    if (!near) joint_sincos<N>(m_, q, s, c);
+    gravity_torque_sc<N>(m_, s, c, [&](int j, double t, double, double) { theta[j] = q[j] + m_.compliance(j) * t; });
   } else {
-    theta = q;
+    for (int j = 0; j < n; ++j) theta[j] = q[j];
   }
   if (m_.has_joint_effects()) {
     // the harmonic effects by their series where its remainder is below kSeriesLeft, at q itself
@@ -165,11 +167,30 @@ VecQ JointAnglesNear::operator()(const VecQ& q) const {
         any_exact = true;
       }
     }
-    if (any_exact)
+    if (any_exact) {
+      const VecQ qv = Eigen::Map<const VecQ>(q, n);
+      VecQ out = Eigen::Map<const VecQ>(theta, n);
       for (const EffectValue& ev : m_.joint_effects())
         if (exact[ev.effect.joint] || !(ev.effect.kind().harmonic || ev.effect.kind().angle_free))
-          add_joint_effect(ev, q, ctx_, theta, nullptr);
+          add_joint_effect(ev, qv, ctx_, out, nullptr);
+      for (int j = 0; j < n; ++j) theta[j] = out[j];
+    }
   }
+}
+
+VecQ JointAnglesNear::operator()(const VecQ& q) const {
+  VecQ theta(m_.dof());  // (not a copy of q: that one called memcpy, 3% of compensation with effects)
+  if (m_.dof() == 6)
+    evaluate<6>(q.data(), theta.data());
+  else
+    evaluate<0>(q.data(), theta.data());
+  return theta;
+}
+
+Vec6 JointAnglesNear::at6(const Vec6& q) const {
+  if (m_.dof() != 6) throw std::invalid_argument("JointAnglesNear::at6: 6 joints only");
+  Vec6 theta;
+  evaluate<6>(q.data(), theta.data());
   return theta;
 }
 

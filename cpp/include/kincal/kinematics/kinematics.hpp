@@ -105,6 +105,9 @@ class JointAnglesNear {
   /// the reference's sines and cosines given (as ChainFrames keeps them)
   JointAnglesNear(const Model& m, const JointTrig& ref, const EffectContext& ctx);
   VecQ operator()(const VecQ& q) const;
+  /// the same for a 6-joint robot in fixed sizes (compensation's fixed point); std::invalid_argument
+  /// for other robots
+  Vec6 at6(const Vec6& q) const;
   /// at the reference itself, with the band of the derivative there (the compliance's and the
   /// harmonic and angle-free effects'; other effects' left out)
   VecQ at_reference(JointBand& band) const;
@@ -119,6 +122,8 @@ class JointAnglesNear {
   std::array<bool, kMaxJoints> series_;  ///< the joint has such effects
   bool other_effects_ = false;  ///< joint effects of other kinds: at q itself
   void prepare_effects();
+  template <int N>
+  void evaluate(const double* q, double* theta) const;
 };
 
 /// The factor every length of the robot scales by (thermal expansion; 1 without it).

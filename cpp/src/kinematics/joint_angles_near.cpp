@@ -3,7 +3,6 @@
 #include "chain_recursions.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -137,7 +136,6 @@ void JointAnglesNear::evaluate(const double* q, double* theta) const {
   if (m_.has_compliance()) {
     // the reference's sines and cosines turned to q (all of q's anew where a joint is farther)
     double s[kMaxJoints + 1], c[kMaxJoints + 1];
-    if constexpr (N == 0) std::fill(s, s + kMaxJoints + 1, 0.0), std::fill(c, c + kMaxJoints + 1, 1.0);
     bool near = true;
     for (int j = 0; j < n; ++j) {
       const double d = q[j] - ref_.q[j];

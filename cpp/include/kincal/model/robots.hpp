@@ -21,7 +21,9 @@ ModelSpec builtin_spec(const std::string& name);
 /// Realistic manufacturing errors for simulations and tests: every axis tilted by about sigma_deg
 /// and moved by about sigma_mm normal to itself, the tool moved and turned by the same amounts;
 /// with_compliance sets a joint compliance on every gravity-loaded joint (deg per kN m, about
-/// `compliance` each). Deterministic for a seed.
+/// `compliance` each). Deterministic for a seed. The compliances are drawn between the joints'
+/// geometric draws, so one seed with and without a compliance gives two different geometries: for the
+/// same robot without compliance, set the compliant spec's compliances to zero.
 ModelSpec perturbed_spec(const ModelSpec& spec, unsigned seed, double sigma_mm = 1.0, double sigma_deg = 0.05,
                          double compliance = 0.0);
 

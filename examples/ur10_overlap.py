@@ -58,7 +58,7 @@ def main() -> None:
     robot = kincal.load_robot("ur10")
     a = series["A"]
     fit = ident.identify(robot, a, effects="joint_compliance", k_folds=0)
-    _, _, _, _, cal = _refit_placements(fit.robot, a, "huber", 0.1)
+    _, _, _, _, cal = _refit_placements(fit.robot, a)
     r = a.xyz - predicted(cal.robot, cal.targets, a)
     folds = grouping.folds(a, 5, 0)
     print(f"series A by itself, geometry + compliance: fitted 3-D RMS {np.sqrt(np.mean(np.sum(r ** 2, 1))):.3f} mm")

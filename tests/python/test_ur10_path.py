@@ -14,8 +14,11 @@ three met (D by 0.001 mm; BENCHMARKS.md shows how the choice moves with the numb
 Since the nineteenth session a target's depth along an axis every tool orientation of a campaign
 shares is held (the core's hold_unseen_frames), at the model's own offset in validate: series D holds
 the probe in two orientations about one axis, and its refit had fitted that depth on D's own rows
-through a lever of 2e-4 (in-sample: the figure it reports). D is now 0.3802 mm, issue 29's 0.38 NOT met
-(by 0.0002 mm); A and C unchanged (0.4517, 0.4961). The
+through a lever of 2e-4 (in-sample: the figure it reports). D was then 0.3802 mm, issue 29's 0.38 not
+met by 0.0002 mm; A and C unchanged (0.4517, 0.4961). Since the thirty-first session validate's refit
+bends its robust loss where every other fit does, at the residuals' robust spread (its own fixed
+0.1 mm was the one default issue 29's single fitting engine had left apart; 0.83-1.09 mm here):
+A 0.4512, C 0.4955, D 0.3791 mm, all three met again (D by 0.0009 mm). The
 diagnosis names joint compliance (every loaded joint, the model's masses) and a smooth joint_map of
 joint 1, a periodic effect credited with what it gains on held-out ranges of its angle. This test
 holds that ground: each series within issue 29's target and within 2% of those figures, far below the
@@ -37,8 +40,8 @@ from conftest import SHARED, run
 BASE = SHARED / "data" / "ipa-robot-accuracy"
 FILES = {"A": "Series_A/measurements_grid.csv", "B": "Series_B/measurements_joint_configurations.csv",
          "C": "Series_C/measurements_random_poses.csv", "D": "Series_D/measurements_iso_cubes.csv"}
-#: the 3-D RMS (mm) this path measured on 2026-11-27, and issue 29's targets
-MEASURED = {"A": 0.4517, "C": 0.4961, "D": 0.3802}
+#: the 3-D RMS (mm) this path measured on 2026-11-29, and issue 29's targets
+MEASURED = {"A": 0.4512, "C": 0.4955, "D": 0.3791}
 TARGET = {"A": 0.46, "C": 0.56, "D": 0.38}
 
 
@@ -59,8 +62,8 @@ def test_ur10_diagnose_on_b_validate_on_the_others(tmp_path):
         v = json.loads((tmp_path / f"v{k}.json").read_text())
         print(f"series {k}: RMS {v['before_rms_mm']:.3f} -> {v['rms_mm']:.3f} mm")
         assert v["rms_mm"] <= 1.02 * rms, (k, v["rms_mm"])
-        if k != "D":  # D: 0.3802 against the issue's 0.38, not met (the docstring)
-            assert v["rms_mm"] <= TARGET[k], (k, v["rms_mm"])
+        assert v["rms_mm"] <= TARGET[k], (k, v["rms_mm"])
+        assert v["loss"]["scale_from"] == "the residuals' robust spread" and v["loss"]["scale_mm"] > 0.1
         assert "the target offsets started from the model's" in v["refitted"]
         assert v["rms_mm"] < 0.7 * v["before_rms_mm"]
         if k == "C":

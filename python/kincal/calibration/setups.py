@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import _core
 from .._core import Robot
-from .fitting import orientation_errors_deg, rms
+from .fitting import DEFAULT_LOSS_SCALE_MM, orientation_errors_deg, rms
 from .simulation import simulate
 
 if TYPE_CHECKING:
@@ -90,6 +90,9 @@ def validation_summary(v: dict[str, Any]) -> str:
             row(f"  setup {name}", f, "deg")
     lines.append("")
     lines.append(f"refitted: {v['refitted']}")
+    loss = v.get("loss")
+    if loss and loss["scale_mm"]:
+        lines.append(f"robust loss: {loss['name']} bending at {loss['scale_mm']:.4f} mm (from {loss['scale_from']})")
     lines += [f"warning: {e['message']}" for e in v.get("extrapolated", [])]
     return "\n".join(lines)
 
@@ -150,18 +153,20 @@ def validation_figures(after: FloatArray, before: FloatArray, o_after: Optional[
     return v
 
 
-def _refit_placements(robot: Robot, data: MeasurementSet, loss: Loss = "huber", loss_scale_mm: float = 0.1,
+def _refit_placements(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
+                      loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM,
                       target_start: Optional[Sequence[Sequence[float]]] = None) -> tuple[
         FloatArray, FloatArray, Optional[FloatArray], Optional[FloatArray], _core.IdentifyResult]:
     """validate()'s errors: every row's position error after refitting only the placements and
     targets, on the calibrated model (after) and the nominal one (before); orientation errors (or
-    None); and the calibrated refit."""
+    None); and the calibrated refit. The robust loss bends as in every fit (FitOptions): at
+    ``loss_scale_mm``, or (None, 0) where the residuals' robust spread puts it."""
 
     def frames_only(calibrated: bool) -> _core.IdentifyResult:
         # the calibrated geometry may load a joint the nominal one does not: each its own names
         layout = _core.PointModel(robot, int(np.max(data.target)) + 1, [], 20.0, calibrated, []).layout
         held = [p.name for p in layout.parameters if p.kind not in ("base", "target")]
-        opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm, fix=held,
+        opts = _core.IdentifyOptions(compliance=False, loss=loss, loss_scale_mm=loss_scale_mm or 0.0, fix=held,
                                      covariance=False)
         if target_start is not None:
             opts.target_start = [np.asarray(t, dtype=float) for t in target_start]
@@ -186,7 +191,7 @@ def extrapolated(robot: Robot, q_deg: FloatArray) -> list[dict[str, Any]]:
 
 
 def inside_and_outside(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
-                       loss_scale_mm: float = 0.1) -> dict[str, dict[str, Any]]:
+                       loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM) -> dict[str, dict[str, Any]]:
     """validate()'s RMS (after, before) split between the rows that take none of the robot's periodic
     effects outside their fitted ranges and the rows that take one: ``{"inside": {"rows",
     "rms_mm", "before_rms_mm"}, "outside": {...}}`` (the placements refitted on every row)."""
@@ -202,7 +207,8 @@ def inside_and_outside(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
     return {"inside": part(~out), "outside": part(out)}
 
 
-def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber", loss_scale_mm: float = 0.1,
+def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
+             loss_scale_mm: Optional[float] = DEFAULT_LOSS_SCALE_MM,
              target_start: Optional[Sequence[Sequence[float]]] = None) -> dict[str, Any]:
     """Accuracy of an identified robot on another measurement campaign, where the instrument stands
     elsewhere (each setup of the data its own placement) and the reflectors or probe may sit
@@ -214,7 +220,9 @@ def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber", loss_scal
     the refitted ``placements``; ``rows``, ``after_rms_mm``, ``after_max_mm`` repeat them under the
     names of earlier versions. ``extrapolated``: the joints whose periodic effects these rows ask for
     outside the angles the model was fitted on (``robot.fitted_ranges_deg``), each ``{"joint",
-    "effects", "fitted_deg", "rows_outside", "share_outside", "message"}``."""
+    "effects", "fitted_deg", "rows_outside", "share_outside", "message"}``. ``loss``: the robust loss of
+    the refit (``name``, ``scale_mm``: where it bent, ``scale_from``): as in identify and diagnose, where
+    the residuals' robust spread puts it unless ``loss_scale_mm`` is given."""
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
     ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm, target_start)
@@ -224,5 +232,7 @@ def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber", loss_scal
                       + (", the probe stations" if data.station_names else "")
                       + "; the model's geometry and effects held (its drift left out)",
              placements=setup_frames(cal.setups),
-             extrapolated=extrapolated(robot, data.q_deg))
+             extrapolated=extrapolated(robot, data.q_deg),
+             loss={"name": loss, "scale_mm": cal.loss_scale_mm or None,
+                   "scale_from": "--loss-scale" if loss_scale_mm else "the residuals' robust spread"})
     return v

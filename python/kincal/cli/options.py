@@ -67,7 +67,8 @@ def effect_opts(sp: argparse.ArgumentParser, default: str, what: str) -> None:
     harmonics_option(sp, "transmission_error")
 
 
-def loss_opts(sp: argparse.ArgumentParser, scale: Optional[float] = 0.1) -> None:
+def loss_opts(sp: argparse.ArgumentParser, scale: Optional[float] = DEFAULT_LOSS_SCALE_MM) -> None:
+    """--loss, --loss-scale: one default for every fit (identify, diagnose, validate's refit)."""
     sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
     sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
                     + (f"{scale})" if scale else "from the residuals' robust spread)"))
@@ -91,7 +92,7 @@ def probe_start(args: argparse.Namespace) -> Optional[list[list[float]]]:
 def fit_opts(sp: argparse.ArgumentParser, noise: bool = True) -> None:
     """The fitting options of identify and diagnose: one group, one default each (kincal.calibration.fitting).
     ``noise``: the fits' noise is --noise (else --fit-noise: diagnose's --noise is where its steps stop)."""
-    loss_opts(sp, DEFAULT_LOSS_SCALE_MM)
+    loss_opts(sp)
     sp.add_argument("--prior-model", metavar="JSON", help="centre the priors on this model's calibrated "
                     "geometry (e.g. last year's calibration; default: the starting model)")
     sp.add_argument("--prior-sd", metavar="KIND=SD,..", help="prior standard deviations over the defaults "

@@ -94,17 +94,23 @@ def test_prior_model_keeps_what_the_task_cannot_see(kr500, task, tmp_path):
     assert "prior model" in json.loads(last_year.model_json())["identification"]["priors"]["centred_on"]
 
 
-def test_priors_never_worse_on_a_wide_campaign(kr500):
-    """150 random configurations, one target, 0.02 mm noise, 5 seeds: the held-out error (300 other
-    noise-free configurations) with the default priors is never worse than without them by more
-    than 1% (measured: the fits differ by less than 0.1%)."""
-    for s in range(1, 6):
+def test_priors_neither_help_nor_harm_on_a_wide_campaign(kr500):
+    """150 random configurations, one target, 0.02 mm noise, the truths of seeds 1-20: the held-out error
+    (300 other noise-free configurations) of the fit with the default priors against the same fit without
+    them. On a campaign that determines every parameter the priors should neither help nor harm: the
+    ratio's median within 1% of 1 and no truth worse by more than 6%. Measured (2026-11-29): median
+    1.002, from 0.949 (seed 20) to 1.051 (seed 19); seeds 1-10: 1.0001, 1.005, 0.9999, 1.0018, 0.9996,
+    1.044, 0.969, 1.012, 1.003, 1.027. (Until the thirty-first session this test
+    took seeds 1-5 and claimed "never worse by more than 1%, the fits differ by less than 0.1%": true of
+    those five, not of seeds 6, 10, 11, 18 and 19, found when a redraw of the truths broke it.)"""
+    ratios = []
+    for s in range(1, 21):
         truth = ident.default_truth(kr500, seed=s)
         train = ident.simulate(truth, 150, seed=10 + s, noise_mm=0.02)
         test = ident.simulate(truth, 300, seed=100 + s, noise_mm=0.0)
         without = _rms(ident.identify(kr500, train, k_folds=0, prior_sd={}), test)
-        with_priors = _rms(ident.identify(kr500, train, k_folds=0), test)
-        assert with_priors <= 1.01 * without, (s, with_priors, without)
+        ratios.append(_rms(ident.identify(kr500, train, k_folds=0), test) / without)
+    assert abs(np.median(ratios) - 1) < 0.01 and max(ratios) < 1.06, np.round(ratios, 4)
 
 
 def _gross(data: kincal.MeasurementSet, share: float, rng) -> kincal.MeasurementSet:

@@ -130,7 +130,11 @@ ModelSpec perturbed_spec(const ModelSpec& spec, unsigned seed, double sigma_mm, 
     const Vec3 tilt = (nd(rng) * u + nd(rng) * v) * sigma_deg * kDeg;
     js.axis = Eigen::AngleAxisd(tilt.norm(), tilt.norm() > 0 ? tilt.normalized() : u) * w;
     js.point += (nd(rng) * u + nd(rng) * v) * sigma_mm;
-    if (compliance > 0 && m.gravity_loaded(j)) js.compliance_deg_per_knm = compliance * ud(rng);
+    // drawn with compliance 0 too (and dropped): one seed with and without compliance is one geometry
+    if (m.gravity_loaded(j)) {
+      const double draw = ud(rng);
+      if (compliance > 0) js.compliance_deg_per_knm = compliance * draw;
+    }
   }
   for (int k = 0; k < 3; ++k) s.tool.xyz[k] += nd(rng) * sigma_mm;
   for (int k = 0; k < 3; ++k) s.tool.abc[k] += nd(rng) * sigma_deg;

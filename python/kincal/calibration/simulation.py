@@ -28,8 +28,8 @@ HiddenEffect = Union[tuple[_core.Effect, Sequence[float]], tuple[str, int, Seque
 def default_truth(robot: Robot, seed: int = 1, sigma_mm: float = 1.0, sigma_deg: float = 0.05,
                   compliance: float = 0.003) -> Robot:
     """A simulated true robot: realistic geometric errors and joint compliance, seen by an
-    instrument at DEFAULT_INSTRUMENT. The compliances are drawn between the geometric errors, so the
-    same seed with ``compliance=0`` is another robot, not this one without its compliance."""
+    instrument at DEFAULT_INSTRUMENT. The same seed with ``compliance=0`` is this robot without its
+    compliance (the compliances are drawn, and dropped, in either case)."""
     return robot.with_calibrated(seed, sigma_mm, sigma_deg, compliance, DEFAULT_INSTRUMENT)
 
 

@@ -22,8 +22,9 @@ ModelSpec builtin_spec(const std::string& name);
 /// and moved by about sigma_mm normal to itself, the tool moved and turned by the same amounts;
 /// with_compliance sets a joint compliance on every gravity-loaded joint (deg per kN m, about
 /// `compliance` each). Deterministic for a seed. The compliances are drawn between the joints'
-/// geometric draws, so one seed with and without a compliance gives two different geometries: for the
-/// same robot without compliance, set the compliant spec's compliances to zero.
+/// geometric draws, with compliance 0 as well (then dropped), so one seed with and without a compliance
+/// gives one geometry (before the thirty-first session a spec without compliance skipped those draws,
+/// and was another robot).
 ModelSpec perturbed_spec(const ModelSpec& spec, unsigned seed, double sigma_mm = 1.0, double sigma_deg = 0.05,
                          double compliance = 0.0);
 

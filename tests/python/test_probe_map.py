@@ -2,9 +2,9 @@
 (MAP) fit of the same data with the same prior widths, written here with scipy, on each probe kind (the
 median over nine truths).
 
-Truth: ident.default_truth(kr500, seed=1..9; the other tests here seed 3): the kr500 with 1 mm / 0.05 deg geometric errors (its tool frame
-too) and joint compliance of about 0.003 deg/kNm on joints 2-6, seen from the simulator's instrument
-placement. Campaigns: kincal.calibration.simulation.simulate_probe, seed 5, the probe's axis within a
+Truth: ident.default_truth(kr500, seed=1..9; the other tests here seed 3): the kr500 with 1 mm / 0.05 deg
+geometric errors (its tool frame too) and joint compliance of about 0.003 deg/kNm on joints 2-6, seen
+from the simulator's instrument placement. Campaigns: kincal.calibration.simulation.simulate_probe, seed 5, the probe's axis within a
 60 deg cone, the ball centre 150 mm along the tool's z, every row's configuration random (no plan):
   1. spheres with a length bar: 6 spheres x 25 touches, noise 0.005 mm on each coordinate of the ball
      centre, the artifact's 5 distances from the first sphere;
@@ -84,8 +84,7 @@ class PlainMap:
     """The MAP fit of probe data on the layout L of kincal's fit of them (its stations and their
     reference normals: structure, not fitted values), every parameter free but the gauge."""
 
-    def __init__(self, robot: kincal.Robot, data: dict, L: _core.ParamLayout, sigma: float,
-                 hold: np.ndarray | None = None) -> None:
+    def __init__(self, robot: kincal.Robot, data: dict, L: _core.ParamLayout, sigma: float) -> None:
         self.data, self.L, self.sigma = data, L, sigma
         self.pm = _core.PointModel(robot, L.n_targets, list(L.effect_list), fit_gravity=L.gravity == "fit",
                                    stations_of=L)
@@ -107,8 +106,6 @@ class PlainMap:
         free[L.base:L.targets] = False  # gauge: the stations absorb the base frame
         col = np.linalg.norm(self.pm.residuals(self.x0, data, True)[1], axis=0)
         free &= ~((col < 1e-9 * col.max()) & ~np.isfinite(self.sd))  # moves no point, no prior
-        if hold is not None:
-            free &= ~hold
         self.free, self.idx = free, np.flatnonzero(free)
         self.prior = free & np.isfinite(self.sd)
         self.result = None

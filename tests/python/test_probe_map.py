@@ -4,8 +4,9 @@ median over nine truths).
 
 Truth: ident.default_truth(kr500, seed=1..9; the other tests here seed 3): the kr500 with 1 mm / 0.05 deg
 geometric errors (its tool frame too) and joint compliance of about 0.003 deg/kNm on joints 2-6, seen
-from the simulator's instrument placement. Campaigns: kincal.calibration.simulation.simulate_probe, seed 5, the probe's axis within a
-60 deg cone, the ball centre 150 mm along the tool's z, every row's configuration random (no plan):
+from the simulator's instrument placement. Campaigns: kincal.calibration.simulation.simulate_probe,
+seed 5, the probe's axis within a 60 deg cone, the ball centre 150 mm along the tool's z, every row's
+configuration random (no plan):
   1. spheres with a length bar: 6 spheres x 25 touches, noise 0.005 mm on each coordinate of the ball
      centre, the artifact's 5 distances from the first sphere;
   2. block faces: 4 faces (top, x-, y+, y-) of the default 400 mm block x 40 touches with a 3 mm ball,

@@ -246,13 +246,14 @@ def test_kincal_is_at_least_as_accurate_as_a_plain_map_fit(tmp_path, name):
     seen along their normals: the ball's offset along the probe against the top's and front's offsets),
     the figure follows the priors' weight, which kincal sets by its estimate of the noise (0.95-1.39 x
     the simulated one here) and the MAP by the simulated noise itself; told it (`--noise`), kincal is the
-    MAP (test_told_the_noise_kincal_is_the_plain_map_fit). Until the thirty-first session this test took
-    truth 3 alone, and the faces were an expected failure there (1.0262)."""
+    MAP (test_told_the_noise_kincal_is_the_plain_map_fit). No truth may be worse by 5% (the worst measured,
+    2.6%, with room: a guard against one draw going badly wrong, not a claim). Until the thirty-first
+    session this test took truth 3 alone, and the faces were an expected failure there (1.0262)."""
     case = CASES[name]
     kr500 = kincal.load_robot("kr500")
     print(f"\n{name}:")
     ratios = [k / m for k, m in (_one_draw(tmp_path, kr500, case, seed) for seed in TRUTHS)]
-    assert np.median(ratios) <= 1.0, np.round(ratios, 4)
+    assert np.median(ratios) <= 1.0 and max(ratios) < 1.05, np.round(ratios, 4)
 
 
 def simulation_of(truth: kincal.Robot, case: dict) -> dict:

@@ -140,8 +140,12 @@ def test_validate_command_on_a_moved_instrument(tmp_path, kr500, truth):
     assert v["mean_mm"] <= v["rms_mm"] <= v["max_mm"]
     # the placement it found is B's (seen by a robot whose base differs from the truth's by the gauge)
     assert np.linalg.norm(np.asarray(v["placements"][0]["base_in_instrument"]["xyz_mm"]) - B[:3]) < 10
+    # the refit's robust loss bends where identify's does (the residuals' robust spread), and says so
+    assert v["loss"]["name"] == "huber" and v["loss"]["scale_from"] == "the residuals' robust spread"
+    assert v["loss"]["scale_mm"] > 0 and v["loss"]["noise_mm"] > 0
     for args, msg in ((["--data", str(tmp_path / "none.csv")], "none.csv"),
-                      (["--model", str(tmp_path / "none.json")], "none.json")):
+                      (["--model", str(tmp_path / "none.json")], "none.json"),
+                      (["--loss-scale", "-1"], "--loss-scale must be a finite number >= 0")):
         base = {"--model": str(tmp_path / "model.json"), "--data": str(tmp_path / "new.csv")}
         base[args[0]] = args[1]
         bad = tmp_path / "bad.json"

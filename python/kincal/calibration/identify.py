@@ -385,7 +385,7 @@ def identify(robot: Robot, data: MeasurementSet, *, effects: Union[str, Sequence
 
     ``fit``: the fitting options (kincal.fitting.FitOptions: priors, robust loss, gravity, orientation
     weight, iteration cap), shared with `kincal diagnose`; without it they are made of the keywords:
-    ``loss_scale_mm``: where the robust loss bends (mm, default 0.1; None or 0: from the residuals'
+    ``loss_scale_mm``: where the robust loss bends (mm; None or 0, the default: from the residuals'
     robust spread);
     ``prior_sd``: prior standard deviations by kind in file units (None: priors.DEFAULT_PRIOR_SD; {}:
     no priors), times ``prior_scale`` ("auto" or None: chosen by grouped cross-validation inside

@@ -221,10 +221,14 @@ def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
     names of earlier versions. ``extrapolated``: the joints whose periodic effects these rows ask for
     outside the angles the model was fitted on (``robot.fitted_ranges_deg``), each ``{"joint",
     "effects", "fitted_deg", "rows_outside", "share_outside", "message"}``. ``loss``: the robust loss of
-    the refit (``name``, ``scale_mm``: where it bent, ``scale_from``): as in identify and diagnose, where
-    the residuals' robust spread puts it unless ``loss_scale_mm`` is given."""
+    the calibrated model's refit (``name``, ``scale_mm``: where it bent, ``noise_mm``: the residuals'
+    robust spread when it was estimated, ``scale_from``; None for ``loss`` "none"): as in identify and
+    diagnose, where the residuals' robust spread puts it unless ``loss_scale_mm`` is given; the nominal
+    model's refit (the "before") bends by the same rule on its own residuals."""
     if loss not in ("none", "huber", "cauchy"):
         raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
+    if loss_scale_mm is not None and not (loss_scale_mm >= 0 and math.isfinite(loss_scale_mm)):
+        raise ValueError(f"--loss-scale must be a finite number >= 0 (0: from the residuals), not {loss_scale_mm}")
     ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm, target_start)
     v = validation_figures(ea, eb, oa, ob, data)
     v.update(source=str(data.source), targets_mm=np.asarray(cal.targets).tolist(),
@@ -233,6 +237,7 @@ def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
                       + "; the model's geometry and effects held (its drift left out)",
              placements=setup_frames(cal.setups),
              extrapolated=extrapolated(robot, data.q_deg),
-             loss={"name": loss, "scale_mm": cal.loss_scale_mm or None,
-                   "scale_from": "--loss-scale" if loss_scale_mm else "the residuals' robust spread"})
+             loss={"name": loss, "scale_mm": cal.loss_scale_mm or None, "noise_mm": cal.noise_mm or None,
+                   "scale_from": None if loss == "none" else
+                   "--loss-scale" if loss_scale_mm else "the residuals' robust spread"})
     return v

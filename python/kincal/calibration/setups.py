@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import _core
 from .._core import Robot
-from .fitting import DEFAULT_LOSS_SCALE_MM, orientation_errors_deg, rms
+from .fitting import DEFAULT_LOSS_SCALE_MM, FitOptions, orientation_errors_deg, rms
 from .simulation import simulate
 
 if TYPE_CHECKING:
@@ -225,10 +225,7 @@ def validate(robot: Robot, data: MeasurementSet, loss: Loss = "huber",
     robust spread when it was estimated, ``scale_from``; None for ``loss`` "none"): as in identify and
     diagnose, where the residuals' robust spread puts it unless ``loss_scale_mm`` is given; the nominal
     model's refit (the "before") bends by the same rule on its own residuals."""
-    if loss not in ("none", "huber", "cauchy"):
-        raise ValueError(f"unknown loss '{loss}' (none, huber, cauchy)")
-    if loss_scale_mm is not None and not (loss_scale_mm >= 0 and math.isfinite(loss_scale_mm)):
-        raise ValueError(f"--loss-scale must be a finite number >= 0 (0: from the residuals), not {loss_scale_mm}")
+    FitOptions(loss=loss, loss_scale_mm=loss_scale_mm)  # the fits' own checks of the loss and its scale
     ea, eb, oa, ob, cal = _refit_placements(robot, data, loss, loss_scale_mm, target_start)
     v = validation_figures(ea, eb, oa, ob, data)
     v.update(source=str(data.source), targets_mm=np.asarray(cal.targets).tolist(),

@@ -67,11 +67,11 @@ def effect_opts(sp: argparse.ArgumentParser, default: str, what: str) -> None:
     harmonics_option(sp, "transmission_error")
 
 
-def loss_opts(sp: argparse.ArgumentParser, scale: Optional[float] = DEFAULT_LOSS_SCALE_MM) -> None:
+def loss_opts(sp: argparse.ArgumentParser) -> None:
     """--loss, --loss-scale: one default for every fit (identify, diagnose, validate's refit)."""
     sp.add_argument("--loss", choices=["huber", "cauchy", "none"], default="huber", help="robust loss")
-    sp.add_argument("--loss-scale", type=float, default=scale, help="where the robust loss bends (mm; default "
-                    + (f"{scale})" if scale else "from the residuals' robust spread)"))
+    sp.add_argument("--loss-scale", type=float, default=DEFAULT_LOSS_SCALE_MM,
+                    help="where the robust loss bends (mm; default from the residuals' robust spread)")
 
 
 def artifact_opt(sp: argparse.ArgumentParser) -> None:

@@ -305,36 +305,46 @@ TEST(Stations, BlockFacesAndABallbarRecoverTheRobot) {
 // Without a known length the overall scale is not seen: the result says so, and the ball centres the
 // fit predicts on 200 random configurations equal those of the fit with the length after the best
 // similarity transform (rotation, translation and scale: Umeyama) to 0.01 mm. Truth, campaign: the
-// spheres above (6 x 25 touches, 60 deg cone, 0.005 mm noise). A tracker campaign sees the scale (60
-// poses: 40, without priors, left base.rz barely determined on one of 30 draws, KINCAL_TEST_SEED=5,
-// and identify refused them before any scale was looked at). Over KINCAL_TEST_SEED 1-60 the centres
-// agree to 0.0021 mm in the median and beyond 0.01 mm on two draws (33: 0.0147 mm, 60: 0.0122). The
-// gap does not follow the scale between the two fits (the largest, 1.0011 at seed 43, agrees to
-// 0.0024 mm); its cause is not known. Looked at in the twenty-eighth session: on seed 33 the two fits
-// hold different barely identifiable parameters (joint6.tilt_u with the length, not without it);
-// with none held (weak_tolerance 0) the gaps are 0.0045 (33) and 0.0146 mm (60), and with one known
-// length instead of the five distances from the first station 0.0154 and 0.0039 mm. A held parameter
-// (joint5.move_u for the scale among them) stays at its start where a change of scale would move it,
-// so the two fits need not be one similarity apart; that this is the whole cause is not shown.
+// spheres above (6 x 25 touches, 60 deg cone, 0.005 mm noise), the length the distance of the second
+// station from the first; both fits without priors. Thirty draws of the campaign (and of the scoring
+// configurations), each within 0.01 mm, their median within 0.002 mm.
+// The same touches with and without the length must hold the same parameters but the one the scale
+// leaves to them: where the lengths' rows took part in judging what the data determine, a parameter
+// near the weak threshold was held in one fit and not in the other (joint6.tilt_u, 2.0e-3 of its
+// effect its own with the length; KINCAL_TEST_SEED=33 of this test until the thirty-second session:
+// 0.0154 mm). Over KINCAL_TEST_SEED 1-60 (one draw each) the largest three were 0.0154, 0.0090 and
+// 0.0060 mm; now 0.0059, 0.0039 and 0.0031 (median 0.0007; BENCHMARKS.md). With the distances of all five other
+// stations from the first (a ball plate: four lengths more than the scale needs) the two fits differ
+// by what those lengths add about the stations' layout: 0.0122 mm on one of those 60 draws (seed 60),
+// with the same parameters held. A tracker campaign sees the scale (60 poses: 40, without priors, left
+// base.rz barely determined on one of 30 draws, KINCAL_TEST_SEED=5, and identify refused them before
+// any scale was looked at).
 TEST(Stations, WithoutALengthTheScaleIsNamedAndOnlyItIsFree) {
   KINCAL_SEED_TRACE(51, 52, 53);
   const Model truth(truth_spec(51, 0.003)), nominal(kr500_spec());
-  const MeasurementSet with = simulate_probe(truth, probe_options(MeasureKind::sphere, 6, 25, 60, test::test_seed(52)));
-  MeasurementSet without = with;
-  without.artifact.clear();
   IdentifyOptions opt;
   opt.covariance = false;
-  const IdentifyResult a = identify(nominal, with, opt), b = identify(nominal, without, opt);
-  EXPECT_TRUE(a.scale_determined);
-  EXPECT_FALSE(b.scale_determined);
-  const std::vector<Vec6> qs = scoring_configurations(test::test_seed(53));
-  const Eigen::Matrix3Xd pa = balls(Model(a.calibrated), qs, a.targets[0]), pb = balls(Model(b.calibrated), qs, b.targets[0]);
-  const Eigen::Matrix4d sim = Eigen::umeyama(pb, pa, true);
-  const Eigen::Matrix3Xd moved = (sim.topLeftCorner<3, 3>() * pb).colwise() + sim.topRightCorner<3, 1>();
-  const double rms = std::sqrt((moved - pa).colwise().squaredNorm().mean());
-  std::printf("without the length: scale %.6f, ball centres after the similarity %.5f mm\n",
-              sim.topLeftCorner<3, 3>().determinant() > 0 ? std::cbrt(sim.topLeftCorner<3, 3>().determinant()) : 0.0, rms);
-  EXPECT_LT(rms, 0.01);
+  std::vector<double> gaps;
+  for (unsigned k = 0; k < 30; ++k) {
+    MeasurementSet with = simulate_probe(truth, probe_options(MeasureKind::sphere, 6, 25, 60, test::test_seed(52 + 100 * k)));
+    ASSERT_FALSE(with.artifact.empty());
+    with.artifact.resize(1);  // one known length: stations 1 and 2
+    MeasurementSet without = with;
+    without.artifact.clear();
+    const IdentifyResult a = identify(nominal, with, opt), b = identify(nominal, without, opt);
+    EXPECT_TRUE(a.scale_determined) << "draw " << k;
+    EXPECT_FALSE(b.scale_determined) << "draw " << k;
+    const std::vector<Vec6> qs = scoring_configurations(test::test_seed(53 + 100 * k));
+    const Eigen::Matrix3Xd pa = balls(Model(a.calibrated), qs, a.targets[0]), pb = balls(Model(b.calibrated), qs, b.targets[0]);
+    const Eigen::Matrix4d sim = Eigen::umeyama(pb, pa, true);
+    const Eigen::Matrix3Xd moved = (sim.topLeftCorner<3, 3>() * pb).colwise() + sim.topRightCorner<3, 1>();
+    gaps.push_back(std::sqrt((moved - pa).colwise().squaredNorm().mean()));
+    std::printf("without the length, draw %u: scale %.6f, ball centres after the similarity %.5f mm\n", k,
+                std::cbrt(sim.topLeftCorner<3, 3>().determinant()), gaps.back());
+    EXPECT_LT(gaps.back(), 0.01) << "draw " << k;
+  }
+  std::nth_element(gaps.begin(), gaps.begin() + 15, gaps.end());
+  EXPECT_LT(gaps[15], 0.002);
   SimulationOptions tracker;
   tracker.poses = 60;
   tracker.seed = test::test_seed(54);
@@ -407,4 +417,3 @@ TEST(Stations, AMixedCampaignWithoutPriorsIsAccepted) {
     EXPECT_LT(joint.identified, 0.03);
   }
 }
-

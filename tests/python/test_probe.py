@@ -14,7 +14,7 @@ import pytest
 
 import kincal
 from kincal import _core
-from kincal.calibration import identify as ident
+from kincal.calibration import identify as ident, simulation
 from kincal.calibration.probe_plan import ball_centres as _balls, rigid_rms as _rigid_rms
 
 from conftest import run
@@ -49,6 +49,48 @@ def test_spheres_with_a_length_bar_from_the_command_line(tmp_path):
             "--effects", "joint_compliance", "--folds", "0")
     assert r.returncode == 0, r.stderr
     assert "scale: not determined by these data" in r.stdout and "--artifact" in r.stdout
+
+
+def _similarity_rms(a: np.ndarray, b: np.ndarray) -> float:
+    """RMS of the 3-D distance between points b and a after the best similarity transform of a onto b
+    (rotation, translation and scale: Umeyama)."""
+    ma, mb = a.mean(0), b.mean(0)
+    u, s, vt = np.linalg.svd((b - mb).T @ (a - ma) / len(a))
+    d = np.diag([1.0, 1.0, np.sign(np.linalg.det(u @ vt))])
+    rot = u @ d @ vt
+    scale = np.trace(np.diag(s) @ d) / np.mean(np.sum((a - ma) ** 2, axis=1))
+    return float(np.sqrt(np.mean(np.sum((scale * (a - ma) @ rot.T - (b - mb)) ** 2, axis=1))))
+
+
+def test_without_the_length_only_the_scale_is_free(tmp_path):
+    """Issue 32: without a known length the ball centres the fit predicts equal those of the fit with
+    it after the best similarity transform, to 0.01 mm. Here with identify's defaults (the priors: the
+    scale held at its prior) where the C++ test (Stations.WithoutALengthTheScaleIsNamedAndOnlyItIsFree)
+    fits without priors. Truths: default_truth seeds 1-10 (the kr500 with 1 mm / 0.05 deg errors and
+    joint compliance 0.003 deg/kNm); campaigns: 6 spheres x 25 touches in a 60 deg cone, 0.005 mm
+    noise, the one length the distance between the first two spheres; the model joint_compliance, no
+    validation; scored on 200 random configurations within 90% of the limits. Measured: 0.0022 mm on
+    truth 3, below 0.0003 mm on the nine others. (This path, with priors, holds nothing for the scale
+    and did the same before the C++ test's fix.)"""
+    robot = kincal.load_robot("kr500")
+    lim = np.asarray(robot.limits_deg)
+    gaps = []
+    for seed in range(1, 11):
+        truth = simulation.default_truth(robot, seed)
+        without = simulation.simulate_probe(truth, "sphere", stations=6, touches=25, cone_deg=60, seed=seed,
+                                            artifact=False)
+        plate = simulation.simulate_probe(truth, "sphere", stations=6, touches=25, cone_deg=60, seed=seed)
+        length = tmp_path / f"length{seed}.csv"  # the first of the simulated distances: S1 to S2
+        length.write_text("\n".join(_core.format_artifact(plate, 6).splitlines()[:2]) + "\n")
+        with_length = _core.read_artifact(str(length), without, 6)
+        assert len(with_length.artifact) == 1
+        fits = [ident.identify(robot, d, effects="joint_compliance", k_folds=0) for d in (with_length, without)]
+        assert fits[0].fit.scale_determined and not fits[1].fit.scale_determined
+        q = np.random.default_rng(seed).uniform(0.9 * lim[:, 0], 0.9 * lim[:, 1], size=(200, 6))
+        a, b = (_balls(f.robot, q, f.targets[0]) for f in fits)
+        gaps.append(_similarity_rms(b, a))
+    print("ball centres without the length, after the similarity (mm):", np.round(gaps, 5))
+    assert max(gaps) < 0.01, gaps
 
 
 def test_a_ballbar_and_block_faces_simulate_and_read_back(tmp_path):

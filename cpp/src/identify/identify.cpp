@@ -332,13 +332,22 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   // with priors, left to them)
   const PointState frames_only = pm.at_frames_only(x, data);  // every row's flange frame once
   hold_unseen_frames(pm, frames_only, data, opt, res);
-  fit_frames(pm, frames_only, nominal, data, opt, x, res);
   res.prior_sd = prior_sds(res.layout, opt);
-  const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd);
+  // without priors a probe campaign with known lengths is judged where its touches alone put the
+  // frames (fix_unidentifiable)
+  std::vector<double> touches_at;
+  MeasurementSet touches;
+  const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double s) { return std::isfinite(s); });
+  if (!priors && data.has_probe() && without_lengths(data, touches)) {
+    IdentifyResult scratch = res;
+    touches_at = x;
+    fit_frames(pm, frames_only, nominal, touches, opt, touches_at, scratch);
+  }
+  fit_frames(pm, frames_only, nominal, data, opt, x, res);
+  const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd, touches_at);
   const std::vector<int> free_idx = free_parameters(data, res, res.prior_sd);
   // stage 2: everything identifiable, its first evaluation the linearization at the start
   Stage2 s2(pm, data, x, opt, res);
-  const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double v) { return std::isfinite(v); });
   if (!(opt.artifact_sd_mm >= 0) || !std::isfinite(opt.artifact_sd_mm))
     throw InputError("identify: the artifact's uncertainty must be a finite number of mm >= 0 (0: as a row's)");
   const bool weighed_artifact = opt.artifact_sd_mm > 0 && !data.artifact.empty();  // needs the noise

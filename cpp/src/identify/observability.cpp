@@ -7,6 +7,7 @@
 #include "linearization.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
@@ -16,12 +17,9 @@ namespace kincal {
 using detail::linearize;
 using detail::normal_matrix_lower;
 
-namespace {
-
-/// The parameters' rates under a uniform scaling of every length about the first setup's base
-/// origin (per unit of the scale's change): the joint lines' points, the tool's and the targets'
-/// offsets, the other placements, the stations; the compliances the inverse (the torques scale with
-/// the arms, the deflection angles stay).
+/// The scaling is about the first setup's base origin: the joint lines' points, the tool's and the
+/// targets' offsets, the other placements, the stations; the compliances the inverse (the torques
+/// scale with the arms, the deflection angles stay).
 Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>& x) {
   const ParamLayout& L = pm.layout();
   const PointState at = pm.at(x);
@@ -56,12 +54,21 @@ Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>&
   return v;
 }
 
+namespace {
+
+/// What the rows (J) see of a uniform scaling at x, relative to what each parameter's part of it
+/// would show alone: 0 when the scaling is not seen at all.
 template <class Matrix>
-bool scale_seen_by(const PointModel& pm, const Matrix& J, const std::vector<double>& x) {
+double scale_visibility_of(const PointModel& pm, const Matrix& J, const std::vector<double>& x) {
   const Eigen::VectorXd v = scale_direction(pm, x);
   double parts = 0;
   for (Eigen::Index i = 0; i < v.size(); ++i) parts += J.col(i).squaredNorm() * v[i] * v[i];
-  return (J * v).norm() > 1e-3 * std::sqrt(parts);
+  return parts > 0 ? (J * v).norm() / std::sqrt(parts) : 0.0;
+}
+
+template <class Matrix>
+bool scale_seen_by(const PointModel& pm, const Matrix& J, const std::vector<double>& x) {
+  return scale_visibility_of(pm, J, x) > 1e-3;
 }
 
 template <class Matrix>
@@ -92,6 +99,10 @@ bool scale_seen(const PointModel& pm, const Eigen::MatrixXd& J, const std::vecto
   return scale_seen_by(pm, J, x);
 }
 
+double scale_visibility(const PointModel& pm, const Eigen::MatrixXd& J, const std::vector<double>& x) {
+  return scale_visibility_of(pm, J, x);
+}
+
 void observability(const PointModel& pm, const MeasurementSet& data, const IdentifyOptions& opt, IdentifyResult& res,
                    const double* jacobian) {
   if (jacobian && data.artifact.empty()) {
@@ -100,6 +111,41 @@ void observability(const PointModel& pm, const MeasurementSet& data, const Ident
   } else {
     observability_of(pm, linearize(pm, data, res.x, opt.orientation_weight).jacobian, data, res);
   }
+}
+
+bool without_lengths(const MeasurementSet& data, MeasurementSet& out) {
+  out = data;
+  out.artifact.clear();
+  for (const ArtifactTerm& a : data.artifact)
+    if (std::isnan(a.distance_mm)) out.artifact.push_back(a);
+  return out.artifact.size() < data.artifact.size();
+}
+
+/// (identifiability.hpp)
+void release_scale(const Eigen::MatrixXd& J, const IdentifyResult& generic, const std::vector<bool>& before,
+                   IdentifyResult& res) {
+  std::vector<int> free_cols, held;
+  for (int i = 0; i < res.layout.size; ++i) {
+    if (!res.fixed[i]) free_cols.push_back(i);
+    else if (!before[static_cast<size_t>(i)] && !generic.fixed[i]) held.push_back(i);
+  }
+  auto unit = [&](int i) -> Eigen::VectorXd {
+    const double n = J.col(i).norm();
+    return J.col(i) / (n > 0 ? n : 1.0);
+  };
+  Eigen::MatrixXd F(J.rows(), static_cast<Eigen::Index>(free_cols.size()));
+  for (size_t k = 0; k < free_cols.size(); ++k) F.col(static_cast<Eigen::Index>(k)) = unit(free_cols[k]);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(F);
+  int best = -1;
+  double most = 0;
+  for (int i : held) {
+    const Eigen::VectorXd c = unit(i);
+    const double left = (c - F * qr.solve(c)).norm();
+    if (left > most) best = i, most = left;
+  }
+  if (best < 0) return;
+  res.fixed[best] = false;
+  res.fixed_reason[best].clear();
 }
 
 }  // namespace kincal

@@ -122,8 +122,11 @@ TEST(Compensation, BlockSolveMatchesPivotedLu) {
 // (0.003 deg/kN m), and with compliance, transmission error (harmonics 1, 2) and backlash on joints
 // 1-3 (seed 7; poses: the nominal FK at random configurations more than 1 deg from every
 // singularity, started at that configuration). Both stop at |F| < 1e-9, so the solutions agree to
-// the joint-space image of that: 1e-8 deg, where the solution is more than 0.5 deg from a
-// singularity (nearer, the image of |F| grows: 1e-8..3e-8 deg at 0.2 deg). A pose where Newton's
+// the joint-space image of that: at each pose within (|F_a| + |F_b|) / sigma_min(J), J the Jacobian
+// of F (mm and deg per deg) at the solution. Over seeds 0-20 the worst is 0.52 of that; in degrees
+// 1e-9..1.1e-8 where the solution is more than 0.5 deg from a singularity (this test asserted 1e-8
+// there until the thirty-second session, exceeded at seeds 3 and 15 by 1.0e-8 and 1.1e-8 deg, each
+// 0.2 of its pose's allowance; nearer a singularity the allowance grows). A pose where Newton's
 // iteration wandered (a joint over 30 deg from the start, to 942 deg once) is no solution a program
 // wants and is not compared. Over seeds 0-20 Newton converges near the start at 95.1-99.7% of the
 // poses (1 deg from the nominal singularities is not 1 deg from the calibrated robot's). Until the
@@ -144,7 +147,7 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
   for (const Model& cal : models) {
     int converged = 0, converged_newton = 0, both = 0, poses = 0;
     long it_reuse = 0, it_newton = 0;
-    double worst = 0;
+    double worst = 0, worst_ratio = 0;
     while (poses < 2000) {
       const auto [q, target, ctx] = random_pose(nom, rng, 1.0, ++poses);
       const CompensationResult a = compensate(cal, target, q, reuse, ctx), b = compensate(cal, target, q, newton, ctx);
@@ -157,15 +160,22 @@ TEST(Compensation, ReusedJacobianReachesNewtonsSolutions) {
       ++both;
       it_reuse += a.iterations;
       it_newton += b.iterations;
-      if (test::singularity_distance_deg(nom, b.q_deg) > 0.5) worst = std::max(worst, (a.q_deg - b.q_deg).cwiseAbs().maxCoeff());
+      const double d = (a.q_deg - b.q_deg).cwiseAbs().maxCoeff();
+      // what the stopping rule allows: two angles whose |F| are below the stop lie within
+      // (|F_a| + |F_b|) / sigma_min(J) of each other (to first order: |dq| ~ 1e-10 rad, so the
+      // second order is some 1e-10 of it)
+      const Eigen::JacobiSVD<Mat6> svd(pose_deviation_jacobian(cal, b.q_deg, target, Residual::RotationVector, ctx));
+      const double allowed = (a.residual + b.residual) / svd.singularValues()[5];
+      worst_ratio = std::max(worst_ratio, d / allowed);
+      if (test::singularity_distance_deg(nom, b.q_deg) > 0.5) worst = std::max(worst, d);
     }
     std::printf("converged: %d reused, %d Newton of %d; mean iterations where both did %.2f reused, %.2f Newton; "
-                "worst difference %.1e deg\n",
+                "worst difference %.1e deg, %.3f of what the stop allows\n",
                 converged, converged_newton, poses, static_cast<double>(it_reuse) / both,
-                static_cast<double>(it_newton) / both, worst);
+                static_cast<double>(it_newton) / both, worst, worst_ratio);
     EXPECT_EQ(both, converged_newton);  // converged wherever Newton did
     EXPECT_GE(both, 1880);              // (see above: 95.1-99.7% over seeds 0-20)
-    EXPECT_LT(worst, 1e-8);
+    EXPECT_LE(worst_ratio, 1.0);  // the same solution, to what the stopping rule allows
   }
 }
 

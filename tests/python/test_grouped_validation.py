@@ -23,12 +23,13 @@ from conftest import run
 CONFIGS, REPEATS, NOISE = 36, 8, 0.02
 
 
-def _repeated(config_column: bool = False) -> tuple[dict, np.ndarray]:
+def _repeated(config_column: bool = False, seeds: tuple[int, int, int] = (3, 4, 7)) -> tuple[dict, np.ndarray]:
+    """The campaign; ``seeds``: the truth's, the configurations', the repeats' noise."""
     robot = kincal.load_robot("kr500")
-    truth = ident.default_truth(robot, seed=3)
-    base = ident.simulate(truth, CONFIGS, seed=4, noise_mm=0.0,
+    truth = ident.default_truth(robot, seed=seeds[0])
+    base = ident.simulate(truth, CONFIGS, seed=seeds[1], noise_mm=0.0,
                           effects=[("transmission_error", 2, [3e-4, -2e-4, 1.5e-4, 1e-4])])
-    rng = np.random.default_rng(7)
+    rng = np.random.default_rng(seeds[2])
     reps = []
     for r in range(REPEATS):
         d = base.columns()  # writable copies
@@ -104,20 +105,35 @@ def test_components_agree_with_scipys_graph_search():
     assert np.all(grouping._components(5000, a, a + 1) == 0)
 
 
-def test_reported_held_out_rms_matches_leave_configurations_out(repeated):
+def test_reported_held_out_rms_matches_leave_configurations_out():
     """identify's 4-fold figure against an independent estimate built here: leave one configuration
     out (36 fits, each predicting the 8 repeats of the configuration it did not see). The row-wise
-    4-fold figure, built here too, shows what the grouping corrects."""
-    data, truth_config = repeated
+    4-fold figure, built here too, shows what the grouping corrects. Over 15 draws (seeds of the truth,
+    the configurations and the noise: (3, 4, 7), the module's campaign, and (k, 10 + k, 20 + k) for
+    k = 1..14): the 4-fold figure near leave-one-configuration-out, the row-wise figure optimistic on
+    every draw and by more than 15% in the median, and on every draw the row-wise figure below the
+    grouped one. This test took the module's draw alone and asserted the 4-fold figure within 15% of
+    LOCO (0.8% there); over 59 draws (an audit, thirty-second session) it was 15-20% off on four (36
+    configurations, 4 folds: each fold's fit sees 27) and the row-wise one at 0.851 on one. Measured
+    on these 15: |4-fold / LOCO - 1| from 0.008 to 0.187, median 0.075 (a guess of 0.05 for the
+    median, made before, did not hold); row-wise / LOCO 0.71-0.81. Asserted, a statement of these
+    15 rather than a hold-out: the median within 10%, every draw within 25%."""
     robot = kincal.load_robot("kr500")
-    res = ident.identify(robot, data, k_folds=4, effects="joint_compliance")  # the model without the effect
-    v = res.validation
-    assert v["configurations"] == CONFIGS and v["scheme"] == "4-fold, whole configurations"
-    loco = _held_rms(robot, data, res.effects, [truth_config == c for c in range(CONFIGS)])
-    assert abs(v["after_rms_mm"] - loco) <= 0.15 * loco, (v["after_rms_mm"], loco)
-    perm = np.random.default_rng(11).permutation(len(truth_config))
-    rowwise = _held_rms(robot, data, res.effects, [np.isin(np.arange(len(perm)), perm[i::4]) for i in range(4)])
-    assert rowwise < 0.85 * loco, (rowwise, loco)   # splitting rows is optimistic by more than 15%
+    off, optimistic = [], []
+    for seeds in [(3, 4, 7)] + [(k, 10 + k, 20 + k) for k in range(1, 15)]:
+        data, truth_config = _repeated(seeds=seeds)
+        res = ident.identify(robot, data, k_folds=4, effects="joint_compliance")  # the model without the effect
+        v = res.validation
+        assert v["configurations"] == CONFIGS and v["scheme"] == "4-fold, whole configurations"
+        loco = _held_rms(robot, data, res.effects, [truth_config == c for c in range(CONFIGS)])
+        perm = np.random.default_rng(11).permutation(len(truth_config))
+        rowwise = _held_rms(robot, data, res.effects, [np.isin(np.arange(len(perm)), perm[i::4]) for i in range(4)])
+        off.append(abs(v["after_rms_mm"] / loco - 1))
+        optimistic.append(rowwise / loco)
+        assert rowwise < v["after_rms_mm"], seeds
+    print("|4-fold / LOCO - 1|:", np.round(off, 3), "row-wise / LOCO:", np.round(optimistic, 3))
+    assert np.median(off) <= 0.10 and max(off) <= 0.25, off
+    assert np.median(optimistic) < 0.85 and max(optimistic) < 1, optimistic   # splitting rows is optimistic
 
 
 def test_identify_command_states_the_scheme(tmp_path, repeated):

@@ -159,22 +159,34 @@ def test_ur10_real_data_calibrates_across_series():
 
 
 def test_observability_selection_beats_random_poses():
-    """truth: default_truth(kr500, seed 3), 3 reflectors, 0.02 mm noise. 30 poses chosen for
-    observability (greedy D-optimal from 300 random ones) against 30 random ones: a larger
-    observability index and a smaller held-out error on 200 other poses."""
+    """30 poses chosen for observability (greedy D-optimal from 300 random ones) against 30 random
+    ones, each set identified (geometry + compliance, Huber): the chosen set has the larger
+    observability index on every draw, and predicts 200 other poses better in the median over 20
+    draws (truth, campaign). Truths: default_truth(kr500, seed t), 3 reflectors, 0.02 mm noise; draws
+    (t, campaign seed, held seed) = (3, 5, 99) and (k, 20 + k, 200 + k) for k = 1..19; the held-out
+    poses noise-free, so that the figure is the model's error, not the noise's. This test took one
+    draw (3, 5, 99) and the noisy held-out poses (0.035 mm of noise against some 0.002 mm of
+    difference): on other draws the random set won on 9 of 43 (an audit in the thirty-second session).
+    Measured: ratio chosen / random 0.66-1.47, median 0.839 (6 of 20 draws above 1); asserted: median
+    at most 0.9."""
     robot = kincal.load_robot("kr500")
-    truth = ident.default_truth(robot, seed=3)
-    held = ident.simulate(truth, 200, seed=99, targets=3)
-    rand = ident.simulate(truth, 30, seed=5, targets=3)
-    chosen = plan.select_observable(robot, ident.simulate(truth, 300, seed=5, targets=3), 30)
-    assert len(np.unique(chosen["pose"])) == 30
-    out = {}
-    for name, d in (("random", rand), ("chosen", chosen)):
-        r = _core.identify(robot, d, _core.IdentifyOptions(compliance=True, loss="huber"))
-        e = _core.point_errors(r.robot, r.targets, held)
-        out[name] = (r.observability_index, float(np.sqrt(np.mean(e ** 2))))
-    assert out["chosen"][0] > out["random"][0]
-    assert out["chosen"][1] < out["random"][1]
+    ratios = []
+    for k in range(20):
+        t, c, h = (3, 5, 99) if k == 0 else (k, 20 + k, 200 + k)
+        truth = ident.default_truth(robot, seed=t)
+        held = ident.simulate(truth, 200, seed=h, targets=3, noise_mm=0.0)
+        rand = ident.simulate(truth, 30, seed=c, targets=3)
+        chosen = plan.select_observable(robot, ident.simulate(truth, 300, seed=c, targets=3), 30)
+        assert len(np.unique(chosen["pose"])) == 30
+        out = {}
+        for name, d in (("random", rand), ("chosen", chosen)):
+            r = _core.identify(robot, d, _core.IdentifyOptions(compliance=True, loss="huber"))
+            e = _core.point_errors(r.robot, r.targets, held)
+            out[name] = (r.observability_index, float(np.sqrt(np.mean(e ** 2))))
+        assert out["chosen"][0] > out["random"][0], (t, c)
+        ratios.append(out["chosen"][1] / out["random"][1])
+    print("held-out RMS chosen / random:", np.round(ratios, 3))
+    assert np.median(ratios) <= 0.9, ratios
 
 
 def test_numpy_residuals_equal_the_core():

@@ -159,17 +159,34 @@ def test_identify_penalties(kr500):
     0.05 deg errors (seed 3) and a joint_map of order 3 on joint 2 (amplitudes 0.004-0.02 deg),
     150 poses x 3 reflectors, 0.02 mm noise. Without a penalty the fit reaches the noise and the
     third order (which the geometry cannot mimic; the first orders trade with the joint lines) is
-    recovered within 0.002 deg; with an overwhelming penalty the map stays at zero and the fit does
-    not reach the noise; a name the model lacks is an error. Without priors (prior_sd={}): with the
-    default priors on the joint lines and none on the map, the map's first orders take what the
-    priors hold back from the joint lines and the third order lands 0.0036 deg off."""
+    recovered within what the fit says of it; with an overwhelming penalty the map stays at zero and
+    the fit does not reach the noise; a name the model lacks is an error. Without priors
+    (prior_sd={}): with the default priors on the joint lines and none on the map, the map's first
+    orders take what the priors hold back from the joint lines and the third order lands 0.0036 deg
+    off.
+    The recovery is checked on 21 draws (geometric truth, campaign): (3, 5) and, for s = 1..20, (3 or
+    20 + s, 5 + 10 s). This test asserted the third order within 0.002 deg on the first draw alone
+    (0.0018 there); the fit's standard deviation of the cosine is 0.0012-0.0015 deg, and on three of the
+    20 others the error was 0.0021-0.0031 deg (an audit, thirty-second session). Now: each third-order
+    amplitude within 4 of its own standard deviations of the truth, and the RMS of those 42 z-scores
+    between 0.7 and 1.4 (the covariance is honest; measured 0.92, the largest |z| 2.2)."""
     truth_vals = D([0.02, -0.01, 0.004, 0.008, -0.006, 0.012])
-    data = ident.simulate(_truth(kr500), 150, seed=5, targets=3, effects=[("joint_map", 2, truth_vals)])
     e = _core.Effect("joint_map", 2, order=3)
-    free = ident.identify(kr500, data, effects=[e], k_folds=0, prior_sd={})
-    (_, got), = free.robot.effects
-    assert np.max(np.abs(np.degrees(np.asarray(got)[4:] - truth_vals[4:]))) < 0.002
-    assert free.fit.rms_mm < 1.1 * NOISE
+    z = []
+    for ts, cs in [(3, 5)] + [(3 if s % 2 else 20 + s, 5 + 10 * s) for s in range(1, 21)]:
+        truth = kr500.with_calibrated(ts, 1.0, 0.05, 0.0, ident.DEFAULT_INSTRUMENT)
+        draw = ident.simulate(truth, 150, seed=cs, targets=3, effects=[("joint_map", 2, truth_vals)])
+        fit = ident.identify(kr500, draw, effects=[e], k_folds=0, prior_sd={})
+        assert fit.fit.rms_mm < 1.1 * NOISE, (ts, cs)
+        got = {p["name"]: p for p in fit.parameters()}
+        for k, t in (("sin3", truth_vals[4]), ("cos3", truth_vals[5])):
+            p = got[f"joint2.map_{k}"]
+            z.append((p["value"] - np.degrees(t)) / p["stddev"])
+            assert abs(z[-1]) < 4, (ts, cs, k, p)
+        if (ts, cs) == (3, 5):
+            data = draw
+    print("third-order z-scores:", np.round(z, 2), "RMS", round(float(np.sqrt(np.mean(np.square(z)))), 3))
+    assert 0.7 < np.sqrt(np.mean(np.square(z))) < 1.4
     names = [f"joint2.{n}" for n in e.parameter_names]
     held = ident.identify(kr500, data, effects=[e], k_folds=0, penalties=[(n, 1e9) for n in names], prior_sd={})
     (_, got0), = held.robot.effects

@@ -38,12 +38,16 @@ def robot():
 
 
 def test_planned_configurations_beat_random_ones(robot):
-    """5 truths (default_truth seeds 1-5: 1 mm / 0.05 deg geometric errors, compliance), 3,000 random
+    """15 truths (default_truth seeds 1-15: 1 mm / 0.05 deg geometric errors, compliance), 3,000 random
     candidates each: 30 planned configurations against 30 random ones of the same candidates, both
     identified (geometry + compliance) from noisy measurements; error on 300 other candidates (whole
-    configurations held out) against the noise-free truth. Median ratio at most 0.85."""
+    configurations held out) against the noise-free truth. This test took truths 1-5 and asserted a
+    median ratio of at most 0.85 (0.844 there); over truths 1-40 (an audit, thirty-second session) the
+    ratios ran 0.53-1.19 with a median of 0.847, and two of the eight groups of five had medians of
+    0.877 and 0.921: a planned campaign is some 15% better in the median, not on every draw. Over
+    truths 1-15 the median is 0.844; asserted (a statement of those draws): at most 0.9."""
     ratios = []
-    for s in range(5):
+    for s in range(15):
         truth = ident.default_truth(robot, seed=s + 1)
         every = plan.random_candidates(robot, 3300, seed=100 + s)
         held, cand = every[:300], every[300:]   # held-out configurations are never candidates
@@ -53,7 +57,8 @@ def test_planned_configurations_beat_random_ones(robot):
         planned = ident.identify(robot, _measure(truth, p.q_deg, NOISE, s), k_folds=0)
         random = ident.identify(robot, _measure(truth, rand, NOISE, s), k_folds=0)
         ratios.append(_held_rms(planned, truth, held) / _held_rms(random, truth, held))
-    assert np.median(ratios) <= 0.85, ratios
+    print("planned / random:", np.round(ratios, 3))
+    assert np.median(ratios) <= 0.9, ratios
 
 
 def test_predicted_tcp_uncertainty_matches_a_noise_only_truth(robot):

@@ -278,7 +278,11 @@ class SerialProblem:
         the held range included, and a map that only a refit of the geometry keeps in check there
         looks better than it predicts); the first variant listed within ORDER_MARGIN of the best held-out
         sum of squares. Orders the library's transmission_error covers on that joint are not offered
-        (covered()). Any other candidate is returned as it is."""
+        (covered()); that transmission_error itself is, first (where the model lacks it): a map that
+        contains it is kept only when it predicts the held ranges better by ORDER_MARGIN (on the
+        linearisation a map of higher order gained a few tenths of a percent over the library's
+        effect on data hiding that very effect, and was named in its place). Any other candidate is
+        returned as it is."""
         if not cand.kind.ordered or cand.joint not in self.map_scale:
             return cand
         top = max([c.order for c in self.candidates if c.kind.ordered and c.joint == cand.joint] + [cand.order])
@@ -287,7 +291,10 @@ class SerialProblem:
         held_masks = self.variant_folds(cand)
         if any(h.all() or not h.any() for h in held_masks):  # the angle's ranges do not split the rows
             return cand
-        offered: list[tuple[_core.Effect, list[tuple[str, float]], float]] = []
+        offered: list[tuple[_core.Effect, list[tuple[str, float]], Optional[float]]] = [
+            (c, [], None) for c in self.candidates
+            if isinstance(c, _core.Effect) and c.kind.harmonic and not c.kind.ordered and c.joint == cand.joint
+            and not any(e.name == c.name and e.joint == c.joint for e in effects)]
         for k in range(1, top + 1):
             e = _core.Effect("joint_map", cand.joint, order=k)
             if self.covered(e, self.candidates):
@@ -305,12 +312,15 @@ class SerialProblem:
             ss.append(total)
         best = min(ss)
         i = next(j for j, v in enumerate(ss) if v <= best * (1.0 + engine.ORDER_MARGIN))
-        e, pen, lam = offered[i]
+        e, pen, smoothing = offered[i]
         n = len(self.data.pose)
-        self.refined[cand.joint] = {"order": e.order, "smoothing": lam, "linear_order": cand.order,
-                                    "range_refit_rms_mm": [[o.order, l, float(np.sqrt(v / n))]
+        self.refined[cand.joint] = {"order": e.order if e.kind.ordered else None, "smoothing": smoothing,
+                                    "linear_order": cand.order,
+                                    "range_refit_rms_mm": [[o.label if not o.kind.ordered else o.order, l,
+                                                            float(np.sqrt(v / n))]
                                                            for (o, _, l), v in zip(offered, ss)]}
-        self.penalty[(e.name, e.joint, e.order)] = pen
+        if e.kind.ordered:
+            self.penalty[(e.name, e.joint, e.order)] = pen
         return e
 
     def variant_folds(self, cand: Candidate) -> list[BoolArray]:
@@ -361,11 +371,13 @@ class SerialProblem:
         """A joint_map step's evidence: the order and smoothing chosen, and the best gain of each order
         1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
         g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
+        ref = self.refined.get(cand.joint)
+        if not cand.kind.ordered and ref and ref["order"] is None:  # refine() kept the library's effect
+            return {"over_map_order": ref["linear_order"], "range_refit_rms_mm": ref["range_refit_rms_mm"]}
         out: dict[str, Any] = {"smoothing": MAP_SMOOTHING[i % len(MAP_SMOOTHING)]}
         if cand.kind.ordered:
             out["order"] = cand.order
             out["order_range_cv_gain"] = [round(float(x), 6) for x in g.max(axis=1)]
-            ref = self.refined.get(cand.joint)
             if ref and ref["order"] == cand.order:  # chosen again by refits (refine())
                 out.update(smoothing=ref["smoothing"], linear_order=ref["linear_order"],
                            linear_smoothing=out["smoothing"], range_refit_rms_mm=ref["range_refit_rms_mm"])

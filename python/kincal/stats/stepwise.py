@@ -331,8 +331,15 @@ def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, 
         best = sig[0]
         cand = best["_cand"]
         refine = getattr(problem, "refine", None)
+        preferred_to = None
         if confirm and refine is not None:  # the variant chosen on the linearisation, chosen again by refits
             cand = refine(effects, cand)
+            # the refits may keep another candidate of the round (a library effect the map contains)
+            other = next((s for s in scored if s["_cand"] is not best["_cand"]
+                          and problem.label(s["_cand"]) == problem.label(cand)), None)
+            if other is not None:
+                preferred_to = dict(problem.describe(best["_cand"]), cv_gain_linear=best["cv_gain"])
+                best = other
         say(f"step {len(steps) + 1}: {problem.label(cand)} (F = {best['F']:.3g}, cross-validated gain "
             f"{best['cv_gain']:.1%})" + ("; refitting" if confirm else ""))
         new = cv_rms(problem, effects + [cand]) if confirm else None
@@ -340,10 +347,14 @@ def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, 
             history[-1]["rejected"] = dict(problem.describe(cand), cv_rms_mm=new)
             break
         runners_up = [dict(problem.describe(s["_cand"]), cv_gain_linear=s["cv_gain"], p_value=s["p_value"])
-                      for s in scored[1:4]]
+                      for s in [s for s in scored[:4] if s is not best][:3]]
         evidence = {"F": best["F"], "p_value": best["p_value"], "parameters": best["parameters"],
                     "cv_gain_linear": best["cv_gain"], "runners_up": runners_up}
-        if "variant_cv_gain" in best:  # the variant chosen, and the cross-validated gain of each
+        if preferred_to is not None:
+            evidence["preferred_by_refits_to"] = preferred_to
+            if hasattr(problem, "variant_evidence"):
+                evidence.update(problem.variant_evidence(cand, 0, []))
+        elif "variant_cv_gain" in best:  # the variant chosen, and the cross-validated gain of each
             if hasattr(problem, "variant_evidence"):
                 evidence.update(problem.variant_evidence(cand, best["variant"], best["variant_cv_gain"]))
             else:

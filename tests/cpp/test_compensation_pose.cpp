@@ -125,8 +125,8 @@ TEST(Compensation, BlockSolveMatchesPivotedLu) {
 // the joint-space image of that: at each pose within (|F_a| + |F_b|) / sigma_min(J), J the Jacobian
 // of F (mm and deg per deg) at the solution. Over seeds 0-20 the worst is 0.52 of that; in degrees
 // 1e-9..1.1e-8 where the solution is more than 0.5 deg from a singularity (this test asserted 1e-8
-// there until the thirty-second session, exceeded at seeds 3 and 15 by 1.0e-8 and 1.1e-8 deg, each
-// 0.2 of its pose's allowance; nearer a singularity the allowance grows). A pose where Newton's
+// there until the thirty-second session; at seeds 3 and 15 the difference reached 1.0086e-8 and 1.1e-8
+// deg, each 0.2 of its pose's allowance; nearer a singularity the allowance grows). A pose where Newton's
 // iteration wandered (a joint over 30 deg from the start, to 942 deg once) is no solution a program
 // wants and is not compared. Over seeds 0-20 Newton converges near the start at 95.1-99.7% of the
 // poses (1 deg from the nominal singularities is not 1 deg from the calibrated robot's). Until the

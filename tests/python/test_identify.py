@@ -167,8 +167,8 @@ def test_observability_selection_beats_random_poses():
     poses noise-free, so that the figure is the model's error, not the noise's. This test took one
     draw (3, 5, 99) and the noisy held-out poses (0.035 mm of noise against some 0.002 mm of
     difference): on other draws the random set won on 9 of 43 (an audit in the thirty-second session).
-    Measured: ratio chosen / random 0.66-1.47, median 0.839 (6 of 20 draws above 1); asserted: median
-    at most 0.9."""
+    Measured: ratio chosen / random 0.66-1.47, median 0.839 (6 of 20 draws above 1); asserted, a
+    statement of these draws rather than a hold-out: median at most 0.9."""
     robot = kincal.load_robot("kr500")
     ratios = []
     for k in range(20):

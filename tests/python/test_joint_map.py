@@ -164,8 +164,8 @@ def test_identify_penalties(kr500):
     (prior_sd={}): with the default priors on the joint lines and none on the map, the map's first
     orders take what the priors hold back from the joint lines and the third order lands 0.0036 deg
     off.
-    The recovery is checked on 21 draws (geometric truth, campaign): (3, 5) and, for s = 1..20, (3 or
-    20 + s, 5 + 10 s). This test asserted the third order within 0.002 deg on the first draw alone
+    The recovery is checked on 21 draws (geometric truth's seed, campaign's seed): (3, 5) and, for
+    s = 1..20, (3 for odd s and 20 + s for even s, 5 + 10 s). This test asserted the third order within 0.002 deg on the first draw alone
     (0.0018 there); the fit's standard deviation of the cosine is 0.0012-0.0015 deg, and on three of the
     20 others the error was 0.0021-0.0031 deg (an audit, thirty-second session). Now: each third-order
     amplitude within 4 of its own standard deviations of the truth, and the RMS of those 42 z-scores
@@ -174,7 +174,7 @@ def test_identify_penalties(kr500):
     e = _core.Effect("joint_map", 2, order=3)
     z = []
     for ts, cs in [(3, 5)] + [(3 if s % 2 else 20 + s, 5 + 10 * s) for s in range(1, 21)]:
-        truth = kr500.with_calibrated(ts, 1.0, 0.05, 0.0, ident.DEFAULT_INSTRUMENT)
+        truth = kr500.with_calibrated(ts, 1.0, 0.05, 0.0, ident.DEFAULT_INSTRUMENT)  # _truth's, seed ts
         draw = ident.simulate(truth, 150, seed=cs, targets=3, effects=[("joint_map", 2, truth_vals)])
         fit = ident.identify(kr500, draw, effects=[e], k_folds=0, prior_sd={})
         assert fit.fit.rms_mm < 1.1 * NOISE, (ts, cs)

@@ -70,8 +70,9 @@ def test_without_the_length_only_the_scale_is_free(tmp_path):
     joint compliance 0.003 deg/kNm); campaigns: 6 spheres x 25 touches in a 60 deg cone, 0.005 mm
     noise, the one length the distance between the first two spheres; the model joint_compliance, no
     validation; scored on 200 random configurations within 90% of the limits. Measured: 0.0022 mm on
-    truth 3, below 0.0003 mm on the nine others. (This path, with priors, holds nothing for the scale
-    and did the same before the C++ test's fix.)"""
+    truth 3, below 0.0003 mm on the nine others. (With priors the priors set the scale and no
+    parameter is held for it: this path did not change with the C++ test's fix, and met the claim
+    before it too.)"""
     robot = kincal.load_robot("kr500")
     lim = np.asarray(robot.limits_deg)
     gaps = []

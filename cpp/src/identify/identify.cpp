@@ -333,12 +333,12 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   const PointState frames_only = pm.at_frames_only(x, data);  // every row's flange frame once
   hold_unseen_frames(pm, frames_only, data, opt, res);
   res.prior_sd = prior_sds(res.layout, opt);
-  // without priors a probe campaign with known lengths is judged where its touches alone put the
-  // frames (fix_unidentifiable)
+  // without priors (and the gravity's moments not fitted) a probe campaign with known lengths is
+  // judged where its touches alone put the frames (fix_unidentifiable)
   std::vector<double> touches_at;
   MeasurementSet touches;
   const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double s) { return std::isfinite(s); });
-  if (!priors && data.has_probe() && without_lengths(data, touches)) {
+  if (!priors && !res.layout.fit_gravity && data.has_probe() && without_lengths(data, touches)) {
     IdentifyResult scratch = res;
     touches_at = x;
     fit_frames(pm, frames_only, nominal, touches, opt, touches_at, scratch);

@@ -122,27 +122,34 @@ bool without_lengths(const MeasurementSet& data, MeasurementSet& out) {
 }
 
 /// (identifiability.hpp)
-void release_scale(const Eigen::MatrixXd& J, const IdentifyResult& generic, const std::vector<bool>& before,
-                   IdentifyResult& res) {
+void release_scale(const Eigen::MatrixXd& J, const Eigen::MatrixXd& J_touches, const IdentifyResult& generic,
+                   const std::vector<bool>& before, IdentifyResult& res) {
   std::vector<int> free_cols, held;
   for (int i = 0; i < res.layout.size; ++i) {
     if (!res.fixed[i]) free_cols.push_back(i);
     else if (!before[static_cast<size_t>(i)] && !generic.fixed[i]) held.push_back(i);
   }
-  auto unit = [&](int i) -> Eigen::VectorXd {
-    const double n = J.col(i).norm();
-    return J.col(i) / (n > 0 ? n : 1.0);
+  // the distance of each held column from the free ones' span, every column scaled to unit norm
+  auto left_of = [&](const Eigen::MatrixXd& M) {
+    auto unit = [&](int i) -> Eigen::VectorXd {
+      const double n = M.col(i).norm();
+      return M.col(i) / (n > 0 ? n : 1.0);
+    };
+    Eigen::MatrixXd F(M.rows(), static_cast<Eigen::Index>(free_cols.size()));
+    for (size_t k = 0; k < free_cols.size(); ++k) F.col(static_cast<Eigen::Index>(k)) = unit(free_cols[k]);
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(F);
+    std::vector<double> left;
+    for (int i : held) {
+      const Eigen::VectorXd c = unit(i);
+      left.push_back((c - F * qr.solve(c)).norm());
+    }
+    return left;
   };
-  Eigen::MatrixXd F(J.rows(), static_cast<Eigen::Index>(free_cols.size()));
-  for (size_t k = 0; k < free_cols.size(); ++k) F.col(static_cast<Eigen::Index>(k)) = unit(free_cols[k]);
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(F);
+  const std::vector<double> with = left_of(J), without = left_of(J_touches);
   int best = -1;
   double most = 0;
-  for (int i : held) {
-    const Eigen::VectorXd c = unit(i);
-    const double left = (c - F * qr.solve(c)).norm();
-    if (left > most) best = i, most = left;
-  }
+  for (size_t k = 0; k < held.size(); ++k)  // what the lengths see: ten times what the touches alone do
+    if (with[k] > most && with[k] > 10 * without[k]) best = held[k], most = with[k];
   if (best < 0) return;
   res.fixed[best] = false;
   res.fixed_reason[best].clear();

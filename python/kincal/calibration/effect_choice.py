@@ -278,9 +278,10 @@ class SerialProblem:
         the held range included, and a map that only a refit of the geometry keeps in check there
         looks better than it predicts); the first variant listed within ORDER_MARGIN of the best held-out
         sum of squares. Orders the library's transmission_error covers on that joint are not offered
-        (covered()); that transmission_error itself is, first (where the model lacks it): a map that
-        contains it is kept only when it predicts the held ranges better by ORDER_MARGIN (on the
-        linearisation a map of higher order gained a few tenths of a percent over the library's
+        (covered()); that transmission_error itself is, first (where the model lacks it; with its
+        default harmonics 1 and 2, a map of order 2 or more contains it): a map is kept instead only
+        when it lowers the held ranges' sum of squares by more than ORDER_MARGIN (1%) of the best's
+        (on the linearisation a map of higher order gained a few tenths of a percent over the library's
         effect on data hiding that very effect, and was named in its place). Any other candidate is
         returned as it is."""
         if not cand.kind.ordered or cand.joint not in self.map_scale:
@@ -369,7 +370,10 @@ class SerialProblem:
 
     def variant_evidence(self, cand: Candidate, i: int, gains: Sequence[float]) -> dict[str, Any]:
         """A joint_map step's evidence: the order and smoothing chosen, and the best gain of each order
-        1..MAX_MAP_ORDER held out by ranges of the joint's angle."""
+        1..MAX_MAP_ORDER held out by ranges of the joint's angle. Where refine() kept the library's
+        transmission_error over the map: the map's order on the linearisation (``over_map_order``)
+        and every variant's RMS on the held ranges (``range_refit_rms_mm``: [variant, smoothing, mm],
+        the library effect's variant its label)."""
         g = np.asarray(gains).reshape(-1, len(MAP_SMOOTHING))
         ref = self.refined.get(cand.joint)
         if not cand.kind.ordered and ref and ref["order"] is None:  # refine() kept the library's effect

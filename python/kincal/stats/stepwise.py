@@ -23,7 +23,9 @@ candidates; effects are _core.Effect objects (or objects with their ``name`` and
 With the refits' confirmation, a Problem's ``refine(effects, candidate)`` may choose the step's
 variant again by refits before it is confirmed (the serial robot's joint_map: its order and smoothing
 by refits holding out ranges of the joint's angle; the linearisation fits the model's own parameters
-on every row, held ones included).
+on every row, held ones included). It may return another kind of effect instead, a library effect
+the map contains (a transmission_error of that joint): the step then carries that candidate's own
+scores of the round and the one it was preferred to (``preferred_by_refits_to``).
 
 Without the refit's confirmation (``confirm=False``: `kincal identify --effects auto`, which chooses
 again inside every training fold of its own cross-validation, so its figure is honest without it) a
@@ -334,12 +336,10 @@ def search(problem: Problem[E], start: Sequence[E], candidates: Sequence[E], *, 
         preferred_to = None
         if confirm and refine is not None:  # the variant chosen on the linearisation, chosen again by refits
             cand = refine(effects, cand)
-            # the refits may keep another candidate of the round (a library effect the map contains)
-            other = next((s for s in scored if s["_cand"] is not best["_cand"]
-                          and problem.label(s["_cand"]) == problem.label(cand)), None)
-            if other is not None:
+            if cand.name != best["_cand"].name:  # another kind kept (a library effect the map contains)
                 preferred_to = dict(problem.describe(best["_cand"]), cv_gain_linear=best["cv_gain"])
-                best = other
+                # its own scores of this round (the round admitted the map that contains it)
+                best = next((s for s in scored if problem.label(s["_cand"]) == problem.label(cand)), best)
         say(f"step {len(steps) + 1}: {problem.label(cand)} (F = {best['F']:.3g}, cross-validated gain "
             f"{best['cv_gain']:.1%})" + ("; refitting" if confirm else ""))
         new = cv_rms(problem, effects + [cand]) if confirm else None

@@ -75,10 +75,11 @@ struct Linearization {
 /// was held at its value): the start of the solve. Returns the data's linearization at x. With priors
 /// (prior_sd: one per parameter, finite where it has one) what only the data leave undetermined is
 /// no error: it stays free, determined by its prior (res.at_prior), or is held when it has none.
-/// Without priors, a probe campaign whose known lengths (its artifact's distances) alone see the
-/// arm's overall scale is judged on its touches at `touches_at` (the frames fitted without those
-/// lengths; empty: x), the parameter held there for the scale then freed: the same touches with and
-/// without a length hold the same parameters but that one.
+/// Without priors and with the gravity's moments not fitted, a probe campaign whose known lengths
+/// (its artifact's distances) alone see the arm's overall scale is judged on its touches at
+/// `touches_at` (the frames fitted without those lengths; empty: x), the parameter held there for
+/// the scale then freed: the same touches with and without a length hold the same parameters but
+/// that one.
 Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
                                  const std::vector<double>& prior_sd = {},
@@ -90,11 +91,13 @@ bool without_lengths(const MeasurementSet& data, MeasurementSet& out);
 /// The one parameter a selection on a probe campaign's touches held for the overall scale, freed (the
 /// known lengths set it): of those the selection held (not held before it, `before`, nor by the
 /// generic campaign), the one the lengths see most beside the free ones, the largest distance of its
-/// unit-scaled column of J (every row, the lengths' included) from their span. (The touches see the
-/// scale barely or not at all: the parameter that carries it is held as barely identifiable, or as a
-/// combination of the others.)
-void release_scale(const Eigen::MatrixXd& J, const IdentifyResult& generic, const std::vector<bool>& before,
-                   IdentifyResult& res);
+/// unit-scaled column of J (every row, the lengths' included) from their span, among those whose
+/// distance there is more than ten times their distance in J_touches (the touches' rows alone: a
+/// parameter held there for another reason is not one the lengths see); none when no such one.
+/// (The touches see the scale barely or not at all: the parameter that carries it is held as barely
+/// identifiable, or as a combination of the others.)
+void release_scale(const Eigen::MatrixXd& J, const Eigen::MatrixXd& J_touches, const IdentifyResult& generic,
+                   const std::vector<bool>& before, IdentifyResult& res);
 
 /// The parameters' rates under a uniform scaling of every length (per unit of the scale's change).
 Eigen::VectorXd scale_direction(const PointModel& pm, const std::vector<double>& x);

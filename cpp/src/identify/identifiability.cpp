@@ -4,6 +4,7 @@
 
 #include "linearization.hpp"
 
+#include "kincal/identify/priors.hpp"
 #include "kincal/kinematics/kinematics.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -416,7 +417,7 @@ void fix_unobservable(const Model& nominal, const MeasurementSet& data, const Id
 
 Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
-                                 const std::vector<double>& prior_sd, const std::vector<double>& touches_at) {
+                                 const std::vector<double>& prior_sd, const Touches* touches) {
   const ParamLayout& L = res.layout;
   // penalised parameters (a ridge determines them where the data do not) are left out of the
   // analysis: always free, they never make another parameter look redundant
@@ -429,24 +430,24 @@ Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, con
   // what the generic campaign determines but the data do not means the data are too few or too alike
   // with the gravity fitted, judged at the moments the data show (fitted_moments)
   std::vector<double> xp = res.layout.fit_gravity ? fitted_moments(pm, data, x, opt, res) : x;
-  const bool priors = std::any_of(prior_sd.begin(), prior_sd.end(), [](double s) { return std::isfinite(s); });
+  const bool priors = any_prior(prior_sd);
   // without priors, a probe campaign's known lengths set the overall scale: what else its rows
   // determine is judged on the touches where the touches alone put the frames, the generic campaign
   // made of them too (near the weak threshold the lengths' rows, and the frames they pulled, tipped
   // another parameter over it: joint6.tilt_u held with the length, free without, the ball centres
   // 0.015 mm apart after the similarity)
-  MeasurementSet touches;
-  bool by_lengths = !priors && !touches_at.empty() && !L.fit_gravity && without_lengths(data, touches);
+  bool by_lengths = !priors && touches && !L.fit_gravity;
   Linearization judged;
-  Eigen::MatrixXd every_row;  // the touches and the lengths, at touches_at
+  Eigen::MatrixXd every_row;  // the touches and the lengths, at the touches' frames
   if (by_lengths) {  // (where the touches see the scale too, as a tracker's points do, nothing changes)
-    judged = linearize(pm, touches, touches_at, opt.orientation_weight);
-    every_row = linearize(pm, data, touches_at, opt.orientation_weight).jacobian;
-    by_lengths = scale_visibility(pm, judged.jacobian, touches_at) < 0.1 * scale_visibility(pm, every_row, touches_at);
+    judged = linearize(pm, touches->rows, touches->at, opt.orientation_weight);
+    every_row = linearize(pm, data, touches->at, opt.orientation_weight).jacobian;
+    by_lengths =
+        scale_visibility(pm, judged.jacobian, touches->at) < 0.1 * scale_visibility(pm, every_row, touches->at);
   }
-  const std::vector<double>& xj = by_lengths ? touches_at : xp;
   IdentifyResult generic = res;
-  select_independent(linearize(pm, generic_campaign(nominal, by_lengths ? touches : data), xj, opt.orientation_weight)
+  select_independent(linearize(pm, generic_campaign(nominal, by_lengths ? touches->rows : data),
+                               by_lengths ? touches->at : xp, opt.orientation_weight)
                          .jacobian, order, opt, generic);
   Linearization lin = linearize(pm, data, xp, opt.orientation_weight);
   res.at_prior.assign(L.size, false);

@@ -335,16 +335,17 @@ IdentifyResult identify(const Model& nominal, const MeasurementSet& all_data, co
   res.prior_sd = prior_sds(res.layout, opt);
   // without priors (and the gravity's moments not fitted) a probe campaign with known lengths is
   // judged where its touches alone put the frames (fix_unidentifiable)
-  std::vector<double> touches_at;
-  MeasurementSet touches;
-  const bool priors = std::any_of(res.prior_sd.begin(), res.prior_sd.end(), [](double s) { return std::isfinite(s); });
-  if (!priors && !res.layout.fit_gravity && data.has_probe() && without_lengths(data, touches)) {
+  Touches touches;
+  const bool priors = any_prior(res.prior_sd);
+  const bool by_touches = !priors && !res.layout.fit_gravity && data.has_probe() && without_lengths(data, touches.rows);
+  if (by_touches) {
     IdentifyResult scratch = res;
-    touches_at = x;
-    fit_frames(pm, frames_only, nominal, touches, opt, touches_at, scratch);
+    touches.at = x;
+    fit_frames(pm, frames_only, nominal, touches.rows, opt, touches.at, scratch);
   }
   fit_frames(pm, frames_only, nominal, data, opt, x, res);
-  const Linearization at_start = fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd, touches_at);
+  const Linearization at_start =
+      fix_unidentifiable(pm, nominal, data, x, opt, res, res.prior_sd, by_touches ? &touches : nullptr);
   const std::vector<int> free_idx = free_parameters(data, res, res.prior_sd);
   // stage 2: everything identifiable, its first evaluation the linearization at the start
   Stage2 s2(pm, data, x, opt, res);

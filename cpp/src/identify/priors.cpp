@@ -51,6 +51,10 @@ std::vector<std::pair<std::string, double>> default_prior_sd() {
   return {{"joint_mm", 1.0}, {"joint_rad", 0.1 * deg}, {"tool_mm", 5.0}, {"tool_rad", 1.0 * deg}};
 }
 
+bool any_prior(const std::vector<double>& sd) {
+  return std::any_of(sd.begin(), sd.end(), [](double s) { return std::isfinite(s); });
+}
+
 std::vector<double> prior_sds(const ParamLayout& L, const IdentifyOptions& opt) {
   std::vector<double> sd(L.size, std::numeric_limits<double>::infinity());
   if (opt.prior_scale == 0) return sd;

@@ -76,14 +76,17 @@ struct Linearization {
 /// (prior_sd: one per parameter, finite where it has one) what only the data leave undetermined is
 /// no error: it stays free, determined by its prior (res.at_prior), or is held when it has none.
 /// Without priors and with the gravity's moments not fitted, a probe campaign whose known lengths
-/// (its artifact's distances) alone see the arm's overall scale is judged on its touches at
-/// `touches_at` (the frames fitted without those lengths; empty: x), the parameter held there for
+/// (its artifact's distances) alone see the arm's overall scale is judged on its `touches` (the rows
+/// and the frames fitted without those lengths; none: as any campaign), the parameter held there for
 /// the scale then freed: the same touches with and without a length hold the same parameters but
 /// that one.
+struct Touches {
+  MeasurementSet rows;     ///< the campaign without its known lengths (without_lengths)
+  std::vector<double> at;  ///< the frames these rows alone give (the nominal geometry's)
+};
 Linearization fix_unidentifiable(const PointModel& pm, const Model& nominal, const MeasurementSet& data,
                                  std::vector<double>& x, const IdentifyOptions& opt, IdentifyResult& res,
-                                 const std::vector<double>& prior_sd = {},
-                                 const std::vector<double>& touches_at = {});
+                                 const std::vector<double>& prior_sd = {}, const Touches* touches = nullptr);
 
 /// The set without its artifact's known distances (its angles kept); whether it had any.
 bool without_lengths(const MeasurementSet& data, MeasurementSet& out);

@@ -23,6 +23,9 @@ struct PenaltyTerm {
 /// an unknown kind or a standard deviation or scale that is not a positive finite number.
 std::vector<double> prior_sds(const ParamLayout& L, const IdentifyOptions& opt);
 
+/// Whether any parameter has a prior (a finite standard deviation of prior_sds).
+bool any_prior(const std::vector<double>& sd);
+
 /// The prior terms of the free parameters that have one, centred on the start: weight noise / sd
 /// (the data's residuals weigh 1 / noise, so the cost is the negative log posterior times noise^2).
 std::vector<PenaltyTerm> prior_terms(const std::vector<double>& sd, const std::vector<double>& start,
